@@ -1,0 +1,142 @@
+//! Per-contact records for the solver, and the contact law data.
+//!
+//! A contact α found at `q_m` carries its local frame `(n, t)` (n towards the
+//! candidate, `t = n` rotated by +90°) and the maps `H*` of eq. (5): for each of
+//! its two bodies the generalized directions `h_n = (n_x, n_y, r × n)` and
+//! `h_t = (t_x, t_y, r × t)`, `r` being the lever arm from the centre of mass to
+//! the contact point. The relative velocity of candidate `a` with respect to
+//! antagonist `b` is `U_N = h_n^a · u_a − h_n^b · u_b` (same for `U_T`), and the
+//! impulse `P` adds `M⁻¹ h P` to `u_a` and subtracts it from `u_b` (eq. 6, 12).
+//!
+//! **Gap prediction.** A contact open at `q_m` (`g_m > 0`) closes only if it
+//! would reach the next step's intermediate configuration overlapping: the normal
+//! law acts on the gap predicted there, `g_m + h U_N ≥ 0`, i.e. `U_N ≥ −g_m/h`.
+//! The end-of-step gap is then `g_f = g_m + θ h U_N ≥ (1 − θ) g_m ≥ 0`, and the
+//! next detection finds the contact at zero gap, where `U_N ≥ 0` holds it
+//! (an impact completes over two steps, without overlap). Enforcing `g_f ≥ 0`
+//! instead (`U_N ≥ −g_m/(θh)`) would close the gap at `q_f` but keep the approach
+//! velocity, so the next `q_m` overlaps by `(1 − θ) h |U_N|` and that overlap
+//! would stay. A contact already overlapping at `q_m` (round-off, rotation,
+//! solver tolerance) obeys the velocity Signorini law `U_N ≥ 0` (eq. 8): its
+//! overlap does not grow and no energy is injected to push it out.
+//!
+//! **Restitution (§2.8).** The law is applied to the weighted mean `U⁺ + e U⁻`
+//! (eq. 11 with `U⁺` replaced). Normally: a contact that closes with `U_N⁻ < 0`
+//! leaves with `U_N⁺ = −e_n U_N⁻`. Tangentially the Coulomb law acts on
+//! `U_T⁺ + e_t U_T⁻`.
+
+use super::coulomb::Delassus;
+use crate::geometry::{cross, perp, Vec2};
+use serde::{Deserialize, Serialize};
+
+/// Identifies a contact across steps: candidate, antagonist, feature pair.
+pub type ContactKey = (u32, u32, u32);
+
+/// The solver's record of one contact: contiguous, everything one update needs.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ContactRow {
+    pub a: u32,
+    pub b: u32,
+    pub hn_a: [f64; 3],
+    pub ht_a: [f64; 3],
+    pub hn_b: [f64; 3],
+    pub ht_b: [f64; 3],
+    pub w: Delassus,
+    /// Impulse `(P_N, P_T)` (N·s).
+    pub p: [f64; 2],
+    /// Open while `U_N ≥ s_open` (m/s).
+    pub s_open: f64,
+    /// Normal velocity enforced once closed (m/s).
+    pub c_closed: f64,
+    /// `e_t U_T⁻` added to `U_T` (m/s).
+    pub shift_t: f64,
+    pub mu: f64,
+}
+
+/// Cold per-contact data, parallel to the rows.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+pub struct ContactGeom {
+    pub key: ContactKey,
+    /// Contact point at `q_m` (m).
+    pub point: Vec2,
+    /// Unit normal towards the candidate.
+    pub normal: Vec2,
+    /// Gap at `q_m` (m).
+    pub gap: f64,
+}
+
+/// Friction and restitution between two materials.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ContactLaw {
+    pub friction: f64,
+    pub restitution_n: f64,
+    pub restitution_t: f64,
+}
+
+impl Default for ContactLaw {
+    fn default() -> Self {
+        Self { friction: 0.0, restitution_n: 0.0, restitution_t: 0.0 }
+    }
+}
+
+#[inline(always)]
+pub fn dot3(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+fn wdot(h: &[f64; 3], im: &[f64; 3], g: &[f64; 3]) -> f64 {
+    h[0] * im[0] * g[0] + h[1] * im[1] * g[1] + h[2] * im[2] * g[2]
+}
+
+/// Generalized direction `(d_x, d_y, r × d)`.
+#[inline(always)]
+pub fn gen_dir(r: Vec2, d: Vec2) -> [f64; 3] {
+    [d.x, d.y, cross(r, d)]
+}
+
+impl ContactRow {
+    /// Builds the row of a contact at point `p` with normal `n` between bodies with
+    /// centres `ga`, `gb`, inverse masses `im_a`, `im_b`, velocities at the start of
+    /// the step `ua`, `ub` (for `U⁻`), gap `gap` at `q_m`, time step `h` (s).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        (a, b): (u32, u32),
+        p: Vec2,
+        n: Vec2,
+        (ga, gb): (Vec2, Vec2),
+        (im_a, im_b): (&[f64; 3], &[f64; 3]),
+        (ua, ub): (&[f64; 3], &[f64; 3]),
+        gap: f64,
+        h: f64,
+        law: &ContactLaw,
+    ) -> Self {
+        let t = perp(n);
+        let (ra, rb) = (p - ga, p - gb);
+        let (hn_a, ht_a, hn_b, ht_b) = (gen_dir(ra, n), gen_dir(ra, t), gen_dir(rb, n), gen_dir(rb, t));
+        let w = Delassus {
+            nn: wdot(&hn_a, im_a, &hn_a) + wdot(&hn_b, im_b, &hn_b),
+            nt: wdot(&hn_a, im_a, &ht_a) + wdot(&hn_b, im_b, &ht_b),
+            tt: wdot(&ht_a, im_a, &ht_a) + wdot(&ht_b, im_b, &ht_b),
+        };
+        let un_minus = dot3(&hn_a, ua) - dot3(&hn_b, ub);
+        let ut_minus = dot3(&ht_a, ua) - dot3(&ht_b, ub);
+        let s_open = if gap > 0.0 { -gap / h } else { 0.0 };
+        let c_closed =
+            if law.restitution_n > 0.0 && un_minus < 0.0 { s_open.max(-law.restitution_n * un_minus) } else { s_open };
+        Self {
+            a,
+            b,
+            hn_a,
+            ht_a,
+            hn_b,
+            ht_b,
+            w,
+            p: [0.0; 2],
+            s_open,
+            c_closed,
+            shift_t: law.restitution_t * ut_minus,
+            mu: law.friction,
+        }
+    }
+}

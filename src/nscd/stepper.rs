@@ -1,0 +1,188 @@
+//! One time step of the Moreau–Jean θ-method (Saussine et al. 2006, §2.2, §2.7):
+//!
+//! 1. `q_m = q_i + (1 − θ) h u_i` and `t_m = t_i + (1 − θ) h`;
+//! 2. contact detection at `q_m`, contact frames and `H`, `H*`, `W` frozen there;
+//! 3. `u_free = u_i + h M⁻¹ F(q_m, t_m)` (gravity and external loads); imposed
+//!    velocity components take their value at `t_f`;
+//! 4. NLGS on `u_f = u_free + M⁻¹ Σ H P` (eq. 12–15), warm-started with the
+//!    impulses of the previous step matched by contact key;
+//! 5. `q_f = q_m + θ h u_f`.
+//!
+//! After the step the state is checked: a non-finite value or an overlap deeper
+//! than half the smaller inradius of the two bodies stops the run with an error
+//! naming the step and body, and the state goes back to the start of the step.
+
+use super::contact::ContactRow;
+use super::nlgs::{apply_impulses, solve_nlgs};
+use super::system::{StepStats, System};
+use crate::error::{Error, Result};
+use crate::geometry::Vec2;
+
+impl System {
+    /// Advances by one step of `params.dt`.
+    pub fn step(&mut self) -> Result<StepStats> {
+        let h = self.params.dt;
+        let theta = self.params.theta;
+        let n = self.bodies.len();
+        let (t_i, t_m, t_f) = (self.time, self.time + (1.0 - theta) * h, self.time + h);
+        let mut ws = std::mem::take(&mut self.ws);
+        ws.q_i.clone_from(&self.bodies.q);
+        ws.u_i.clone_from(&self.bodies.u);
+        let _ = t_i;
+
+        // 1. Intermediate configuration.
+        ws.q_m.clone_from(&self.bodies.q);
+        let mut v_max: f64 = 0.0;
+        for i in 0..n {
+            let u = self.bodies.u[i];
+            for d in 0..3 {
+                ws.q_m[i][d] += (1.0 - theta) * h * u[d];
+            }
+            let r = self.bodies.info[i].shape.bounding_radius();
+            v_max = v_max.max(u[0].hypot(u[1]) + u[2].abs() * r);
+        }
+        // 2. Detection.
+        let alert = self.params.alert_distance.max(2.0 * h * v_max);
+        ws.detector.run(&self.bodies, &ws.q_m, alert);
+        ws.rows.clear();
+        ws.geoms.clear();
+        let mut prev = 0;
+        for (key, c) in &ws.detector.found {
+            let (a, b) = (key.0 as usize, key.1 as usize);
+            let ga = Vec2::new(ws.q_m[a][0], ws.q_m[a][1]);
+            let gb = Vec2::new(ws.q_m[b][0], ws.q_m[b][1]);
+            let mut row = ContactRow::new(
+                (key.0, key.1),
+                c.point,
+                c.normal,
+                (ga, gb),
+                (&self.bodies.inv_m[a], &self.bodies.inv_m[b]),
+                (&ws.u_i[a], &ws.u_i[b]),
+                c.gap,
+                h,
+                self.law(a, b),
+            );
+            // Warm start: both lists are sorted by key.
+            while prev < self.contacts.len() && self.contacts[prev].key < *key {
+                prev += 1;
+            }
+            if prev < self.contacts.len() && self.contacts[prev].key == *key {
+                row.p = self.impulses[prev];
+            }
+            ws.rows.push(row);
+            ws.geoms.push(super::contact::ContactGeom { key: *key, point: c.point, normal: c.normal, gap: c.gap });
+        }
+        ws.spring_rows.clear();
+        for s in &self.springs {
+            ws.spring_rows.push(s.row((&ws.q_i, &ws.u_i), &ws.q_m, &self.bodies.inv_m, h, theta));
+        }
+
+        // 3. Free velocity.
+        let g = self.params.gravity;
+        for i in 0..n {
+            let info = &self.bodies.info[i];
+            if info.fixed {
+                continue;
+            }
+            let mut f = [info.mass * g[0], info.mass * g[1], 0.0];
+            for load in &info.loads {
+                let l = load.at(t_m);
+                f[0] += l[0];
+                f[1] += l[1];
+            }
+            let im = self.bodies.inv_m[i];
+            let u = &mut self.bodies.u[i];
+            for d in 0..3 {
+                u[d] += h * im[d] * f[d];
+                if let Some(v) = info.imposed.dof[d] {
+                    u[d] = v.at(t_f);
+                }
+            }
+        }
+
+        // 4. NLGS.
+        apply_impulses(&mut self.bodies.u, &self.bodies.inv_m, &ws.rows, &ws.spring_rows);
+        let report = solve_nlgs(
+            &self.params.nlgs,
+            &mut self.bodies.u,
+            &self.bodies.inv_m,
+            &mut ws.rows,
+            &mut ws.spring_rows,
+        );
+
+        // 5. Final configuration.
+        for i in 0..n {
+            let u = self.bodies.u[i];
+            for d in 0..3 {
+                self.bodies.q[i][d] = ws.q_m[i][d] + theta * h * u[d];
+            }
+        }
+
+        // Statistics and sanity checks.
+        let mut stats = StepStats {
+            time: t_f,
+            step: self.step + 1,
+            contacts: ws.rows.len(),
+            iterations: report.iterations,
+            criterion: report.criterion,
+            converged: report.converged,
+            ..Default::default()
+        };
+        let mut sum_overlap = 0.0;
+        let mut failure = None;
+        for (r, geom) in ws.rows.iter().zip(&ws.geoms) {
+            let (ua, ub) = (&self.bodies.u[r.a as usize], &self.bodies.u[r.b as usize]);
+            let un = super::contact::dot3(&r.hn_a, ua) - super::contact::dot3(&r.hn_b, ub);
+            let g_f = geom.gap + theta * h * un;
+            let overlap = (-g_f).max(0.0);
+            if r.p[0] > 0.0 || overlap > 0.0 {
+                stats.active_contacts += 1;
+                sum_overlap += overlap;
+            }
+            stats.max_overlap = stats.max_overlap.max(overlap);
+            let limit = 0.5
+                * self.bodies.info[r.a as usize]
+                    .shape
+                    .inner_radius()
+                    .min(self.bodies.info[r.b as usize].shape.inner_radius());
+            if (overlap > limit || !g_f.is_finite()) && failure.is_none() {
+                failure = Some((r.a as usize, format!("runaway overlap {overlap:.3e} m with body {}", r.b)));
+            }
+        }
+        if stats.active_contacts > 0 {
+            stats.mean_overlap = sum_overlap / stats.active_contacts as f64;
+        }
+        for i in 0..n {
+            let bad = self.bodies.q[i].iter().chain(&self.bodies.u[i]).any(|x| !x.is_finite());
+            if bad {
+                failure = Some((i, "non-finite position or velocity".to_string()));
+                break;
+            }
+        }
+        if let Some((body, what)) = failure {
+            self.bodies.q.clone_from(&ws.q_i);
+            self.bodies.u.clone_from(&ws.u_i);
+            self.ws = ws;
+            return Err(Error::Diverged {
+                step: self.step + 1,
+                body,
+                name: self.bodies.info[body].name.clone(),
+                what,
+            });
+        }
+        stats.kinetic_energy = self.bodies.kinetic_energy();
+
+        // Keep the contacts and impulses for the next warm start.
+        self.contacts.clear();
+        self.contacts.extend_from_slice(&ws.geoms);
+        self.impulses.clear();
+        self.impulses.extend(ws.rows.iter().map(|r| r.p));
+        for (s, row) in self.springs.iter_mut().zip(&ws.spring_rows) {
+            s.impulse = row.p;
+        }
+        self.time = t_f;
+        self.step += 1;
+        self.ws = ws;
+        Ok(stats)
+    }
+}

@@ -1,0 +1,159 @@
+//! The NSCD system: bodies, springs, contact laws, parameters, clock and the
+//! warm-start memory, all plain serde-serializable data so a driver can read and
+//! set every body's state, checkpoint and resume. Scratch buffers are rebuilt
+//! on demand and never serialized.
+
+use super::bodies::Bodies;
+use super::contact::{ContactGeom, ContactLaw, ContactRow};
+use super::detection::Detector;
+use super::nlgs::NlgsSettings;
+use super::sublayer::{Spring, SpringRow};
+use crate::geometry::Vec2;
+use serde::{Deserialize, Serialize};
+
+/// Time-stepping parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NscdParams {
+    /// Time step `h` (s).
+    pub dt: f64,
+    /// θ of the θ-method, in [0.5, 1].
+    pub theta: f64,
+    /// Gravity (m/s²).
+    pub gravity: [f64; 2],
+    /// Alert distance (m): pairs closer than this are contacts (possibly open).
+    /// Each step it is raised to `2 h v_max` if the fastest body needs it.
+    pub alert_distance: f64,
+    pub nlgs: NlgsSettings,
+}
+
+/// Statistics of one time step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct StepStats {
+    /// Time at the end of the step (s).
+    pub time: f64,
+    pub step: u64,
+    /// Contacts detected (open ones within the alert distance included).
+    pub contacts: usize,
+    /// Contacts carrying a force or overlapping at the end of the step.
+    pub active_contacts: usize,
+    pub iterations: usize,
+    /// Final value of the convergence norm.
+    pub criterion: f64,
+    pub converged: bool,
+    /// Mean overlap over the active contacts at the end of the step (m).
+    pub mean_overlap: f64,
+    /// Largest overlap at the end of the step (m).
+    pub max_overlap: f64,
+    /// Kinetic energy at the end of the step (J).
+    pub kinetic_energy: f64,
+}
+
+/// A contact as seen from outside, with its force over the last step.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ContactInfo {
+    pub candidate: usize,
+    pub antagonist: usize,
+    /// Point (m) and unit normal towards the candidate, at `q_m`.
+    pub point: [f64; 2],
+    pub normal: [f64; 2],
+    /// Gap at `q_m` (m).
+    pub gap: f64,
+    /// Mean normal and tangential force on the candidate over the step (N).
+    pub r_n: f64,
+    pub r_t: f64,
+}
+
+/// Reused buffers.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Workspace {
+    pub q_i: Vec<[f64; 3]>,
+    pub u_i: Vec<[f64; 3]>,
+    pub q_m: Vec<[f64; 3]>,
+    pub rows: Vec<ContactRow>,
+    pub geoms: Vec<ContactGeom>,
+    pub spring_rows: Vec<SpringRow>,
+    pub detector: Detector,
+}
+
+/// The complete state of an NSCD simulation.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct System {
+    pub params: NscdParams,
+    pub bodies: Bodies,
+    pub springs: Vec<Spring>,
+    /// Contact law of material pair `(i, j)` at `i * materials + j`.
+    pub laws: Vec<ContactLaw>,
+    pub materials: usize,
+    /// Time (s) and number of steps done.
+    pub time: f64,
+    pub step: u64,
+    /// Contacts of the last step and their impulses `(P_N, P_T)` (N·s), sorted by
+    /// key: the warm start of the next step.
+    pub contacts: Vec<ContactGeom>,
+    pub impulses: Vec<[f64; 2]>,
+    #[serde(skip)]
+    pub(crate) ws: Workspace,
+}
+
+impl System {
+    /// An empty system with `materials` materials and frictionless, plastic contacts.
+    pub fn new(params: NscdParams, materials: usize) -> Self {
+        Self {
+            params,
+            bodies: Bodies::default(),
+            springs: Vec::new(),
+            laws: vec![ContactLaw::default(); materials * materials],
+            materials,
+            time: 0.0,
+            step: 0,
+            contacts: Vec::new(),
+            impulses: Vec::new(),
+            ws: Workspace::default(),
+        }
+    }
+
+    /// Sets the contact law between materials `i` and `j` (both orders).
+    pub fn set_law(&mut self, i: usize, j: usize, law: ContactLaw) {
+        self.laws[i * self.materials + j] = law;
+        self.laws[j * self.materials + i] = law;
+    }
+
+    #[inline]
+    pub(crate) fn law(&self, a: usize, b: usize) -> &ContactLaw {
+        &self.laws[self.bodies.info[a].material * self.materials + self.bodies.info[b].material]
+    }
+
+    /// Contacts of the last step with their mean forces (N).
+    pub fn contact_forces(&self) -> impl Iterator<Item = ContactInfo> + '_ {
+        let h = self.params.dt;
+        self.contacts.iter().zip(&self.impulses).map(move |(g, p)| ContactInfo {
+            candidate: g.key.0 as usize,
+            antagonist: g.key.1 as usize,
+            point: [g.point.x, g.point.y],
+            normal: [g.normal.x, g.normal.y],
+            gap: g.gap,
+            r_n: p[0] / h,
+            r_t: p[1] / h,
+        })
+    }
+
+    /// Resultant contact force (N) on body `i` over the last step.
+    pub fn contact_resultant(&self, i: usize) -> [f64; 2] {
+        let mut f = Vec2::zeros();
+        for c in self.contact_forces() {
+            let n = Vec2::new(c.normal[0], c.normal[1]);
+            let r = n * c.r_n + crate::geometry::perp(n) * c.r_t;
+            if c.candidate == i {
+                f += r;
+            } else if c.antagonist == i {
+                f -= r;
+            }
+        }
+        [f.x, f.y]
+    }
+
+    /// Mean force (N) of each spring over the last step, pushing its ends apart.
+    pub fn spring_forces(&self) -> impl Iterator<Item = f64> + '_ {
+        self.springs.iter().map(move |s| s.impulse / self.params.dt)
+    }
+}
