@@ -82,8 +82,8 @@ pub fn sweep(u: &mut [[f64; 3]], inv_m: &[[f64; 3]], rows: &mut [ContactRow], sp
                 apply(&mut u[b], &inv_m[b], &s.hn_b, dp, &[0.0; 3], 0.0, -1.0);
             }
         }
-        let du = s.w * dp;
-        norms.add(du * du, p * p, p * s.w * p, dp != 0.0);
+        let (du, wp) = (s.w * dp, s.w * p);
+        norms.add(du * du, p * p, wp * wp, p * wp, dp != 0.0);
     }
     for r in rows.iter_mut() {
         let (a, b) = (r.a as usize, r.b as usize);
@@ -104,7 +104,7 @@ pub fn sweep(u: &mut [[f64; 3]], inv_m: &[[f64; 3]], rows: &mut [ContactRow], sp
         }
         let (dun, dut) = (w.nn * dn + w.nt * dt, w.nt * dn + w.tt * dt);
         let (wqn, wqt) = (w.nn * qn + w.nt * qt, w.nt * qn + w.tt * qt);
-        norms.add(dun * dun + dut * dut, qn * qn + qt * qt, qn * wqn + qt * wqt, changed);
+        norms.add(dun * dun + dut * dut, qn * qn + qt * qt, wqn * wqn + wqt * wqt, qn * wqn + qt * wqt, changed);
     }
     norms
 }
@@ -127,6 +127,9 @@ pub fn solve_nlgs(
         let (value, ok) =
             evaluate(settings.policy, settings.tolerance, settings.max_factor, &norms, previous_wpp);
         previous_wpp = norms.sum_wpp;
+        if std::env::var_os("BALLAST_TRACE").is_some() {
+            eprintln!("sweep {it}: {value:.3e} quad {:.3e} max {:.3e}", norms.quad(), norms.max());
+        }
         report = NlgsReport { iterations: it, criterion: value, converged: ok };
         if ok && it >= settings.min_iterations {
             break;

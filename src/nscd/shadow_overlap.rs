@@ -221,15 +221,18 @@ fn manifold(
         let hi = sr0.max(sr1).min(sk.max(sw));
         let size = (r1 - r0).norm().min((pw - pk).norm());
         if hi - lo > 1e-9 * size {
-            for (slot, s) in [lo, hi].into_iter().enumerate() {
+            // The key must not depend on which polygon holds the reference edge (a
+            // tie for parallel faces): it names both edges and the end along the
+            // final tangent `perp(n)`, `n` from B to A.
+            let (edge_a, edge_b) = if ref_is_b { (inc_edge, edge) } else { (edge, inc_edge) };
+            for (end, s) in [lo, hi].into_iter().enumerate() {
                 let on_ref = r0 + (r1 - r0) * ((s - sr0) / (sr1 - sr0));
                 let on_inc = pk + (pw - pk) * ((s - sk) / (sw - sk));
                 let gap = (on_inc - on_ref).dot(&nb);
                 if gap <= alert {
-                    // Slot 0 is the end nearer the reference edge's first vertex.
-                    let slot = if sr0 <= sr1 { slot as u32 } else { 1 - slot as u32 };
+                    let slot = if to_a > 0.0 { end } else { 1 - end } as u32;
                     emit(ContactPoint {
-                        feature: feature(ref_is_b, edge, SLOT_FLAG | slot),
+                        feature: ((edge_a as u32 & 0x7fff) << 16) | SLOT_FLAG | ((edge_b as u32 & 0x1fff) << 1) | slot,
                         point: 0.5 * (on_ref + on_inc),
                         normal: to_a * nb,
                         gap,

@@ -146,7 +146,10 @@ impl System {
                     .inner_radius()
                     .min(self.bodies.info[r.b as usize].shape.inner_radius());
             if (overlap > limit || !g_f.is_finite()) && failure.is_none() {
-                failure = Some((r.a as usize, format!("runaway overlap {overlap:.3e} m with body {}", r.b)));
+                // Name the body that moved into the other (the candidate unless it is fixed).
+                let (culprit, other) =
+                    if self.bodies.is_mobile(r.a as usize) { (r.a, r.b) } else { (r.b, r.a) };
+                failure = Some((culprit as usize, format!("runaway overlap {overlap:.3e} m with body {other}")));
             }
         }
         if stats.active_contacts > 0 {
