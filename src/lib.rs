@@ -12,6 +12,7 @@ pub mod error;
 pub mod geometry;
 pub mod io;
 pub mod nscd;
+pub mod scenarios;
 pub mod scene;
 
 pub use error::{Error, Result};

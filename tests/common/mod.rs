@@ -19,6 +19,7 @@ pub fn params(dt: f64) -> NscdParams {
             min_iterations: 1,
             max_iterations: 5000,
             max_factor: 16.0,
+            symmetric: false,
         },
     }
 }

@@ -1,0 +1,37 @@
+//! NLGS throughput on the settled 536-pentagon pile of `data/`: contact updates
+//! per second (one update = one row's local solve and velocity scatter). The
+//! problem is the pile's first step restarted cold (`P = 0`, `u = u_free`), so
+//! every sweep does real corrections. Single thread.
+
+use ballast::nscd::nlgs::sweep;
+use ballast::scene::Scene;
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
+use std::hint::black_box;
+
+const SWEEPS: usize = 20;
+
+fn bench(c: &mut Criterion) {
+    let scene = Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/data/pentagon_pile_536.toml")).unwrap();
+    let mut sys = scene.build().unwrap();
+    sys.step().unwrap();
+    let problem = sys.nlgs_problem();
+    let rows = problem.rows.len() + problem.springs.len();
+    eprintln!("{} bodies, {} contact rows", sys.bodies.len(), rows);
+    let mut g = c.benchmark_group("nlgs");
+    g.throughput(Throughput::Elements((rows * SWEEPS) as u64));
+    g.bench_function("sweeps_pentagon_pile_536", |b| {
+        b.iter_batched_ref(
+            || problem.clone(),
+            |p| {
+                for _ in 0..SWEEPS {
+                    black_box(sweep(&mut p.u, &p.inv_m, &mut p.rows, &mut p.springs, false));
+                }
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
