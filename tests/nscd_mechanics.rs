@@ -151,3 +151,40 @@ fn resting_column_does_not_drift_and_floor_carries_its_weight() {
     assert!((-r[1] - weight).abs() < 1e-6 * weight, "floor reaction {} vs weight {weight}", -r[1]);
     assert!(r[0].abs() < 1e-6 * weight);
 }
+
+/// Tangential restitution (§2.8): with friction large enough to stay in the cone,
+/// the weighted-mean law reverses the slip of the contact point, `U_T⁺ = −e_t U_T⁻`,
+/// and the normal velocity becomes `−e_n U_N⁻`.
+#[test]
+fn rough_disc_impact_reverses_slip_by_tangential_restitution() {
+    let h = 1e-6;
+    let mut s = system(h, 10.0, 0.5);
+    s.set_law(0, 0, ballast::nscd::ContactLaw { friction: 10.0, restitution_n: 0.5, restitution_t: 0.3 });
+    floor(&mut s);
+    let r = 0.01;
+    let d = disc(&mut s, r, 0.0, r, false);
+    s.params.gravity = [0.0, 0.0];
+    s.bodies.u[d] = [1.0, -2.0, 0.0];
+    // Contact point velocity relative to the floor: v + ω × (0, −r) = (vx + ω r, vy).
+    let slip = |u: [f64; 3]| u[0] + u[2] * r;
+    let before = (slip(s.bodies.u[d]), s.bodies.u[d][1]);
+    while s.bodies.u[d][1] < 0.0 {
+        s.step().unwrap();
+    }
+    let after = (slip(s.bodies.u[d]), s.bodies.u[d][1]);
+    // The local law is solved exactly (the friction needed, |ΔP_T|/ΔP_N ≈ 0.25, is far
+    // inside the cone μ = 10), so the normal velocity is exact to round-off. The
+    // contact point is taken at q_m, where the disc overlaps the floor by up to
+    // h |v_N|: its lever arm differs from r by 2e-4 r, hence 1e-3 on the slip.
+    assert!((after.1 + 0.5 * before.1).abs() < 1e-9, "normal {after:?} vs {before:?}");
+    assert!((after.0 + 0.3 * before.0).abs() < 1e-3 * before.0.abs(), "slip {after:?} vs {before:?}");
+}
+
+/// θ outside [0.5, 1] is refused by the library too, not only by scene files.
+#[test]
+fn theta_out_of_range_is_an_error() {
+    let mut s = system(1e-3, 0.5, 0.0);
+    s.params.theta = 0.3;
+    let e = s.step().unwrap_err().to_string();
+    assert!(e.contains("theta"), "{e}");
+}

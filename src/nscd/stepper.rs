@@ -21,14 +21,14 @@ use crate::geometry::Vec2;
 impl System {
     /// Advances by one step of `params.dt`.
     pub fn step(&mut self) -> Result<StepStats> {
+        self.params.check()?;
         let h = self.params.dt;
         let theta = self.params.theta;
         let n = self.bodies.len();
-        let (t_i, t_m, t_f) = (self.time, self.time + (1.0 - theta) * h, self.time + h);
+        let (t_m, t_f) = (self.time + (1.0 - theta) * h, self.time + h);
         let mut ws = std::mem::take(&mut self.ws);
         ws.q_i.clone_from(&self.bodies.q);
         ws.u_i.clone_from(&self.bodies.u);
-        let _ = t_i;
 
         // 1. Intermediate configuration.
         ws.q_m.clone_from(&self.bodies.q);
