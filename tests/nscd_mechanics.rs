@@ -97,7 +97,13 @@ fn pentagon_dropped_with_zero_restitution_does_not_bounce() {
     // No bounce: the centre stays at the resting height, to the contact tolerance
     // (the impact is resolved with the gap predicted to close within the step).
     assert!(highest_after - rest < 1e-6, "rose {} m above rest", highest_after - rest);
-    assert!((s.bodies.q[b][1] - rest).abs() < 1e-6, "final y {} rest {rest} q {:?} u {:?}", s.bodies.q[b][1], s.bodies.q[b], s.bodies.u[b]);
+    assert!(
+        (s.bodies.q[b][1] - rest).abs() < 1e-6,
+        "final y {} rest {rest} q {:?} u {:?}",
+        s.bodies.q[b][1],
+        s.bodies.q[b],
+        s.bodies.u[b]
+    );
 }
 
 /// A square dropped flat from h0 with e = 0.5 rebounds to e² h0.

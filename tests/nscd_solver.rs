@@ -22,10 +22,9 @@ fn impact_scene(policy: Policy, drop: f64) -> System {
     let side = 0.01;
     for k in 0..150 {
         let i = rect(&mut s, side, side, -0.9 + 0.012 * k as f64, side / 2.0, 0.0, false);
-        s.bodies.info[i].loads.push(ballast::nscd::Load {
-            direction: [0.0, -1.0],
-            force: ballast::nscd::Harmonic::constant(500.0),
-        });
+        s.bodies.info[i]
+            .loads
+            .push(ballast::nscd::Load { direction: [0.0, -1.0], force: ballast::nscd::Harmonic::constant(500.0) });
     }
     for k in 0..12 {
         rect(&mut s, side, side, 0.95, side * (k as f64 + 0.5), 0.0, false);
@@ -128,4 +127,24 @@ fn runaway_overlap_stops_with_the_step_and_body() {
     s.bodies.u[b][0] = f64::NAN;
     let e = s.step().unwrap_err().to_string();
     assert!(e.contains("step 3") && e.contains("bullet") && e.contains("non-finite"), "{e}");
+}
+
+/// A body flung to an absurd position stops the run with an error (no panic or
+/// hang in the tile grid), and a fixed body ignores an imposed velocity.
+#[test]
+fn runaway_position_is_an_error_and_fixed_bodies_never_move() {
+    let mut s = system(1e-3, 0.5, 0.0);
+    floor(&mut s);
+    let b = rect(&mut s, 0.01, 0.01, 0.0, 0.5, 0.0, false);
+    s.bodies.q[b][0] = 1e300;
+    let e = s.step().unwrap_err().to_string();
+    assert!(e.contains("step 1") && e.contains("runaway position"), "{e}");
+
+    let mut s = system(1e-3, 0.5, 0.0);
+    let f = floor(&mut s);
+    let mut info = s.bodies.info[f].clone();
+    info.imposed.dof[0] = Some(ballast::nscd::Harmonic::constant(1.0));
+    let g = s.bodies.push(info, [0.0, -0.5, 0.0], [0.0; 3]);
+    run(&mut s, 10);
+    assert_eq!(s.bodies.q[g], [0.0, -0.5, 0.0]);
 }

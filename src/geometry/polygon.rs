@@ -114,10 +114,7 @@ impl ConvexPolygon {
             })
             .collect();
         let circumradius = vertices.iter().map(|p| p.norm()).fold(0.0, f64::max);
-        let inradius = (0..n)
-            .map(|k| -vertices[k].dot(&normals[k]))
-            .fold(f64::INFINITY, f64::min)
-            .abs();
+        let inradius = (0..n).map(|k| -vertices[k].dot(&normals[k])).fold(f64::INFINITY, f64::min).abs();
         Self { vertices, normals, circumradius, inradius }
     }
 

@@ -63,10 +63,12 @@ impl Bodies {
         if info.fixed {
             u = [0.0; 3];
         }
-        for d in 0..3 {
-            if let Some(f) = info.imposed.dof[d] {
-                inv[d] = 0.0;
-                u[d] = f.at(0.0);
+        if !info.fixed {
+            for d in 0..3 {
+                if let Some(f) = info.imposed.dof[d] {
+                    inv[d] = 0.0;
+                    u[d] = f.at(0.0);
+                }
             }
         }
         self.info.push(info);

@@ -54,12 +54,18 @@ impl Grid {
                 hi[d] = hi[d].max(b.max[d]);
             }
         }
-        // Keep the tile count within a few times the body count.
-        let mut cell = cell.max(f64::MIN_POSITIVE);
+        // Keep the tile count within a few times the body count. Extents are finite
+        // (the stepper checks q_m first); the tile count is capped so that a very
+        // spread-out system degrades to larger tiles, never to an overflow.
+        let span = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+        if !span.is_finite() {
+            return;
+        }
+        let mut cell = cell.max(span / (4 * n + 64) as f64).max(f64::MIN_POSITIVE);
         let dims = |c: f64| {
             (
-                (((hi[0] - lo[0]) / c).floor() as usize + 1).max(1),
-                (((hi[1] - lo[1]) / c).floor() as usize + 1).max(1),
+                (((hi[0] - lo[0]) / c).floor() as usize).saturating_add(1),
+                (((hi[1] - lo[1]) / c).floor() as usize).saturating_add(1),
             )
         };
         let (mut nx, mut ny) = dims(cell);

@@ -28,8 +28,7 @@ impl Harmonic {
         if self.amplitude == 0.0 {
             self.mean
         } else {
-            self.mean
-                + self.amplitude * (std::f64::consts::TAU * self.frequency * t - self.phase).cos()
+            self.mean + self.amplitude * (std::f64::consts::TAU * self.frequency * t - self.phase).cos()
         }
     }
 }

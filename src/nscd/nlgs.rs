@@ -35,7 +35,14 @@ pub struct NlgsSettings {
 
 impl Default for NlgsSettings {
     fn default() -> Self {
-        Self { policy: Policy::Quad, tolerance: 1e-4, min_iterations: 1, max_iterations: 1000, max_factor: 16.0, symmetric: false }
+        Self {
+            policy: Policy::Quad,
+            tolerance: 1e-4,
+            min_iterations: 1,
+            max_iterations: 1000,
+            max_factor: 16.0,
+            symmetric: false,
+        }
     }
 }
 
@@ -160,8 +167,7 @@ pub fn solve_nlgs(
     for it in 1..=settings.max_iterations {
         let backwards = settings.symmetric && it % 2 == 0;
         let norms = sweep(u, inv_m, rows, springs, backwards);
-        let (value, ok) =
-            evaluate(settings.policy, settings.tolerance, settings.max_factor, &norms, previous_wpp);
+        let (value, ok) = evaluate(settings.policy, settings.tolerance, settings.max_factor, &norms, previous_wpp);
         previous_wpp = norms.sum_wpp;
         report = NlgsReport { iterations: it, criterion: value, converged: ok };
         if ok && it >= settings.min_iterations {

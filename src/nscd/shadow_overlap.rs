@@ -204,7 +204,7 @@ fn manifold(
     let r0 = rp.vertices[edge];
     let r1 = rp.vertices[(edge + 1) % nr_len];
     let nr = rp.normals[edge]; // outward of the reference polygon, towards the incident one
-    // Sign turning "from reference to incident" into "from antagonist B to candidate A".
+                               // Sign turning "from reference to incident" into "from antagonist B to candidate A".
     let to_a = if ref_is_b { 1.0 } else { -1.0 };
     let pen = |p: Vec2| (r0 - p).dot(&nr);
     let (prev, next) = ((inc + ni_len - 1) % ni_len, (inc + 1) % ni_len);

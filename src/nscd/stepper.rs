@@ -33,13 +33,21 @@ impl System {
         // 1. Intermediate configuration.
         ws.q_m.clone_from(&self.bodies.q);
         let mut v_max: f64 = 0.0;
-        for i in 0..n {
-            let u = self.bodies.u[i];
-            for d in 0..3 {
-                ws.q_m[i][d] += (1.0 - theta) * h * u[d];
+        for ((qm, u), info) in ws.q_m.iter_mut().zip(&self.bodies.u).zip(&self.bodies.info) {
+            for (q, v) in qm.iter_mut().zip(u) {
+                *q += (1.0 - theta) * h * v;
             }
-            let r = self.bodies.info[i].shape.bounding_radius();
-            v_max = v_max.max(u[0].hypot(u[1]) + u[2].abs() * r);
+            v_max = v_max.max(u[0].hypot(u[1]) + u[2].abs() * info.shape.bounding_radius());
+        }
+        if let Some(i) = ws.q_m.iter().position(|q| q.iter().any(|x| !x.is_finite() || x.abs() > 1e12)) {
+            self.bodies.u.clone_from(&ws.u_i);
+            self.ws = ws;
+            return Err(Error::Diverged {
+                step: self.step + 1,
+                body: i,
+                name: self.bodies.info[i].name.clone(),
+                what: "non-finite or runaway position".into(),
+            });
         }
         // 2. Detection.
         let alert = self.params.alert_distance.max(2.0 * h * v_max);
@@ -102,19 +110,13 @@ impl System {
 
         // 4. NLGS.
         apply_impulses(&mut self.bodies.u, &self.bodies.inv_m, &ws.rows, &ws.spring_rows);
-        let report = solve_nlgs(
-            &self.params.nlgs,
-            &mut self.bodies.u,
-            &self.bodies.inv_m,
-            &mut ws.rows,
-            &mut ws.spring_rows,
-        );
+        let report =
+            solve_nlgs(&self.params.nlgs, &mut self.bodies.u, &self.bodies.inv_m, &mut ws.rows, &mut ws.spring_rows);
 
         // 5. Final configuration.
-        for i in 0..n {
-            let u = self.bodies.u[i];
+        for ((q, qm), u) in self.bodies.q.iter_mut().zip(&ws.q_m).zip(&self.bodies.u) {
             for d in 0..3 {
-                self.bodies.q[i][d] = ws.q_m[i][d] + theta * h * u[d];
+                q[d] = qm[d] + theta * h * u[d];
             }
         }
 
@@ -147,8 +149,7 @@ impl System {
                     .min(self.bodies.info[r.b as usize].shape.inner_radius());
             if (overlap > limit || !g_f.is_finite()) && failure.is_none() {
                 // Name the body that moved into the other (the candidate unless it is fixed).
-                let (culprit, other) =
-                    if self.bodies.is_mobile(r.a as usize) { (r.a, r.b) } else { (r.b, r.a) };
+                let (culprit, other) = if self.bodies.is_mobile(r.a as usize) { (r.a, r.b) } else { (r.b, r.a) };
                 failure = Some((culprit as usize, format!("runaway overlap {overlap:.3e} m with body {other}")));
             }
         }
@@ -166,14 +167,22 @@ impl System {
             self.bodies.q.clone_from(&ws.q_i);
             self.bodies.u.clone_from(&ws.u_i);
             self.ws = ws;
-            return Err(Error::Diverged {
-                step: self.step + 1,
-                body,
-                name: self.bodies.info[body].name.clone(),
-                what,
-            });
+            return Err(Error::Diverged { step: self.step + 1, body, name: self.bodies.info[body].name.clone(), what });
         }
         stats.kinetic_energy = self.bodies.kinetic_energy();
+        if !stats.kinetic_energy.is_finite() {
+            let i =
+                (0..n).max_by(|&a, &b| self.bodies.u[a][0].abs().total_cmp(&self.bodies.u[b][0].abs())).unwrap_or(0);
+            self.bodies.q.clone_from(&ws.q_i);
+            self.bodies.u.clone_from(&ws.u_i);
+            self.ws = ws;
+            return Err(Error::Diverged {
+                step: self.step + 1,
+                body: i,
+                name: self.bodies.info[i].name.clone(),
+                what: "kinetic energy overflow".into(),
+            });
+        }
 
         // Keep the contacts and impulses for the next warm start.
         self.contacts.clear();

@@ -29,25 +29,25 @@ pub struct NscdParams {
 impl NscdParams {
     /// Checks the ranges the scheme needs; the message names the parameter.
     pub fn check(&self) -> crate::Result<()> {
-        let bad = |what: &str, v: f64| Err(crate::Error::Scene(format!("nscd.{what}: out of range, got {v}")));
+        let bad = |what: &str, v: f64| Err(crate::Error::Scene(format!("{what}: out of range, got {v}")));
         if !(self.dt.is_finite() && self.dt > 0.0) {
-            return bad("dt", self.dt);
+            return bad("simulation.dt", self.dt);
         }
         if !(0.5..=1.0).contains(&self.theta) {
-            return bad("theta (must be in [0.5, 1])", self.theta);
+            return bad("nscd.theta (must be in [0.5, 1])", self.theta);
         }
         if !(self.alert_distance.is_finite() && self.alert_distance >= 0.0) {
-            return bad("alert_distance", self.alert_distance);
+            return bad("nscd.alert_distance", self.alert_distance);
         }
         let n = &self.nlgs;
         if !(n.tolerance.is_finite() && n.tolerance > 0.0) {
-            return bad("tolerance", n.tolerance);
+            return bad("nscd.tolerance", n.tolerance);
         }
         if n.min_iterations < 1 || n.max_iterations < n.min_iterations {
-            return bad("max_iterations (must be >= min_iterations >= 1)", n.max_iterations as f64);
+            return bad("nscd.max_iterations (must be >= min_iterations >= 1)", n.max_iterations as f64);
         }
         if self.gravity.iter().any(|g| !g.is_finite()) {
-            return bad("gravity", self.gravity[0] + self.gravity[1]);
+            return bad("simulation.gravity", self.gravity[0] + self.gravity[1]);
         }
         Ok(())
     }

@@ -63,7 +63,11 @@ pub fn pentagon_deposit(spec: &DepositSpec) -> String {
     let wall = 0.05;
     let mut s = String::new();
     let _ = writeln!(s, "# Loose pentagon deposit: {} grains, seed {}.", radii.len(), spec.seed);
-    let _ = writeln!(s, "[simulation]\nengine = \"nscd\"\ndt = {:e}\nduration = {}\ngravity = [0.0, -9.81]\nseed = {}\n", spec.dt, spec.duration, spec.seed);
+    let _ = writeln!(
+        s,
+        "[simulation]\nengine = \"nscd\"\ndt = {:e}\nduration = {}\ngravity = [0.0, -9.81]\nseed = {}\n",
+        spec.dt, spec.duration, spec.seed
+    );
     let _ = writeln!(s, "[nscd]\ntheta = 0.5\ncriterion = \"quad_max\"\ntolerance = 1.0e-4\nmin_iterations = 1\nmax_iterations = 2000\n");
     let _ = writeln!(s, "[output]\nevery = 50\n");
     let _ = writeln!(s, "[[material]]\nname = \"grain\"\ndensity = {}\n", spec.density);
@@ -79,7 +83,10 @@ pub fn pentagon_deposit(spec: &DepositSpec) -> String {
         ("left_wall", rect(-w / 2.0 - wall, 0.0, -w / 2.0, height)),
         ("right_wall", rect(w / 2.0, 0.0, w / 2.0 + wall, height)),
     ] {
-        let _ = writeln!(s, "[[body]]\nname = \"{name}\"\nmaterial = \"wall\"\npolygon = {poly}\nposition = [0.0, 0.0]\nfixed = true\n");
+        let _ = writeln!(
+            s,
+            "[[body]]\nname = \"{name}\"\nmaterial = \"wall\"\npolygon = {poly}\nposition = [0.0, 0.0]\nfixed = true\n"
+        );
     }
     let x0 = -w / 2.0 + 0.5 * (w - (cols as f64 - 1.0) * pitch);
     for (k, r) in radii.iter().enumerate() {

@@ -1,0 +1,85 @@
+//! Output files of a run, all in one output directory:
+//!
+//! - `series.csv`: one row of step statistics every `output.every` steps
+//!   ([`series::SeriesWriter`]);
+//! - `final.json`: the state of every body at the end ([`final_state::FinalState`]);
+//! - `scene.toml`: a byte copy of the input scene ([`copy_scene`]);
+//! - `final_scene.toml`: the input scene with the final state, to restart from;
+//! - `run.json`: seed, engine, crate version, number of steps, time step ([`RunInfo`]).
+//!
+//! Every I/O error names the file it happened on.
+
+pub mod final_state;
+pub mod series;
+
+use crate::error::{Error, Result};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+pub use final_state::{BodyState, FinalState};
+pub use series::{SeriesWriter, SERIES_HEADER};
+
+/// An I/O error with the path it happened on in its message.
+pub fn io_error(path: &Path, what: &str, e: std::io::Error) -> Error {
+    Error::Io(std::io::Error::new(e.kind(), format!("cannot {what} '{}': {e}", path.display())))
+}
+
+/// Creates the output directory `dir` (and its parents) if needed.
+pub fn create_output_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| io_error(dir, "create output directory", e))
+}
+
+/// Removes `dir/name` if it exists.
+pub fn remove_stale(dir: &Path, name: &str) -> Result<()> {
+    let path = dir.join(name);
+    match std::fs::remove_file(&path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(io_error(&path, "remove", e)),
+        _ => Ok(()),
+    }
+}
+
+/// Writes `text` to `dir/name`, returning the path.
+pub fn write_text(dir: &Path, name: &str, text: &str) -> Result<PathBuf> {
+    let path = dir.join(name);
+    std::fs::write(&path, text).map_err(|e| io_error(&path, "write", e))?;
+    Ok(path)
+}
+
+/// Copies the scene file `scene` byte for byte to `dir/scene.toml`.
+pub fn copy_scene(scene: &Path, dir: &Path) -> Result<PathBuf> {
+    let bytes = std::fs::read(scene).map_err(|e| io_error(scene, "read", e))?;
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, bytes).map_err(|e| io_error(&path, "write", e))?;
+    Ok(path)
+}
+
+/// Contents of `run.json`: what is needed to reproduce a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunInfo {
+    /// Random seed of the scene.
+    pub seed: u64,
+    /// Engine name (`"nscd"`).
+    pub engine: String,
+    /// Version of `ballast` that made the run.
+    pub version: String,
+    /// Number of time steps asked for, `round(duration / dt)`.
+    pub steps: u64,
+    /// Time step (s).
+    pub dt: f64,
+}
+
+impl RunInfo {
+    /// Writes `dir/run.json`.
+    pub fn write(&self, dir: &Path) -> Result<PathBuf> {
+        write_json(&dir.join("run.json"), self)
+    }
+}
+
+/// Writes `value` as pretty JSON (with a final newline) to `path`.
+pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<PathBuf> {
+    let mut text =
+        serde_json::to_string_pretty(value).map_err(|e| io_error(path, "serialize", std::io::Error::other(e)))?;
+    text.push('\n');
+    std::fs::write(path, text).map_err(|e| io_error(path, "write", e))?;
+    Ok(path.to_path_buf())
+}

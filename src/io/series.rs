@@ -1,0 +1,66 @@
+//! `series.csv`: one row of [`StepStats`] per output step.
+//!
+//! Columns ([`SERIES_HEADER`]): `time` (s), `kinetic_energy` (J), `contacts`,
+//! `active_contacts`, `iterations` (NLGS sweeps), `criterion` (final value of
+//! the convergence norm), `converged` (1 or 0), `mean_overlap` (m),
+//! `max_overlap` (m). Floats are written with `{:e}`, the shortest text that
+//! reads back to the same `f64`.
+
+use super::io_error;
+use crate::error::Result;
+use crate::nscd::StepStats;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// Header line of `series.csv` (without the newline).
+pub const SERIES_HEADER: &str =
+    "time,kinetic_energy,contacts,active_contacts,iterations,criterion,converged,mean_overlap,max_overlap";
+
+/// Buffered writer of `series.csv`.
+#[derive(Debug)]
+pub struct SeriesWriter {
+    path: PathBuf,
+    out: BufWriter<File>,
+    rows: u64,
+}
+
+impl SeriesWriter {
+    /// Creates (truncates) the file at `path` and writes the header.
+    pub fn create(path: &Path) -> Result<Self> {
+        let file = File::create(path).map_err(|e| io_error(path, "create", e))?;
+        let mut w = Self { path: path.to_path_buf(), out: BufWriter::new(file), rows: 0 };
+        writeln!(w.out, "{SERIES_HEADER}").map_err(|e| io_error(path, "write", e))?;
+        Ok(w)
+    }
+
+    /// Appends the row of one step.
+    pub fn write(&mut self, s: &StepStats) -> Result<()> {
+        writeln!(
+            self.out,
+            "{:e},{:e},{},{},{},{:e},{},{:e},{:e}",
+            s.time,
+            s.kinetic_energy,
+            s.contacts,
+            s.active_contacts,
+            s.iterations,
+            s.criterion,
+            u8::from(s.converged),
+            s.mean_overlap,
+            s.max_overlap
+        )
+        .map_err(|e| io_error(&self.path, "write", e))?;
+        self.rows += 1;
+        Ok(())
+    }
+
+    /// Number of rows written (header excluded).
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// Flushes the file.
+    pub fn finish(mut self) -> Result<()> {
+        self.out.flush().map_err(|e| io_error(&self.path, "write", e))
+    }
+}

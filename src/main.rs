@@ -1,0 +1,171 @@
+//! The `ballast` command line.
+//!
+//! `ballast run SCENE.toml --out DIR [--quiet]` loads and validates the scene,
+//! builds the system, makes `round(duration / dt)` steps and writes
+//! `series.csv`, `final.json`, `scene.toml`, `final_scene.toml` and `run.json`
+//! in `DIR` (see [`ballast::io`]).
+//!
+//! Exit codes: 0 on success; 2 for an invalid scene or command line (one line
+//! `error: …` on stderr); 1 if the run diverges (`series.csv` and `final.json`
+//! then hold the last good state) or an output file cannot be written.
+
+use ballast::io::{self, FinalState, RunInfo, SeriesWriter};
+use ballast::nscd::StepStats;
+use ballast::scene::Scene;
+use ballast::Error;
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(Debug, Parser)]
+#[command(name = "ballast", version, about = "Granular mechanics under cyclic loading (railway ballast settlement)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Runs a scene and writes its outputs to a directory.
+    Run {
+        /// The scene file (TOML, see docs/scene-format.md).
+        scene: PathBuf,
+        /// Output directory (created if needed; existing output files are overwritten).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+}
+
+/// Why a command failed, and its exit code.
+enum Failure {
+    /// Invalid input: exit code 2.
+    Input(Error),
+    /// The run or its outputs failed: exit code 1.
+    Run(Error),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run { scene, out, quiet } => run(&scene, &out, quiet),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Input(e)) => {
+            eprintln!("error: {}", one_line(&e));
+            ExitCode::from(2)
+        }
+        Err(Failure::Run(e)) => {
+            eprintln!("error: {}", one_line(&e));
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// The error's message on a single line.
+fn one_line(e: &Error) -> String {
+    e.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr());
+    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {msg} [{elapsed_precise} < {eta}]") {
+        pb.set_style(style);
+    }
+    pb
+}
+
+/// `ballast run`.
+fn run(scene_path: &Path, out: &Path, quiet: bool) -> Result<(), Failure> {
+    let scene = Scene::load(scene_path).map_err(Failure::Input)?;
+    let mut sys = scene.build().map_err(Failure::Input)?;
+    let steps = scene.steps();
+    let every = scene.output_every();
+
+    io::create_output_dir(out).map_err(Failure::Run)?;
+    // A final scene left by an earlier run would pass for this run's.
+    io::remove_stale(out, "final_scene.toml").map_err(Failure::Run)?;
+    io::copy_scene(scene_path, out).map_err(Failure::Run)?;
+    let info = RunInfo {
+        seed: scene.seed(),
+        engine: scene.simulation.engine.clone(),
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        steps,
+        dt: scene.simulation.dt,
+    };
+    info.write(out).map_err(Failure::Run)?;
+    let mut series = SeriesWriter::create(&out.join("series.csv")).map_err(Failure::Run)?;
+
+    let pb = progress_bar(steps, quiet);
+    let message_every = (steps / 1000).max(1);
+    let started = Instant::now();
+    let mut last: Option<(StepStats, bool)> = None;
+    let mut max_overlap: f64 = 0.0;
+    let mut unconverged = 0u64;
+    let mut diverged = None;
+    for k in 1..=steps {
+        match sys.step() {
+            Ok(stats) => {
+                max_overlap = max_overlap.max(stats.max_overlap);
+                unconverged += u64::from(!stats.converged);
+                let written = k % every == 0 || k == steps;
+                if written {
+                    series.write(&stats).map_err(Failure::Run)?;
+                }
+                last = Some((stats, written));
+                if k % message_every == 0 {
+                    pb.set_message(format!("t = {:.4} s, Ek = {:.3e} J", stats.time, stats.kinetic_energy));
+                }
+                pb.inc(1);
+            }
+            Err(e) => {
+                diverged = Some(e);
+                break;
+            }
+        }
+    }
+    pb.finish_and_clear();
+    if let Some((stats, false)) = last {
+        // The run stopped early: keep the last good step in the series.
+        series.write(&stats).map_err(Failure::Run)?;
+    }
+    series.finish().map_err(Failure::Run)?;
+    FinalState::of(&sys).write(&out.join("final.json")).map_err(Failure::Run)?;
+    if let Some(e) = diverged {
+        return Err(Failure::Run(e));
+    }
+    let state = scene.with_state(&sys).to_toml_string().map_err(Failure::Run)?;
+    let final_scene = format!(
+        "# Written by ballast {}: the state of {} at t = {} s (step {}).\n\
+         # Rerun it with `ballast run`; time restarts at 0.\n\n{}",
+        env!("CARGO_PKG_VERSION"),
+        scene_path.display().to_string().replace(char::is_control, "?"),
+        sys.time,
+        sys.step,
+        state
+    );
+    io::write_text(out, "final_scene.toml", &final_scene).map_err(Failure::Run)?;
+
+    let energy = last.map_or(0.0, |(s, _)| s.kinetic_energy);
+    println!(
+        "{} steps to t = {:.6} s in {:.2} s: {} bodies, final kinetic energy {:.3e} J, max overlap {:.3e} m, {} \
+         steps not converged; outputs in {}",
+        sys.step,
+        sys.time,
+        started.elapsed().as_secs_f64(),
+        sys.bodies.len(),
+        energy,
+        max_overlap,
+        unconverged,
+        out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,434 @@
+//! The serde mirror of the TOML scene format (see `docs/scene-format.md`).
+//!
+//! Every table refuses unknown keys. Optional keys are `Option`s (or empty
+//! vectors) so that a scene written back with [`Scene::to_toml_string`] keeps
+//! exactly the keys the user gave; the defaults live in the accessor methods and
+//! the `DEFAULT_*` constants. All quantities are SI.
+
+use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
+use serde::{Deserialize, Serialize};
+use std::marker::PhantomData;
+
+/// Default gravity (m/s²).
+pub const DEFAULT_GRAVITY: [f64; 2] = [0.0, -9.81];
+/// Default out-of-plane thickness (m).
+pub const DEFAULT_THICKNESS: f64 = 1.0;
+/// Default θ of the Moreau–Jean θ-method.
+pub const DEFAULT_THETA: f64 = 0.5;
+/// Default convergence criterion of the NLGS.
+pub const DEFAULT_CRITERION: &str = "quad";
+/// Default NLGS tolerance (dimensionless).
+pub const DEFAULT_TOLERANCE: f64 = 1.0e-4;
+/// Default minimum number of NLGS sweeps per step.
+pub const DEFAULT_MIN_ITERATIONS: usize = 1;
+/// Default maximum number of NLGS sweeps per step.
+pub const DEFAULT_MAX_ITERATIONS: usize = 1000;
+/// Default `max_factor` of the `quad_max` criterion.
+pub const DEFAULT_MAX_FACTOR: f64 = 16.0;
+/// Default alert distance, as a fraction of the smallest inner radius (m/m).
+pub const DEFAULT_ALERT_FRACTION: f64 = 0.01;
+/// Default number of steps between two rows of `series.csv`.
+pub const DEFAULT_OUTPUT_EVERY: u64 = 1;
+
+/// A whole scene file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// `[simulation]`: engine, time step, duration, gravity, thickness, seed.
+    pub simulation: Simulation,
+    /// `[nscd]`: settings of the NSCD engine (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nscd: Option<NscdSection>,
+    /// `[output]`: output settings (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output: Option<OutputSection>,
+    /// `[[material]]` entries; a material's index is its position here.
+    #[serde(default, rename = "material", skip_serializing_if = "Vec::is_empty")]
+    pub materials: Vec<Material>,
+    /// `[[contact]]` entries: contact laws between pairs of materials.
+    #[serde(default, rename = "contact", skip_serializing_if = "Vec::is_empty")]
+    pub contacts: Vec<ContactEntry>,
+    /// `[[body]]` entries, in order (body `i` of the system is `bodies[i]`).
+    #[serde(default, rename = "body", skip_serializing_if = "Vec::is_empty")]
+    pub bodies: Vec<BodySpec>,
+    /// `[[spring]]` entries: viscoelastic sublayer springs.
+    #[serde(default, rename = "spring", skip_serializing_if = "Vec::is_empty")]
+    pub springs: Vec<SpringSpec>,
+}
+
+/// `[simulation]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Simulation {
+    /// Engine name; only `"nscd"` is implemented.
+    pub engine: String,
+    /// Time step `h` (s), > 0.
+    pub dt: f64,
+    /// Simulated duration (s), > 0; the run makes `round(duration / dt)` steps.
+    pub duration: f64,
+    /// Gravity (m/s²); default [`DEFAULT_GRAVITY`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "opt_pair")]
+    pub gravity: Option<[f64; 2]>,
+    /// Out-of-plane thickness (m), > 0; default [`DEFAULT_THICKNESS`]. A body
+    /// of area `A` (m²) and density `ρ` (kg/m³) has mass `ρ A thickness` (kg).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<f64>,
+    /// Random seed, recorded in the outputs; default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+}
+
+impl Simulation {
+    /// Gravity (m/s²).
+    pub fn gravity(&self) -> [f64; 2] {
+        self.gravity.unwrap_or(DEFAULT_GRAVITY)
+    }
+
+    /// Out-of-plane thickness (m).
+    pub fn thickness(&self) -> f64 {
+        self.thickness.unwrap_or(DEFAULT_THICKNESS)
+    }
+}
+
+/// `[nscd]`: every key is optional.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NscdSection {
+    /// θ of the θ-method, in [0.5, 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub theta: Option<f64>,
+    /// `"strict"`, `"quad"`, `"quad_max"` or `"energy"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub criterion: Option<String>,
+    /// NLGS tolerance (dimensionless), in (0, 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// Minimum NLGS sweeps per step, ≥ 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_iterations: Option<usize>,
+    /// Maximum NLGS sweeps per step, ≥ `min_iterations`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_iterations: Option<usize>,
+    /// `quad_max`: the maximum norm may reach `max_factor · tolerance`; ≥ 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_factor: Option<f64>,
+    /// Alternate forward and backward NLGS sweeps (symmetric Gauss–Seidel); default false.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub symmetric: Option<bool>,
+    /// Alert distance (m), ≥ 0; default: [`DEFAULT_ALERT_FRACTION`] times the
+    /// smallest inner radius of the non-fixed bodies (of all bodies if none moves).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alert_distance: Option<f64>,
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSection {
+    /// Steps between two rows of `series.csv`, ≥ 1 (the last step always has a row).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub every: Option<u64>,
+}
+
+/// `[[material]]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Unique, non-empty name.
+    pub name: String,
+    /// Density (kg/m³), > 0.
+    pub density: f64,
+}
+
+/// `[[contact]]`: the contact law between two materials. Pairs of materials
+/// without an entry are frictionless, with zero restitution.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactEntry {
+    /// The two material names (may be the same material twice).
+    #[serde(deserialize_with = "pair")]
+    pub between: [String; 2],
+    /// Coulomb friction coefficient, ≥ 0.
+    pub friction: f64,
+    /// Normal restitution coefficient, in [0, 1]; default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub restitution: Option<f64>,
+    /// Tangential restitution coefficient, in [0, 1]; default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tangential_restitution: Option<f64>,
+}
+
+/// `regular = { sides, radius }`: a regular polygon.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegularSpec {
+    /// Number of sides, ≥ 3.
+    pub sides: usize,
+    /// Circumradius (m), > 0; the first vertex is on the body-frame +x axis.
+    pub radius: f64,
+}
+
+/// `[[body]]`: one rigid body. Exactly one of `polygon`, `regular`, `disc`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Optional name (default empty); non-empty names are unique.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub name: String,
+    /// Name of the body's material.
+    pub material: String,
+    /// Convex polygon: vertices (m) in the body frame, counter-clockwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "opt_points")]
+    pub polygon: Option<Vec<[f64; 2]>>,
+    /// Regular polygon centred on the body-frame origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub regular: Option<RegularSpec>,
+    /// Disc of this radius (m) centred on the body-frame origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub disc: Option<f64>,
+    /// World position of the body-frame origin (m).
+    #[serde(deserialize_with = "pair")]
+    pub position: [f64; 2],
+    /// Angle of the body frame (rad), counter-clockwise; default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle: Option<f64>,
+    /// Velocity of the body-frame origin (m/s); default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "opt_pair")]
+    pub velocity: Option<[f64; 2]>,
+    /// Angular velocity (rad/s), counter-clockwise; default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spin: Option<f64>,
+    /// A fixed body never moves; default false.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fixed: Option<bool>,
+    /// Imposed velocity components.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub imposed: Option<ImposedSpec>,
+    /// External force at the centre of mass.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load: Option<LoadSpec>,
+}
+
+impl BodySpec {
+    /// Angle (rad).
+    pub fn angle(&self) -> f64 {
+        self.angle.unwrap_or(0.0)
+    }
+
+    /// Velocity of the body-frame origin (m/s).
+    pub fn velocity(&self) -> [f64; 2] {
+        self.velocity.unwrap_or([0.0, 0.0])
+    }
+
+    /// Spin (rad/s).
+    pub fn spin(&self) -> f64 {
+        self.spin.unwrap_or(0.0)
+    }
+
+    /// Whether the body is fixed.
+    pub fn is_fixed(&self) -> bool {
+        self.fixed.unwrap_or(false)
+    }
+}
+
+/// `imposed = { vx, vy, spin }`: imposed velocity components of the centre of
+/// mass (m/s) and spin (rad/s); absent components are free.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImposedSpec {
+    /// Imposed x velocity of the centre of mass (m/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vx: Option<Drive>,
+    /// Imposed y velocity of the centre of mass (m/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vy: Option<Drive>,
+    /// Imposed spin (rad/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spin: Option<Drive>,
+}
+
+/// A time-dependent value: a constant, or `mean + amplitude·cos(2π·frequency·t − phase)`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Drive {
+    /// A constant value (unit of the driven quantity).
+    Constant(f64),
+    /// A harmonic value.
+    Harmonic(HarmonicSpec),
+}
+
+impl Drive {
+    /// As the engine's harmonic law.
+    pub fn to_harmonic(self) -> crate::nscd::Harmonic {
+        match self {
+            Drive::Constant(v) => crate::nscd::Harmonic::constant(v),
+            Drive::Harmonic(h) => h.to_harmonic(),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Drive {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct DriveVisitor;
+        impl<'de> Visitor<'de> for DriveVisitor {
+            type Value = Drive;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number or a table { mean, amplitude, frequency, phase }")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Drive, E> {
+                Ok(Drive::Constant(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Drive, E> {
+                Ok(Drive::Constant(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Drive, E> {
+                Ok(Drive::Constant(v as f64))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Drive, A::Error> {
+                HarmonicSpec::deserialize(de::value::MapAccessDeserializer::new(map)).map(Drive::Harmonic)
+            }
+        }
+        d.deserialize_any(DriveVisitor)
+    }
+}
+
+/// `{ mean, amplitude, frequency, phase }`:
+/// `mean + amplitude·cos(2π·frequency·t − phase)`; `amplitude`, `frequency` (Hz)
+/// and `phase` (rad) default to 0.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HarmonicSpec {
+    /// Mean value (unit of the driven quantity).
+    pub mean: f64,
+    /// Amplitude (unit of the driven quantity); default 0.
+    #[serde(default)]
+    pub amplitude: f64,
+    /// Frequency (Hz); default 0.
+    #[serde(default)]
+    pub frequency: f64,
+    /// Phase (rad); default 0.
+    #[serde(default)]
+    pub phase: f64,
+}
+
+impl HarmonicSpec {
+    /// As the engine's harmonic law.
+    pub fn to_harmonic(self) -> crate::nscd::Harmonic {
+        crate::nscd::Harmonic {
+            mean: self.mean,
+            amplitude: self.amplitude,
+            frequency: self.frequency,
+            phase: self.phase,
+        }
+    }
+}
+
+/// `load = { direction, mean, amplitude, frequency, phase }`: the force
+/// `(mean + amplitude·cos(2π·frequency·t − phase)) · unit(direction)` (N) at the
+/// centre of mass.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// Direction of the force (any non-zero length; it is normalised).
+    #[serde(deserialize_with = "pair")]
+    pub direction: [f64; 2],
+    /// Mean force (N).
+    pub mean: f64,
+    /// Amplitude (N); default 0.
+    #[serde(default)]
+    pub amplitude: f64,
+    /// Frequency (Hz); default 0.
+    #[serde(default)]
+    pub frequency: f64,
+    /// Phase (rad); default 0.
+    #[serde(default)]
+    pub phase: f64,
+}
+
+/// `[[spring]]`: a viscoelastic sublayer spring (law (17), see
+/// [`crate::nscd::sublayer`]) between a point of `body` and either a world
+/// `anchor` or a point of the body `other`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringSpec {
+    /// Name of the first body.
+    pub body: String,
+    /// Attachment on `body` (m), in its body frame (relative to the body-frame
+    /// origin, like polygon vertices); default `[0, 0]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "opt_pair")]
+    pub point: Option<[f64; 2]>,
+    /// World anchor point (m); exactly one of `anchor` and `other`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "opt_pair")]
+    pub anchor: Option<[f64; 2]>,
+    /// Name of the second body; exactly one of `anchor` and `other`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub other: Option<String>,
+    /// Attachment on `other` (m), in its body frame; default `[0, 0]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "opt_pair")]
+    pub other_point: Option<[f64; 2]>,
+    /// Force per unit strain `k_N` (N), ≥ 0.
+    pub k_n: f64,
+    /// Force per unit strain rate `ν` (N·s), ≥ 0; default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nu: Option<f64>,
+    /// Rest length `L0` (m), > 0; default: the initial length.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rest_length: Option<f64>,
+    /// Prestrain `ε0`; default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prestrain: Option<f64>,
+    /// Only pushes the ends apart; default false.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compression_only: Option<bool>,
+}
+
+/// Visitor of an array of exactly two `T` (serde's own `[T; 2]` lets `toml`
+/// ignore extra elements).
+struct PairVisitor<T>(PhantomData<T>);
+
+impl<'de, T: Deserialize<'de>> Visitor<'de> for PairVisitor<T> {
+    type Value = [T; 2];
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("an array of exactly 2 elements")
+    }
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<[T; 2], A::Error> {
+        let x: T = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(0, &self))?;
+        let y: T = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(1, &self))?;
+        let mut n = 2;
+        while seq.next_element::<de::IgnoredAny>()?.is_some() {
+            n += 1;
+        }
+        if n > 2 {
+            return Err(de::Error::invalid_length(n, &self));
+        }
+        Ok([x, y])
+    }
+}
+
+/// A pair that is exactly two elements long.
+#[derive(Debug, Clone, Copy)]
+struct Pair<T>([T; 2]);
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for Pair<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_seq(PairVisitor(PhantomData)).map(Pair)
+    }
+}
+
+fn pair<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<[T; 2], D::Error> {
+    Pair::deserialize(d).map(|p| p.0)
+}
+
+fn opt_pair<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
+    Pair::deserialize(d).map(|p| Some(p.0))
+}
+
+fn opt_points<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<[f64; 2]>>, D::Error> {
+    Vec::<Pair<f64>>::deserialize(d).map(|v| Some(v.into_iter().map(|p| p.0).collect()))
+}

@@ -1,0 +1,89 @@
+//! TOML scene files: parsing, validation, building an [`nscd::System`](crate::nscd::System)
+//! and saving a system's state back as a scene. The format is documented in
+//! `docs/scene-format.md`; all quantities are SI.
+//!
+//! ```
+//! let scene = ballast::scene::Scene::from_toml_str(r#"
+//!     [simulation]
+//!     engine = "nscd"
+//!     dt = 1e-3
+//!     duration = 0.01
+//!     [[material]]
+//!     name = "grain"
+//!     density = 2700.0
+//!     [[body]]
+//!     material = "grain"
+//!     disc = 0.01
+//!     position = [0.0, 0.0]
+//! "#).unwrap();
+//! assert_eq!(scene.steps(), 10);
+//! let sys = scene.build().unwrap();
+//! assert_eq!(sys.bodies.len(), 1);
+//! ```
+
+mod build;
+mod format;
+mod parse;
+mod validate;
+mod write;
+
+pub use format::*;
+pub use validate::{MAX_LENGTH, MAX_SIDES, MAX_STEPS, MIN_SIZE};
+
+use crate::error::{Error, Result};
+use std::path::Path;
+
+impl Scene {
+    /// Parses and fully validates a scene. Errors are [`Error::Scene`] with a
+    /// single-line message; TOML syntax errors, unknown keys and missing fields
+    /// read `scene.toml line L: …`.
+    pub fn from_toml_str(text: &str) -> Result<Scene> {
+        Self::from_toml_str_named(text, "scene.toml")
+    }
+
+    /// As [`Scene::from_toml_str`], with `name` in place of `scene.toml` in the
+    /// messages of syntax errors.
+    pub fn from_toml_str_named(text: &str, name: &str) -> Result<Scene> {
+        let scene: Scene = toml::from_str(text).map_err(|e| Error::Scene(parse::one_line(name, text, &e)))?;
+        validate::check(&scene)?;
+        Ok(scene)
+    }
+
+    /// Reads, parses and validates the scene file at `path`; syntax errors name
+    /// the file as given. A file that cannot be read is an [`Error::Scene`] too.
+    pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::Scene(format!("cannot read scene file '{}': {e}", path.display())))?;
+        Self::from_toml_str_named(&text, &path.display().to_string())
+    }
+
+    /// The scene as TOML text, laid out like a hand-written scene (only the keys
+    /// the scene has, inline tables for `regular`, `imposed` and `load`), which
+    /// [`Scene::from_toml_str`] reads back to an equal scene: floats are written
+    /// in their shortest exact form. It does not fail at present; the `Result`
+    /// leaves room for formats that might.
+    pub fn to_toml_string(&self) -> Result<String> {
+        Ok(write::to_toml(self))
+    }
+
+    /// Number of time steps of the run, `round(duration / dt)` (0 if `dt` is not positive).
+    pub fn steps(&self) -> u64 {
+        let n = (self.simulation.duration / self.simulation.dt).round();
+        if n.is_finite() && n >= 0.0 {
+            n.min(MAX_STEPS) as u64
+        } else {
+            0
+        }
+    }
+
+    /// Random seed recorded in the outputs (default 0).
+    pub fn seed(&self) -> u64 {
+        self.simulation.seed.unwrap_or(0)
+    }
+
+    /// Number of steps between two rows of `series.csv` (default 1, never 0).
+    pub fn output_every(&self) -> u64 {
+        self.output.as_ref().and_then(|o| o.every).unwrap_or(DEFAULT_OUTPUT_EVERY).max(1)
+    }
+}

@@ -1,0 +1,432 @@
+//! Validation of a parsed scene: every value is checked (finite, in range,
+//! names resolved, shapes convex) and resolved into the data needed to build a
+//! system. Each error is one line naming the section or body and the field, e.g.
+//! `body[3] 'block': polygon: non-convex polygon: the turn at vertex 2 is clockwise`.
+
+use super::format::{
+    BodySpec, Drive, Scene, DEFAULT_ALERT_FRACTION, DEFAULT_CRITERION, DEFAULT_MAX_FACTOR, DEFAULT_MAX_ITERATIONS,
+    DEFAULT_MIN_ITERATIONS, DEFAULT_THETA, DEFAULT_TOLERANCE,
+};
+use crate::error::{Error, Result};
+use crate::geometry::{rotate, ConvexPolygon, Shape, Vec2};
+use crate::nscd::{NlgsSettings, Policy};
+use std::collections::HashMap;
+
+/// Largest number of steps a scene may ask for (2⁵³, where `f64` stops counting exactly).
+pub const MAX_STEPS: f64 = 9.007_199_254_740_992e15;
+
+/// Largest coordinate or size (m) a scene may use, so that the contact
+/// detection grid stays finite.
+pub const MAX_LENGTH: f64 = 1.0e9;
+/// Smallest size (radius of the enclosing circle, m) of a body.
+pub const MIN_SIZE: f64 = 1.0e-9;
+
+/// Largest number of sides of a `regular` polygon.
+pub const MAX_SIDES: usize = 10_000;
+
+/// A body resolved by validation.
+#[derive(Debug, Clone)]
+pub(crate) struct CheckedBody {
+    /// Shape centred on its centroid.
+    pub shape: Shape,
+    /// Centroid in the scene's body frame (m).
+    pub centroid: Vec2,
+    pub material: usize,
+    /// Mass (kg) and polar inertia about the centroid (kg·m²).
+    pub mass: f64,
+    pub inertia: f64,
+}
+
+/// A spring resolved by validation.
+#[derive(Debug, Clone)]
+pub(crate) struct CheckedSpring {
+    pub a: usize,
+    /// Attachment on `a` in the scene's body frame (m).
+    pub point_a: [f64; 2],
+    pub b: Option<usize>,
+    /// Attachment on `b` in its scene body frame, or the world anchor (m).
+    pub point_b: [f64; 2],
+    pub rest_length: f64,
+}
+
+/// Everything validation resolved.
+#[derive(Debug, Clone)]
+pub(crate) struct Checked {
+    pub nlgs: NlgsSettings,
+    pub theta: f64,
+    pub alert_distance: f64,
+    pub bodies: Vec<CheckedBody>,
+    pub springs: Vec<CheckedSpring>,
+}
+
+/// `v` in plain notation when that is short, else in scientific notation.
+pub(crate) fn num(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+fn err<T>(msg: String) -> Result<T> {
+    Err(Error::Scene(msg))
+}
+
+/// `ctx: must be finite, got …` unless `v` is finite.
+fn finite(ctx: &str, v: f64) -> Result<f64> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        err(format!("{ctx}: must be finite, got {}", num(v)))
+    }
+}
+
+fn finite2(ctx: &str, v: [f64; 2]) -> Result<[f64; 2]> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(v)
+    } else {
+        err(format!("{ctx}: must be finite, got [{}, {}]", num(v[0]), num(v[1])))
+    }
+}
+
+/// A finite point whose coordinates are within [`MAX_LENGTH`].
+fn coordinates(ctx: &str, v: [f64; 2]) -> Result<[f64; 2]> {
+    finite2(ctx, v)?;
+    if v.iter().all(|x| x.abs() <= MAX_LENGTH) {
+        Ok(v)
+    } else {
+        err(format!("{ctx}: coordinates must be within ±{MAX_LENGTH:e} m, got [{}, {}]", num(v[0]), num(v[1])))
+    }
+}
+
+fn positive(ctx: &str, v: f64) -> Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        err(format!("{ctx}: must be positive and finite, got {}", num(v)))
+    }
+}
+
+fn non_negative(ctx: &str, v: f64) -> Result<f64> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        err(format!("{ctx}: must be non-negative and finite, got {}", num(v)))
+    }
+}
+
+fn in_unit(ctx: &str, v: f64) -> Result<f64> {
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        err(format!("{ctx}: must be in [0, 1], got {}", num(v)))
+    }
+}
+
+/// `body[3] 'block'`, or `body[3]` for an unnamed body.
+pub(crate) fn body_label(i: usize, b: &BodySpec) -> String {
+    if b.name.is_empty() {
+        format!("body[{i}]")
+    } else {
+        format!("body[{i}] '{}'", b.name)
+    }
+}
+
+/// The shape of a body (centred on its centroid) and its centroid in the
+/// scene's body frame, or the message of why the shape is refused.
+pub(crate) fn shape_of(b: &BodySpec) -> std::result::Result<(Shape, Vec2), String> {
+    let given = [b.polygon.is_some(), b.regular.is_some(), b.disc.is_some()];
+    match given.iter().filter(|&&x| x).count() {
+        0 => return Err("shape: missing, give exactly one of polygon, regular, disc".into()),
+        1 => {}
+        _ => return Err("shape: give exactly one of polygon, regular, disc, not several".into()),
+    }
+    if let Some(p) = &b.polygon {
+        ConvexPolygon::new(p).map(|(p, c)| (Shape::Polygon(p), c)).map_err(|e| format!("polygon: {e}"))
+    } else if let Some(r) = &b.regular {
+        if r.sides > MAX_SIDES {
+            return Err(format!("regular: at most {MAX_SIDES} sides, got {}", r.sides));
+        }
+        ConvexPolygon::regular(r.sides, r.radius)
+            .map(|p| (Shape::Polygon(p), Vec2::zeros()))
+            .map_err(|e| format!("regular: {e}"))
+    } else {
+        let r = b.disc.unwrap_or(0.0);
+        Shape::disc(r).map(|s| (s, Vec2::zeros())).map_err(|e| format!("disc: {e}"))
+    }
+}
+
+/// The policy named `name`.
+fn policy(name: &str) -> Option<Policy> {
+    [Policy::Strict, Policy::Quad, Policy::QuadMax, Policy::Energy].into_iter().find(|p| p.name() == name)
+}
+
+fn check_drive(ctx: &str, d: Drive) -> Result<()> {
+    match d {
+        Drive::Constant(v) => finite(ctx, v).map(|_| ()),
+        Drive::Harmonic(h) => {
+            finite(&format!("{ctx}.mean"), h.mean)?;
+            finite(&format!("{ctx}.amplitude"), h.amplitude)?;
+            finite(&format!("{ctx}.frequency"), h.frequency)?;
+            finite(&format!("{ctx}.phase"), h.phase)?;
+            Ok(())
+        }
+    }
+}
+
+/// Checks the whole scene and resolves names, shapes and defaults.
+pub(crate) fn check(scene: &Scene) -> Result<Checked> {
+    // [simulation]
+    let sim = &scene.simulation;
+    match sim.engine.as_str() {
+        "nscd" => {}
+        "md" => return err("simulation.engine: 'md' is not implemented yet (only 'nscd' is)".into()),
+        other => return err(format!("simulation.engine: unknown engine '{other}', expected 'nscd'")),
+    }
+    let dt = positive("simulation.dt", sim.dt)?;
+    let duration = positive("simulation.duration", sim.duration)?;
+    let steps = (duration / dt).round();
+    if steps < 1.0 {
+        return err(format!(
+            "simulation.duration: {} s is shorter than half a time step (dt = {} s)",
+            num(duration),
+            num(dt)
+        ));
+    }
+    if steps > MAX_STEPS {
+        return err(format!("simulation.duration: duration/dt = {steps:e} steps is too many"));
+    }
+    finite2("simulation.gravity", sim.gravity())?;
+    let thickness = positive("simulation.thickness", sim.thickness())?;
+
+    // [nscd]
+    let ns = scene.nscd.clone().unwrap_or_default();
+    let theta = ns.theta.unwrap_or(DEFAULT_THETA);
+    if !(0.5..=1.0).contains(&theta) {
+        return err(format!("nscd.theta: must be in [0.5, 1], got {}", num(theta)));
+    }
+    let criterion = ns.criterion.as_deref().unwrap_or(DEFAULT_CRITERION);
+    let Some(policy) = policy(criterion) else {
+        return err(format!(
+            "nscd.criterion: unknown criterion '{criterion}', expected one of 'strict', 'quad', 'quad_max', 'energy'"
+        ));
+    };
+    let tolerance = ns.tolerance.unwrap_or(DEFAULT_TOLERANCE);
+    if !(tolerance > 0.0 && tolerance < 1.0) {
+        return err(format!("nscd.tolerance: must be in (0, 1), got {}", num(tolerance)));
+    }
+    let min_iterations = ns.min_iterations.unwrap_or(DEFAULT_MIN_ITERATIONS);
+    if min_iterations < 1 {
+        return err(format!("nscd.min_iterations: must be at least 1, got {min_iterations}"));
+    }
+    let max_iterations = ns.max_iterations.unwrap_or(DEFAULT_MAX_ITERATIONS.max(min_iterations));
+    if max_iterations < min_iterations {
+        return err(format!(
+            "nscd.max_iterations: must be at least min_iterations = {min_iterations}, got {max_iterations}"
+        ));
+    }
+    let max_factor = ns.max_factor.unwrap_or(DEFAULT_MAX_FACTOR);
+    if !(max_factor.is_finite() && max_factor >= 1.0) {
+        return err(format!("nscd.max_factor: must be finite and at least 1, got {}", num(max_factor)));
+    }
+    if let Some(a) = ns.alert_distance {
+        non_negative("nscd.alert_distance", a)?;
+        if a > MAX_LENGTH {
+            return err(format!("nscd.alert_distance: must be at most {MAX_LENGTH:e} m, got {}", num(a)));
+        }
+    }
+    let nlgs = NlgsSettings {
+        policy,
+        tolerance,
+        min_iterations,
+        max_iterations,
+        max_factor,
+        symmetric: ns.symmetric.unwrap_or(false),
+    };
+
+    // [output]
+    if let Some(every) = scene.output.as_ref().and_then(|o| o.every) {
+        if every < 1 {
+            return err(format!("output.every: must be at least 1, got {every}"));
+        }
+    }
+
+    // [[material]]
+    let mut materials: HashMap<&str, usize> = HashMap::new();
+    for (i, m) in scene.materials.iter().enumerate() {
+        if m.name.is_empty() {
+            return err(format!("material[{i}].name: must not be empty"));
+        }
+        if let Some(j) = materials.insert(m.name.as_str(), i) {
+            return err(format!("material[{i}].name: duplicate material '{}' (also material[{j}])", m.name));
+        }
+        positive(&format!("material[{i}] '{}': density", m.name), m.density)?;
+    }
+
+    // [[contact]]
+    let mut pairs: HashMap<(usize, usize), usize> = HashMap::new();
+    for (i, c) in scene.contacts.iter().enumerate() {
+        let mut ids = [0; 2];
+        for (k, name) in c.between.iter().enumerate() {
+            match materials.get(name.as_str()) {
+                Some(&m) => ids[k] = m,
+                None => return err(format!("contact[{i}].between: unknown material '{name}'")),
+            }
+        }
+        let key = (ids[0].min(ids[1]), ids[0].max(ids[1]));
+        if let Some(j) = pairs.insert(key, i) {
+            return err(format!(
+                "contact[{i}].between: duplicate law for materials '{}' and '{}' (also contact[{j}])",
+                c.between[0], c.between[1]
+            ));
+        }
+        non_negative(&format!("contact[{i}].friction"), c.friction)?;
+        in_unit(&format!("contact[{i}].restitution"), c.restitution.unwrap_or(0.0))?;
+        in_unit(&format!("contact[{i}].tangential_restitution"), c.tangential_restitution.unwrap_or(0.0))?;
+    }
+
+    // [[body]]
+    if scene.bodies.is_empty() {
+        return err("body: the scene has no [[body]]".into());
+    }
+    let mut names: HashMap<&str, usize> = HashMap::new();
+    let mut bodies = Vec::with_capacity(scene.bodies.len());
+    for (i, b) in scene.bodies.iter().enumerate() {
+        let label = body_label(i, b);
+        let ctx = |field: &str| format!("{label}: {field}");
+        if !b.name.is_empty() {
+            if let Some(j) = names.insert(b.name.as_str(), i) {
+                return err(format!("{}: duplicate body name (also body[{j}])", ctx("name")));
+            }
+        }
+        let Some(&material) = materials.get(b.material.as_str()) else {
+            return err(format!("{}: unknown material '{}'", ctx("material"), b.material));
+        };
+        let (shape, centroid) = shape_of(b).map_err(|e| Error::Scene(format!("{label}: {e}")))?;
+        let size = shape.bounding_radius() + centroid.norm();
+        if !(MIN_SIZE..=MAX_LENGTH).contains(&shape.bounding_radius()) || size > MAX_LENGTH {
+            return err(format!(
+                "{}: the body's size {:e} m is outside [{MIN_SIZE:e}, {MAX_LENGTH:e}] m",
+                ctx("shape"),
+                shape.bounding_radius()
+            ));
+        }
+        coordinates(&ctx("position"), b.position)?;
+        finite(&ctx("angle"), b.angle())?;
+        finite2(&ctx("velocity"), b.velocity())?;
+        finite(&ctx("spin"), b.spin())?;
+        if let Some(imp) = &b.imposed {
+            if b.is_fixed() {
+                return err(format!("{}: a fixed body cannot have imposed velocities", ctx("imposed")));
+            }
+            for (name, d) in [("vx", imp.vx), ("vy", imp.vy), ("spin", imp.spin)] {
+                if let Some(d) = d {
+                    check_drive(&ctx(&format!("imposed.{name}")), d)?;
+                }
+            }
+        }
+        if let Some(l) = &b.load {
+            if b.is_fixed() {
+                return err(format!("{}: a fixed body cannot carry a load", ctx("load")));
+            }
+            let d = finite2(&ctx("load.direction"), l.direction)?;
+            let norm = d[0].hypot(d[1]);
+            if !(norm > 0.0 && norm.is_finite()) {
+                return err(format!(
+                    "{}: must be a non-zero vector, got [{}, {}]",
+                    ctx("load.direction"),
+                    num(d[0]),
+                    num(d[1])
+                ));
+            }
+            finite(&ctx("load.mean"), l.mean)?;
+            finite(&ctx("load.amplitude"), l.amplitude)?;
+            finite(&ctx("load.frequency"), l.frequency)?;
+            finite(&ctx("load.phase"), l.phase)?;
+        }
+        let density = scene.materials[material].density;
+        let (area, polar) = shape.area_and_polar_moment();
+        let mass = density * thickness * area;
+        let inertia = density * thickness * polar;
+        if !(mass.is_finite() && mass > 0.0 && inertia.is_finite() && inertia > 0.0) {
+            return err(format!(
+                "{}: mass {mass:e} kg or inertia {inertia:e} kg m^2 (density*thickness*area) is not positive and finite",
+                ctx("shape")
+            ));
+        }
+        bodies.push(CheckedBody { shape, centroid, material, mass, inertia });
+    }
+
+    // [[spring]]
+    let world = |i: usize, p: [f64; 2]| -> Vec2 {
+        let b = &scene.bodies[i];
+        let (s, c) = b.angle().sin_cos();
+        Vec2::new(b.position[0], b.position[1]) + rotate(Vec2::new(p[0], p[1]), c, s)
+    };
+    let mut springs = Vec::with_capacity(scene.springs.len());
+    for (i, s) in scene.springs.iter().enumerate() {
+        let ctx = |field: &str| format!("spring[{i}].{field}");
+        let Some(&a) = names.get(s.body.as_str()) else {
+            return err(format!("{}: unknown body '{}'", ctx("body"), s.body));
+        };
+        let point_a = coordinates(&ctx("point"), s.point.unwrap_or([0.0, 0.0]))?;
+        let (b, point_b, end_b) = match (&s.anchor, &s.other) {
+            (Some(_), Some(_)) => return err(format!("{}: give either anchor or other, not both", ctx("anchor"))),
+            (None, None) => return err(format!("{}: missing, give either anchor or other", ctx("anchor"))),
+            (Some(anchor), None) => {
+                if s.other_point.is_some() {
+                    return err(format!("{}: only allowed with other", ctx("other_point")));
+                }
+                let p = coordinates(&ctx("anchor"), *anchor)?;
+                (None, p, Vec2::new(p[0], p[1]))
+            }
+            (None, Some(other)) => {
+                let Some(&b) = names.get(other.as_str()) else {
+                    return err(format!("{}: unknown body '{other}'", ctx("other")));
+                };
+                if b == a {
+                    return err(format!("{}: the spring joins body '{other}' to itself", ctx("other")));
+                }
+                let p = coordinates(&ctx("other_point"), s.other_point.unwrap_or([0.0, 0.0]))?;
+                (Some(b), p, world(b, p))
+            }
+        };
+        non_negative(&ctx("k_n"), s.k_n)?;
+        non_negative(&ctx("nu"), s.nu.unwrap_or(0.0))?;
+        finite(&ctx("prestrain"), s.prestrain.unwrap_or(0.0))?;
+        let length = (world(a, point_a) - end_b).norm();
+        let rest_length = match s.rest_length {
+            Some(l) => positive(&ctx("rest_length"), l)?,
+            None if length > 0.0 && length.is_finite() => length,
+            None => {
+                return err(format!(
+                    "{}: the initial length is {}, give a positive rest_length",
+                    ctx("rest_length"),
+                    num(length)
+                ))
+            }
+        };
+        springs.push(CheckedSpring { a, point_a, b, point_b, rest_length });
+    }
+
+    // Alert distance.
+    let alert_distance = match ns.alert_distance {
+        Some(a) => a,
+        None => {
+            let inner = |mobile_only: bool| {
+                scene
+                    .bodies
+                    .iter()
+                    .zip(&bodies)
+                    .filter(|(s, _)| !mobile_only || !s.is_fixed())
+                    .map(|(_, b)| b.shape.inner_radius())
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let r = if scene.bodies.iter().any(|b| !b.is_fixed()) { inner(true) } else { inner(false) };
+            DEFAULT_ALERT_FRACTION * r
+        }
+    };
+
+    Ok(Checked { nlgs, theta, alert_distance, bodies, springs })
+}

@@ -1,0 +1,183 @@
+//! Writing a scene back as TOML, laid out like a hand-written scene: one
+//! `[[body]]` table per body with `regular`, `imposed` and `load` as inline
+//! tables, only the keys the scene has, and floats in their shortest form that
+//! reads back to the same `f64`.
+
+use super::format::{BodySpec, Drive, HarmonicSpec, Scene};
+use std::fmt::Write;
+
+/// A float as a TOML float that reads back exactly (`nan`, `inf` included).
+fn float(x: f64) -> String {
+    if x.is_nan() {
+        "nan".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "inf" } else { "-inf" }.into()
+    } else {
+        // `Debug` is the shortest round-trip form and always has a `.` or an exponent.
+        format!("{x:?}")
+    }
+}
+
+/// A TOML basic string.
+fn string(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            '\t' => out.push_str("\\t"),
+            '\r' => out.push_str("\\r"),
+            c if c.is_control() => {
+                let _ = write!(out, "\\u{:04X}", c as u32);
+            }
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+fn pair(p: [f64; 2]) -> String {
+    format!("[{}, {}]", float(p[0]), float(p[1]))
+}
+
+fn harmonic(h: &HarmonicSpec) -> String {
+    format!(
+        "{{ mean = {}, amplitude = {}, frequency = {}, phase = {} }}",
+        float(h.mean),
+        float(h.amplitude),
+        float(h.frequency),
+        float(h.phase)
+    )
+}
+
+fn drive(d: &Drive) -> String {
+    match d {
+        Drive::Constant(v) => float(*v),
+        Drive::Harmonic(h) => harmonic(h),
+    }
+}
+
+/// Appends `key = value` if `value` is present.
+fn opt<T>(out: &mut String, key: &str, value: Option<T>, show: impl Fn(T) -> String) {
+    if let Some(v) = value {
+        let _ = writeln!(out, "{key} = {}", show(v));
+    }
+}
+
+fn body(out: &mut String, b: &BodySpec) {
+    out.push_str("\n[[body]]\n");
+    if !b.name.is_empty() {
+        let _ = writeln!(out, "name = {}", string(&b.name));
+    }
+    let _ = writeln!(out, "material = {}", string(&b.material));
+    opt(out, "polygon", b.polygon.as_ref(), |p| {
+        format!("[{}]", p.iter().map(|&v| pair(v)).collect::<Vec<_>>().join(", "))
+    });
+    opt(out, "regular", b.regular, |r| format!("{{ sides = {}, radius = {} }}", r.sides, float(r.radius)));
+    opt(out, "disc", b.disc, float);
+    let _ = writeln!(out, "position = {}", pair(b.position));
+    opt(out, "angle", b.angle, float);
+    opt(out, "velocity", b.velocity, pair);
+    opt(out, "spin", b.spin, float);
+    opt(out, "fixed", b.fixed, |f| f.to_string());
+    opt(out, "imposed", b.imposed, |i| {
+        let parts: Vec<String> = [("vx", i.vx), ("vy", i.vy), ("spin", i.spin)]
+            .iter()
+            .filter_map(|(k, d)| d.as_ref().map(|d| format!("{k} = {}", drive(d))))
+            .collect();
+        if parts.is_empty() {
+            "{}".into()
+        } else {
+            format!("{{ {} }}", parts.join(", "))
+        }
+    });
+    opt(out, "load", b.load, |l| {
+        format!(
+            "{{ direction = {}, mean = {}, amplitude = {}, frequency = {}, phase = {} }}",
+            pair(l.direction),
+            float(l.mean),
+            float(l.amplitude),
+            float(l.frequency),
+            float(l.phase)
+        )
+    });
+}
+
+/// The scene as TOML text.
+pub(crate) fn to_toml(scene: &Scene) -> String {
+    let mut out = String::new();
+    let sim = &scene.simulation;
+    out.push_str("[simulation]\n");
+    let _ = writeln!(out, "engine = {}", string(&sim.engine));
+    let _ = writeln!(out, "dt = {}", float(sim.dt));
+    let _ = writeln!(out, "duration = {}", float(sim.duration));
+    opt(&mut out, "gravity", sim.gravity, pair);
+    opt(&mut out, "thickness", sim.thickness, float);
+    opt(&mut out, "seed", sim.seed, |s| s.to_string());
+    if let Some(n) = &scene.nscd {
+        out.push_str("\n[nscd]\n");
+        opt(&mut out, "theta", n.theta, float);
+        opt(&mut out, "criterion", n.criterion.as_deref(), string);
+        opt(&mut out, "tolerance", n.tolerance, float);
+        opt(&mut out, "min_iterations", n.min_iterations, |i| i.to_string());
+        opt(&mut out, "max_iterations", n.max_iterations, |i| i.to_string());
+        opt(&mut out, "max_factor", n.max_factor, float);
+        opt(&mut out, "symmetric", n.symmetric, |b| b.to_string());
+        opt(&mut out, "alert_distance", n.alert_distance, float);
+    }
+    if let Some(o) = &scene.output {
+        out.push_str("\n[output]\n");
+        opt(&mut out, "every", o.every, |e| e.to_string());
+    }
+    for m in &scene.materials {
+        out.push_str("\n[[material]]\n");
+        let _ = writeln!(out, "name = {}", string(&m.name));
+        let _ = writeln!(out, "density = {}", float(m.density));
+    }
+    for c in &scene.contacts {
+        out.push_str("\n[[contact]]\n");
+        let _ = writeln!(out, "between = [{}, {}]", string(&c.between[0]), string(&c.between[1]));
+        let _ = writeln!(out, "friction = {}", float(c.friction));
+        opt(&mut out, "restitution", c.restitution, float);
+        opt(&mut out, "tangential_restitution", c.tangential_restitution, float);
+    }
+    for b in &scene.bodies {
+        body(&mut out, b);
+    }
+    for s in &scene.springs {
+        out.push_str("\n[[spring]]\n");
+        let _ = writeln!(out, "body = {}", string(&s.body));
+        opt(&mut out, "point", s.point, pair);
+        opt(&mut out, "anchor", s.anchor, pair);
+        opt(&mut out, "other", s.other.as_deref(), string);
+        opt(&mut out, "other_point", s.other_point, pair);
+        let _ = writeln!(out, "k_n = {}", float(s.k_n));
+        opt(&mut out, "nu", s.nu, float);
+        opt(&mut out, "rest_length", s.rest_length, float);
+        opt(&mut out, "prestrain", s.prestrain, float);
+        opt(&mut out, "compression_only", s.compression_only, |c| c.to_string());
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn floats_and_strings_read_back() {
+        for x in [0.0, -0.0, 0.1, 1.0, -3.5, 1e-7, 1e16, 1.2345678901234567e-300, f64::MAX, f64::INFINITY] {
+            let text = format!("x = {}", float(x));
+            let v: toml::Table = toml::from_str(&text).unwrap();
+            assert_eq!(v["x"].as_float().unwrap().to_bits(), x.to_bits(), "{text}");
+        }
+        for s in ["plain", "quote \" and \\ backslash", "tab\tnew\nline\u{7f}\u{1}", "é ü 漢"] {
+            let text = format!("x = {}", string(s));
+            let v: toml::Table = toml::from_str(&text).unwrap();
+            assert_eq!(v["x"].as_str().unwrap(), s, "{text}");
+        }
+    }
+}

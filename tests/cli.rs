@@ -1,0 +1,211 @@
+//! The `ballast run` command: output files on a valid scene, exit code 2 and a
+//! one-line error on an invalid one.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+const SCENE: &str = r#"
+[simulation]
+engine = "nscd"
+dt = 1.0e-3
+duration = 0.05
+seed = 42
+
+[output]
+every = 7
+
+[[material]]
+name = "grain"
+density = 2700.0
+
+[[contact]]
+between = ["grain", "grain"]
+friction = 0.5
+
+[[body]]
+name = "floor"
+material = "grain"
+polygon = [[-0.5, -0.1], [0.5, -0.1], [0.5, 0.0], [-0.5, 0.0]]
+position = [0.0, 0.0]
+fixed = true
+
+[[body]]
+name = "block"
+material = "grain"
+polygon = [[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]]
+position = [0.0, 0.051]
+
+[[body]]
+name = "pebble"
+material = "grain"
+regular = { sides = 5, radius = 0.02 }
+position = [0.2, 0.1]
+"#;
+
+/// A fresh directory under the system temp dir, unique to this test and process.
+fn temp_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ballast-cli-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn ballast() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_ballast"))
+}
+
+#[test]
+fn run_writes_the_outputs() {
+    let dir = temp_dir("valid");
+    let scene = dir.join("in.toml");
+    std::fs::write(&scene, SCENE).unwrap();
+    let out = dir.join("out");
+    let result = ballast().arg("run").arg(&scene).arg("--out").arg(&out).arg("--quiet").output().unwrap();
+    assert!(result.status.success(), "stderr: {}", String::from_utf8_lossy(&result.stderr));
+
+    for name in ["series.csv", "final.json", "scene.toml", "run.json", "final_scene.toml"] {
+        assert!(out.join(name).is_file(), "{name} missing");
+    }
+    // scene.toml is a byte copy.
+    assert_eq!(std::fs::read(out.join("scene.toml")).unwrap(), SCENE.as_bytes());
+
+    // series.csv: required columns, one row every 7 steps and the last (50 steps: 7, 14, …, 49, 50).
+    let series = std::fs::read_to_string(out.join("series.csv")).unwrap();
+    let mut lines = series.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for col in ["time", "kinetic_energy", "contacts", "iterations", "criterion", "mean_overlap", "max_overlap"] {
+        assert!(header.contains(&col), "column {col} missing from {header:?}");
+    }
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()).collect()).collect();
+    assert_eq!(rows.len(), 8);
+    let t = header.iter().position(|&c| c == "time").unwrap();
+    assert!((rows[0][t] - 0.007).abs() < 1e-12);
+    assert!((rows[7][t] - 0.05).abs() < 1e-12);
+    for r in &rows {
+        assert_eq!(r.len(), header.len());
+    }
+
+    // final.json: bodies in scene order.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("final.json")).unwrap()).unwrap();
+    assert_eq!(json["step"], 50);
+    assert!((json["time"].as_f64().unwrap() - 0.05).abs() < 1e-12);
+    let names: Vec<&str> = json["bodies"].as_array().unwrap().iter().map(|b| b["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["floor", "block", "pebble"]);
+    let block = &json["bodies"][1];
+    // The block rests on the floor: its centre stays 5 cm above it.
+    assert!((block["position"][1].as_f64().unwrap() - 0.05).abs() < 1e-4);
+    assert!(block["velocity"][0].is_number() && block["spin"].is_number() && block["angle"].is_number());
+
+    // run.json
+    let run: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(run["seed"], 42);
+    assert_eq!(run["engine"], "nscd");
+    assert_eq!(run["steps"], 50);
+    assert_eq!(run["dt"], 1.0e-3);
+    assert_eq!(run["version"], env!("CARGO_PKG_VERSION"));
+
+    // final_scene.toml is a valid scene with the final state; it runs again.
+    let restarted = ballast()
+        .arg("run")
+        .arg(out.join("final_scene.toml"))
+        .arg("--out")
+        .arg(dir.join("out2"))
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert!(restarted.status.success(), "stderr: {}", String::from_utf8_lossy(&restarted.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+fn assert_scene_error(args: &[&str], scene: Option<&str>, test: &str, expected: &str) {
+    let dir = temp_dir(test);
+    let path = dir.join("bad.toml");
+    if let Some(text) = scene {
+        std::fs::write(&path, text).unwrap();
+    }
+    let result = ballast().arg("run").arg(&path).arg("--out").arg(dir.join("out")).args(args).output().unwrap();
+    assert_eq!(result.status.code(), Some(2));
+    let stderr = String::from_utf8(result.stderr).unwrap();
+    assert!(stderr.starts_with("error: "), "stderr: {stderr:?}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "stderr: {stderr:?}");
+    assert!(stderr.contains(expected), "stderr: {stderr:?}");
+    assert!(!dir.join("out").join("series.csv").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_scene_exits_with_code_2() {
+    let bad = SCENE.replace("friction = 0.5", "friction = -0.5");
+    assert_scene_error(&["--quiet"], Some(&bad), "bad", "contact[0].friction");
+    let unknown = SCENE.replace("seed = 42", "seed = 42\nsteps = 3");
+    assert_scene_error(&[], Some(&unknown), "unknown", "bad.toml line 7: unknown field `steps`");
+    let polygon = SCENE.replace("[0.05, -0.05], [0.05, 0.05]", "[0.05, 0.05], [0.05, -0.05]");
+    assert_scene_error(&["--quiet"], Some(&polygon), "polygon", "body[1] 'block': polygon");
+}
+
+#[test]
+fn missing_scene_file_exits_with_code_2() {
+    assert_scene_error(&["--quiet"], None, "missing", "cannot read scene file");
+}
+
+/// A block squeezed between a fixed floor and a press whose velocity is imposed:
+/// nothing can stop the press, so the overlap runs away.
+const SQUEEZE: &str = r#"
+[simulation]
+engine = "nscd"
+dt = 1.0e-3
+duration = 0.1
+
+[output]
+every = 10
+
+[[material]]
+name = "grain"
+density = 2700.0
+
+[[body]]
+name = "floor"
+material = "grain"
+polygon = [[-0.5, -0.1], [0.5, -0.1], [0.5, 0.0], [-0.5, 0.0]]
+position = [0.0, 0.0]
+fixed = true
+
+[[body]]
+name = "block"
+material = "grain"
+polygon = [[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]]
+position = [0.0, 0.05]
+
+[[body]]
+name = "press"
+material = "grain"
+polygon = [[-0.1, 0.0], [0.1, 0.0], [0.1, 0.05], [-0.1, 0.05]]
+position = [0.0, 0.11]
+imposed = { vx = 0.0, vy = -1.0, spin = 0.0 }
+"#;
+
+#[test]
+fn diverging_run_exits_with_code_1_and_keeps_the_last_good_state() {
+    let dir = temp_dir("diverge");
+    let path = dir.join("in.toml");
+    std::fs::write(&path, SQUEEZE).unwrap();
+    let out = dir.join("out");
+    let result = ballast().arg("run").arg(&path).arg("--out").arg(&out).arg("--quiet").output().unwrap();
+    let stderr = String::from_utf8(result.stderr).unwrap();
+    assert_eq!(result.status.code(), Some(1), "stderr: {stderr:?}");
+    assert!(stderr.starts_with("error: step "), "stderr: {stderr:?}");
+    assert!(stderr.contains("'block'"), "stderr: {stderr:?}");
+    assert_eq!(stderr.trim_end().lines().count(), 1);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("final.json")).unwrap()).unwrap();
+    let step = json["step"].as_u64().unwrap();
+    assert!(step > 0 && step < 100, "step {step}");
+    assert!(json["bodies"][1]["position"][1].as_f64().unwrap().is_finite());
+    // The last row of the series is the last good step, even off the output grid.
+    let series = std::fs::read_to_string(out.join("series.csv")).unwrap();
+    let last: f64 = series.lines().last().unwrap().split(',').next().unwrap().parse().unwrap();
+    assert_eq!(last, json["time"].as_f64().unwrap());
+    assert!(!out.join("final_scene.toml").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
