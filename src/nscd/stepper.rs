@@ -25,7 +25,8 @@ impl System {
         let h = self.params.dt;
         let theta = self.params.theta;
         let n = self.bodies.len();
-        let (t_m, t_f) = (self.time + (1.0 - theta) * h, self.time + h);
+        let t_f = self.time_origin + (self.step + 1 - self.step_origin) as f64 * h;
+        let t_m = t_f - theta * h;
         let mut ws = std::mem::take(&mut self.ws);
         ws.q_i.clone_from(&self.bodies.q);
         ws.u_i.clone_from(&self.bodies.u);

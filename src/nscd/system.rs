@@ -111,9 +111,15 @@ pub struct System {
     /// Contact law of material pair `(i, j)` at `i * materials + j`.
     pub laws: Vec<ContactLaw>,
     pub materials: usize,
-    /// Time (s) and number of steps done.
+    /// Time (s) and number of steps done. The time is recomputed each step as
+    /// `time_origin + (step − step_origin) · dt`, never accumulated, so it does not
+    /// drift over millions of steps; [`System::set_dt`] rebases the origin.
     pub time: f64,
     pub step: u64,
+    #[serde(default)]
+    pub time_origin: f64,
+    #[serde(default)]
+    pub step_origin: u64,
     /// Contacts of the last step and their impulses `(P_N, P_T)` (N·s), sorted by
     /// key: the warm start of the next step.
     pub contacts: Vec<ContactGeom>,
@@ -133,10 +139,19 @@ impl System {
             materials,
             time: 0.0,
             step: 0,
+            time_origin: 0.0,
+            step_origin: 0,
             contacts: Vec::new(),
             impulses: Vec::new(),
             ws: Workspace::default(),
         }
+    }
+
+    /// Changes the time step (s) from now on, keeping the clock exact.
+    pub fn set_dt(&mut self, dt: f64) {
+        self.time_origin = self.time;
+        self.step_origin = self.step;
+        self.params.dt = dt;
     }
 
     /// Sets the contact law between materials `i` and `j` (both orders).
