@@ -7,6 +7,17 @@
 //! - [`io`]: output files (`series.csv`, `final.json`).
 //!
 //! All quantities are SI and `f64`.
+//!
+//! ```
+//! let scene = ballast::scene::Scene::load("examples/block_on_floor.toml")?;
+//! let mut sys = scene.build()?; // nscd::System: plain serde data
+//! for _ in 0..scene.steps() {
+//!     let stats = sys.step()?; // contacts, iterations, criterion, overlaps, kinetic energy
+//!     assert!(stats.max_overlap < 1e-6);
+//! }
+//! println!("{:?}", sys.bodies.q); // (x, y, θ) of every centre of mass
+//! # Ok::<(), ballast::Error>(())
+//! ```
 
 pub mod error;
 pub mod geometry;
