@@ -15,11 +15,16 @@
 //! - otherwise the final `V` is the normal of an edge of one polygon, crossed by the
 //!   critical (intruding) corner of the other: the edge direction is the tangent and
 //!   the depth is `shov`; the contact point lies half-way between the corner and its
-//!   projection on the edge. Rotating once more, the neighbouring corner is tested:
-//!   if it also lies within the alert distance of that edge (double intrusion,
-//!   edge-to-edge), the common tangent is the bisector of the two edges and the two
-//!   contact points are the ends of the contact segment (the overlap of both edges
-//!   projected on that tangent).
+//!   projection on the edge. The second intruding corner is looked for on the
+//!   incident edge (the intruding corner and its neighbour nearer the edge): the
+//!   contact segment is the overlap of the reference and incident edges projected on
+//!   the tangent of their bisector, and its two ends are the contact points when
+//!   both lie within the alert distance (double intrusion, edge-to-edge). Each end
+//!   is a corner of one polygon facing the other's edge (a corner of either
+//!   polygon); it takes that corner's gap and that edge's normal, so its gap
+//!   changes exactly at the rate `U_N` even for tilted, sliding edges (a common
+//!   bisector normal lets such ends drift into overlap by slip × tilt per step);
+//!   for parallel edges both normals are the common normal.
 //!
 //! The descent finds the local minimum reached from the line of centres, which is
 //! the physical contact for grains of comparable size. When a small body touches
@@ -211,34 +216,52 @@ fn manifold(
     let (w, inc_edge) = if pen(ip.vertices[prev]) > pen(ip.vertices[next]) { (prev, prev) } else { (next, inc) };
     let pk = ip.vertices[inc];
     let pw = ip.vertices[w];
-    if pen(pw) >= -alert {
-        // Double intrusion: contact segment on the bisector tangent.
-        let nb = (nr - ip.normals[inc_edge]).normalize();
-        let t = perp(nb);
-        let (sr0, sr1) = (t.dot(&r0), t.dot(&r1));
-        let (sk, sw) = (t.dot(&pk), t.dot(&pw));
-        let lo = sr0.min(sr1).max(sk.min(sw));
-        let hi = sr0.max(sr1).min(sk.max(sw));
-        let size = (r1 - r0).norm().min((pw - pk).norm());
-        if hi - lo > 1e-9 * size {
-            // The key must not depend on which polygon holds the reference edge (a
-            // tie for parallel faces): it names both edges and the end along the
-            // final tangent `perp(n)`, `n` from B to A.
-            let (edge_a, edge_b) = if ref_is_b { (inc_edge, edge) } else { (edge, inc_edge) };
-            for (end, s) in [lo, hi].into_iter().enumerate() {
-                let on_ref = r0 + (r1 - r0) * ((s - sr0) / (sr1 - sr0));
-                let on_inc = pk + (pw - pk) * ((s - sk) / (sw - sk));
-                let gap = (on_inc - on_ref).dot(&nb);
-                if gap <= alert {
-                    let slot = if to_a > 0.0 { end } else { 1 - end } as u32;
-                    emit(ContactPoint {
-                        feature: ((edge_a as u32 & 0x7fff) << 16) | SLOT_FLAG | ((edge_b as u32 & 0x1fff) << 1) | slot,
-                        point: 0.5 * (on_ref + on_inc),
-                        normal: to_a * nb,
-                        gap,
-                    });
-                }
+    let ni = ip.normals[inc_edge]; // outward of the incident polygon, towards the reference one
+                                   // Contact segment: the overlap of both edges projected on the tangent of their
+                                   // bisector. Each end is a corner of one polygon facing the other's edge: a
+                                   // corner of the incident edge against the reference edge, or a corner of the
+                                   // reference edge against the incident edge. Its gap and normal are those of
+                                   // that corner and edge, so the gap of each end changes exactly at the rate
+                                   // `U_N` even when the edges are tilted and slide; for parallel edges both
+                                   // normals are the common normal of the paper's averaging.
+    let nb = (nr - ni).normalize();
+    let t = perp(nb);
+    let (sr0, sr1) = (t.dot(&r0), t.dot(&r1));
+    let (sk, sw) = (t.dot(&pk), t.dot(&pw));
+    let lo = sr0.min(sr1).max(sk.min(sw));
+    let hi = sr0.max(sr1).min(sk.max(sw));
+    let size = (r1 - r0).norm().min((pw - pk).norm());
+    if hi - lo > 1e-9 * size {
+        // The key must not depend on which polygon holds the reference edge (a tie
+        // for parallel faces): it names both edges and the end along the tangent.
+        let (edge_a, edge_b) = if ref_is_b { (inc_edge, edge) } else { (edge, inc_edge) };
+        let mut emitted = false;
+        for (end, s) in [lo, hi].into_iter().enumerate() {
+            // Which corner makes this end: the nearest endpoint projection
+            // (an incident corner wins a tie).
+            let inc_corner = if (s - sk).abs() <= (s - sw).abs() { pk } else { pw };
+            let ref_corner = if (s - sr0).abs() <= (s - sr1).abs() { r0 } else { r1 };
+            let from_incident = (t.dot(&inc_corner) - s).abs() <= (t.dot(&ref_corner) - s).abs();
+            let (corner, n_edge, gap) = if from_incident {
+                (inc_corner, nr, (inc_corner - r0).dot(&nr))
+            } else {
+                (ref_corner, ni, (ref_corner - pk).dot(&ni))
+            };
+            if gap <= alert {
+                // Normal from B to A: the reference normal points to the incident
+                // polygon, the incident normal to the reference one.
+                let normal = if from_incident { to_a * nr } else { -to_a * ni };
+                let slot = if to_a > 0.0 { end } else { 1 - end } as u32;
+                emit(ContactPoint {
+                    feature: ((edge_a as u32 & 0x7fff) << 16) | SLOT_FLAG | ((edge_b as u32 & 0x1fff) << 1) | slot,
+                    point: corner - 0.5 * gap * n_edge,
+                    normal,
+                    gap,
+                });
+                emitted = true;
             }
+        }
+        if emitted {
             return;
         }
     }
