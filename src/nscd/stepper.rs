@@ -41,14 +41,7 @@ impl System {
             v_max = v_max.max(u[0].hypot(u[1]) + u[2].abs() * info.shape.bounding_radius());
         }
         if let Some(i) = ws.q_m.iter().position(|q| q.iter().any(|x| !x.is_finite() || x.abs() > 1e12)) {
-            self.bodies.u.clone_from(&ws.u_i);
-            self.ws = ws;
-            return Err(Error::Diverged {
-                step: self.step + 1,
-                body: i,
-                name: self.bodies.info[i].name.clone(),
-                what: "non-finite or runaway position".into(),
-            });
+            return Err(self.roll_back(ws, i, "non-finite or runaway position".into()));
         }
         // 2. Detection.
         let alert = self.params.alert_distance.max(2.0 * h * v_max);
@@ -157,32 +150,17 @@ impl System {
         if stats.active_contacts > 0 {
             stats.mean_overlap = sum_overlap / stats.active_contacts as f64;
         }
-        for i in 0..n {
-            let bad = self.bodies.q[i].iter().chain(&self.bodies.u[i]).any(|x| !x.is_finite());
-            if bad {
-                failure = Some((i, "non-finite position or velocity".to_string()));
-                break;
-            }
-        }
-        if let Some((body, what)) = failure {
-            self.bodies.q.clone_from(&ws.q_i);
-            self.bodies.u.clone_from(&ws.u_i);
-            self.ws = ws;
-            return Err(Error::Diverged { step: self.step + 1, body, name: self.bodies.info[body].name.clone(), what });
+        if let Some(i) = (0..n).find(|&i| self.bodies.q[i].iter().chain(&self.bodies.u[i]).any(|x| !x.is_finite())) {
+            failure = Some((i, "non-finite position or velocity".to_string()));
         }
         stats.kinetic_energy = self.bodies.kinetic_energy();
-        if !stats.kinetic_energy.is_finite() {
-            let i =
-                (0..n).max_by(|&a, &b| self.bodies.u[a][0].abs().total_cmp(&self.bodies.u[b][0].abs())).unwrap_or(0);
-            self.bodies.q.clone_from(&ws.q_i);
-            self.bodies.u.clone_from(&ws.u_i);
-            self.ws = ws;
-            return Err(Error::Diverged {
-                step: self.step + 1,
-                body: i,
-                name: self.bodies.info[i].name.clone(),
-                what: "kinetic energy overflow".into(),
-            });
+        if failure.is_none() && !stats.kinetic_energy.is_finite() {
+            let speed = |i: usize| self.bodies.u[i][0].hypot(self.bodies.u[i][1]);
+            let i = (0..n).max_by(|&a, &b| speed(a).total_cmp(&speed(b))).unwrap_or(0);
+            failure = Some((i, "kinetic energy overflow".to_string()));
+        }
+        if let Some((body, what)) = failure {
+            return Err(self.roll_back(ws, body, what));
         }
 
         // Keep the contacts and impulses for the next warm start.
@@ -197,5 +175,13 @@ impl System {
         self.step += 1;
         self.ws = ws;
         Ok(stats)
+    }
+
+    /// Restores the state of the start of the failed step and names the culprit.
+    fn roll_back(&mut self, ws: super::system::Workspace, body: usize, what: String) -> Error {
+        self.bodies.q.clone_from(&ws.q_i);
+        self.bodies.u.clone_from(&ws.u_i);
+        self.ws = ws;
+        Error::Diverged { step: self.step + 1, body, name: self.bodies.info[body].name.clone(), what }
     }
 }
