@@ -1,15 +1,18 @@
 //! The `ballast` command line.
 //!
-//! `ballast run SCENE.toml --out DIR [--quiet]` loads and validates the scene,
-//! builds the system, makes `round(duration / dt)` steps and writes
-//! `series.csv`, `final.json`, `scene.toml`, `final_scene.toml` and `run.json`
-//! in `DIR` (see [`ballast::io`]).
+//! `ballast run SCENE.toml --out DIR [--quiet] [--checkpoint-every S] [--resume]
+//! [--stop-after N]` loads and validates the scene, builds the system, makes
+//! `round(duration / dt)` steps and writes `series.csv`, `final.json`,
+//! `scene.toml`, `final_scene.toml` and `run.json` in `DIR` (see [`ballast::io`]).
+//! Every `S` seconds of wall time (default 300) it writes `checkpoint.json`;
+//! `--resume` continues from it with the same numbers as an uninterrupted run;
+//! `--stop-after N` stops after N steps with a checkpoint.
 //!
 //! Exit codes: 0 on success; 2 for an invalid scene or command line (one line
 //! `error: …` on stderr); 1 if the run diverges (`series.csv` and `final.json`
 //! then hold the last good state) or an output file cannot be written.
 
-use ballast::io::{self, FinalState, RunInfo, SeriesWriter};
+use ballast::io::{self, Checkpoint, FinalState, RunInfo, SeriesWriter, CHECKPOINT_FILE};
 use ballast::nscd::StepStats;
 use ballast::scene::Scene;
 use ballast::Error;
@@ -38,6 +41,15 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Wall-clock seconds between checkpoints (`DIR/checkpoint.json`); 0 disables them.
+        #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
+        checkpoint_every: f64,
+        /// Continue a killed or stopped run from `DIR/checkpoint.json` (same scene file).
+        #[arg(long)]
+        resume: bool,
+        /// Stop after this many steps in this invocation, with a checkpoint to resume from.
+        #[arg(long, value_name = "STEPS")]
+        stop_after: Option<u64>,
     },
     /// Writes the scene of a loose pentagon deposit with the Saussine et al. (2006)
     /// grading (circumradii 5, 7.5, 10 mm in the numbers 361 : 242 : 121), ready for `run`.
@@ -74,7 +86,9 @@ enum Failure {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { scene, out, quiet } => run(&scene, &out, quiet),
+        Command::Run { scene, out, quiet, checkpoint_every, resume, stop_after } => {
+            run(&scene, &out, &RunOptions { quiet, checkpoint_every, resume, stop_after })
+        }
         Command::Deposit { grains, width, seed, dt, duration, out } => deposit(grains, width, seed, dt, duration, &out),
     };
     match result {
@@ -122,35 +136,76 @@ fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
     pb
 }
 
+/// Options of `ballast run` besides the scene and the output directory.
+struct RunOptions {
+    quiet: bool,
+    checkpoint_every: f64,
+    resume: bool,
+    stop_after: Option<u64>,
+}
+
 /// `ballast run`.
-fn run(scene_path: &Path, out: &Path, quiet: bool) -> Result<(), Failure> {
-    let scene = Scene::load(scene_path).map_err(Failure::Input)?;
-    let mut sys = scene.build().map_err(Failure::Input)?;
+fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> {
+    let scene_text = Scene::read_text(scene_path).map_err(Failure::Input)?;
+    let scene = Scene::from_toml_str_named(&scene_text, &scene_path.display().to_string()).map_err(Failure::Input)?;
     let steps = scene.steps();
     let every = scene.output_every();
+    if !(opts.checkpoint_every.is_finite() && opts.checkpoint_every >= 0.0) {
+        return Err(Failure::Input(Error::Scene(format!(
+            "--checkpoint-every: must be a non-negative number of seconds, got {}",
+            opts.checkpoint_every
+        ))));
+    }
 
-    io::create_output_dir(out).map_err(Failure::Run)?;
-    // A final scene left by an earlier run would pass for this run's.
-    io::remove_stale(out, "final_scene.toml").map_err(Failure::Run)?;
-    io::copy_scene(scene_path, out).map_err(Failure::Run)?;
-    let info = RunInfo {
-        seed: scene.seed(),
-        engine: scene.simulation.engine.clone(),
-        version: env!("CARGO_PKG_VERSION").to_string(),
-        steps,
-        dt: scene.simulation.dt,
+    // A fresh run, or the continuation of a checkpointed one.
+    let (mut sys, mut series, mut max_overlap, mut unconverged) = if opts.resume {
+        let cp = Checkpoint::load(out, &scene_text).map_err(Failure::Input)?;
+        let series =
+            SeriesWriter::resume(&out.join("series.csv"), cp.series_bytes, cp.series_rows).map_err(Failure::Run)?;
+        io::remove_stale(out, "final_scene.toml").map_err(Failure::Run)?;
+        (cp.system, series, cp.max_overlap, cp.unconverged)
+    } else {
+        let sys = scene.build().map_err(Failure::Input)?;
+        io::create_output_dir(out).map_err(Failure::Run)?;
+        // Files left by an earlier run would pass for this run's.
+        io::remove_stale(out, "final_scene.toml").map_err(Failure::Run)?;
+        io::remove_stale(out, CHECKPOINT_FILE).map_err(Failure::Run)?;
+        io::copy_scene(scene_path, out).map_err(Failure::Run)?;
+        let info = RunInfo {
+            seed: scene.seed(),
+            engine: scene.simulation.engine.clone(),
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            steps,
+            dt: scene.simulation.dt,
+        };
+        info.write(out).map_err(Failure::Run)?;
+        let series = SeriesWriter::create(&out.join("series.csv")).map_err(Failure::Run)?;
+        (sys, series, 0.0, 0)
     };
-    info.write(out).map_err(Failure::Run)?;
-    let mut series = SeriesWriter::create(&out.join("series.csv")).map_err(Failure::Run)?;
+    let first = sys.step + 1;
+    let last_step = opts.stop_after.map_or(steps, |n| steps.min(sys.step.saturating_add(n)));
 
-    let pb = progress_bar(steps, quiet);
+    let pb = progress_bar(steps, opts.quiet);
+    pb.set_position(sys.step);
     let message_every = (steps / 1000).max(1);
     let started = Instant::now();
+    let mut checkpointed = Instant::now();
     let mut last: Option<(StepStats, bool)> = None;
-    let mut max_overlap: f64 = 0.0;
-    let mut unconverged = 0u64;
     let mut diverged = None;
-    for k in 1..=steps {
+    let checkpoint = |sys: &ballast::nscd::System, series: &mut SeriesWriter, max_overlap: f64, unconverged: u64| {
+        let series_bytes = series.sync()?;
+        Checkpoint {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            scene: scene_text.clone(),
+            series_bytes,
+            series_rows: series.rows(),
+            max_overlap,
+            unconverged,
+            system: sys.clone(),
+        }
+        .write(out)
+    };
+    for k in first..=last_step {
         match sys.step() {
             Ok(stats) => {
                 max_overlap = max_overlap.max(stats.max_overlap);
@@ -164,6 +219,10 @@ fn run(scene_path: &Path, out: &Path, quiet: bool) -> Result<(), Failure> {
                     pb.set_message(format!("t = {:.4} s, Ek = {:.3e} J", stats.time, stats.kinetic_energy));
                 }
                 pb.inc(1);
+                if opts.checkpoint_every > 0.0 && checkpointed.elapsed().as_secs_f64() >= opts.checkpoint_every {
+                    checkpoint(&sys, &mut series, max_overlap, unconverged).map_err(Failure::Run)?;
+                    checkpointed = Instant::now();
+                }
             }
             Err(e) => {
                 diverged = Some(e);
@@ -172,6 +231,18 @@ fn run(scene_path: &Path, out: &Path, quiet: bool) -> Result<(), Failure> {
         }
     }
     pb.finish_and_clear();
+    if diverged.is_none() && sys.step < steps {
+        // Stopped on request: leave a checkpoint and nothing that looks final.
+        checkpoint(&sys, &mut series, max_overlap, unconverged).map_err(Failure::Run)?;
+        series.finish().map_err(Failure::Run)?;
+        println!(
+            "stopped at step {} of {steps} (t = {:.6} s) after {:.2} s; continue with --resume",
+            sys.step,
+            sys.time,
+            started.elapsed().as_secs_f64()
+        );
+        return Ok(());
+    }
     if let Some((stats, false)) = last {
         // The run stopped early: keep the last good step in the series.
         series.write(&stats).map_err(Failure::Run)?;
@@ -181,6 +252,7 @@ fn run(scene_path: &Path, out: &Path, quiet: bool) -> Result<(), Failure> {
     if let Some(e) = diverged {
         return Err(Failure::Run(e));
     }
+    io::remove_stale(out, CHECKPOINT_FILE).map_err(Failure::Run)?;
     let state = scene.with_state(&sys).to_toml_string().map_err(Failure::Run)?;
     let final_scene = format!(
         "# Written by ballast {}: the state of {} at t = {} s (step {}).\n\

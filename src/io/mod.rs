@@ -5,10 +5,13 @@
 //! - `final.json`: the state of every body at the end ([`final_state::FinalState`]);
 //! - `scene.toml`: a byte copy of the input scene ([`copy_scene`]);
 //! - `final_scene.toml`: the input scene with the final state, to restart from;
-//! - `run.json`: seed, engine, crate version, number of steps, time step ([`RunInfo`]).
+//! - `run.json`: seed, engine, crate version, number of steps, time step ([`RunInfo`]);
+//! - `checkpoint.json`: the whole state, every few minutes, for `--resume`
+//!   ([`checkpoint::Checkpoint`]).
 //!
 //! Every I/O error names the file it happened on.
 
+pub mod checkpoint;
 pub mod final_state;
 pub mod series;
 
@@ -16,6 +19,7 @@ use crate::error::{Error, Result};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
+pub use checkpoint::{Checkpoint, CHECKPOINT_FILE};
 pub use final_state::{BodyState, FinalState};
 pub use series::{SeriesWriter, SERIES_HEADER};
 

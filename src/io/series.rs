@@ -34,6 +34,33 @@ impl SeriesWriter {
         Ok(w)
     }
 
+    /// Reopens `series.csv` to continue a run from a checkpoint: the file is cut
+    /// back to `bytes` (its length when the checkpoint was written, so rows of
+    /// the killed run after it disappear) and `rows` rows are counted as written.
+    pub fn resume(path: &Path, bytes: u64, rows: u64) -> Result<Self> {
+        let file = std::fs::OpenOptions::new().write(true).open(path).map_err(|e| io_error(path, "open", e))?;
+        let len = file.metadata().map_err(|e| io_error(path, "read", e))?.len();
+        if len < bytes {
+            return Err(crate::Error::Io(std::io::Error::other(format!(
+                "'{}' is shorter ({len} bytes) than at the checkpoint ({bytes} bytes)",
+                path.display()
+            ))));
+        }
+        file.set_len(bytes).map_err(|e| io_error(path, "truncate", e))?;
+        let mut out = BufWriter::new(file);
+        use std::io::Seek;
+        out.seek(std::io::SeekFrom::End(0)).map_err(|e| io_error(path, "seek", e))?;
+        Ok(Self { path: path.to_path_buf(), out, rows })
+    }
+
+    /// Flushes what is buffered and returns the length of the file (bytes), for a checkpoint.
+    pub fn sync(&mut self) -> Result<u64> {
+        self.out.flush().map_err(|e| io_error(&self.path, "write", e))?;
+        let f = self.out.get_ref();
+        f.sync_data().map_err(|e| io_error(&self.path, "sync", e))?;
+        Ok(f.metadata().map_err(|e| io_error(&self.path, "read", e))?.len())
+    }
+
     /// Appends the row of one step.
     pub fn write(&mut self, s: &StepStats) -> Result<()> {
         writeln!(

@@ -53,9 +53,14 @@ impl Scene {
     /// the file as given. A file that cannot be read is an [`Error::Scene`] too.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::Scene(format!("cannot read scene file '{}': {e}", path.display())))?;
-        Self::from_toml_str_named(&text, &path.display().to_string())
+        Self::from_toml_str_named(&Self::read_text(path)?, &path.display().to_string())
+    }
+
+    /// The text of a scene file, with a one-line error naming the file if it cannot be read.
+    pub fn read_text(path: impl AsRef<Path>) -> Result<String> {
+        let path = path.as_ref();
+        std::fs::read_to_string(path)
+            .map_err(|e| Error::Scene(format!("cannot read scene file '{}': {e}", path.display())))
     }
 
     /// The scene as TOML text, laid out like a hand-written scene (only the keys
