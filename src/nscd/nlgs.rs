@@ -40,7 +40,7 @@ impl Default for NlgsSettings {
             tolerance: 1e-4,
             min_iterations: 1,
             max_iterations: 1000,
-            max_factor: 16.0,
+            max_factor: 4.0,
             symmetric: false,
         }
     }
@@ -124,8 +124,18 @@ fn sweep_in<'r, 's>(
                 apply(&mut u[b], &inv_m[b], &s.hn_b, dp, &[0.0; 3], 0.0, -1.0);
             }
         }
-        let (du, wp) = (s.w * dp, s.w * p);
-        norms.add(du * du, p * p, wp * wp, p * wp, dp != 0.0);
+        let (p_old, du) = (p - dp, s.w * dp);
+        let pm = 0.5 * (p_old + p);
+        let (wp_old, wp) = (s.w * p_old, s.w * p);
+        norms.add(
+            du * du,
+            pm * pm,
+            pm * du,
+            0.5 * (p_old * wp_old + p * wp),
+            0.5 * (wp_old * wp_old + wp * wp),
+            p * wp,
+            dp != 0.0,
+        );
     }
     for r in rows {
         let (a, b) = (r.a as usize, r.b as usize);
@@ -145,8 +155,19 @@ fn sweep_in<'r, 's>(
             apply(&mut u[b], &inv_m[b], &r.hn_b, dn, &r.ht_b, dt, -1.0);
         }
         let (dun, dut) = (w.nn * dn + w.nt * dt, w.nt * dn + w.tt * dt);
+        let (wpn, wpt) = (w.nn * pn + w.nt * pt, w.nt * pn + w.tt * pt);
         let (wqn, wqt) = (w.nn * qn + w.nt * qt, w.nt * qn + w.tt * qt);
-        norms.add(dun * dun + dut * dut, qn * qn + qt * qt, wqn * wqn + wqt * wqt, qn * wqn + qt * wqt, changed);
+        let (mn, mt) = (0.5 * (pn + qn), 0.5 * (pt + qt));
+        let wqq = qn * wqn + qt * wqt;
+        norms.add(
+            dun * dun + dut * dut,
+            mn * mn + mt * mt,
+            mn * dun + mt * dut,
+            0.5 * (pn * wpn + pt * wpt + wqq),
+            0.5 * (wpn * wpn + wpt * wpt + wqn * wqn + wqt * wqt),
+            wqq,
+            changed,
+        );
     }
     norms
 }

@@ -24,7 +24,7 @@ pub const DEFAULT_MIN_ITERATIONS: usize = 1;
 /// Default maximum number of NLGS sweeps per step.
 pub const DEFAULT_MAX_ITERATIONS: usize = 1000;
 /// Default `max_factor` of the `quad_max` criterion.
-pub const DEFAULT_MAX_FACTOR: f64 = 16.0;
+pub const DEFAULT_MAX_FACTOR: f64 = 4.0;
 /// Default alert distance, as a fraction of the smallest inner radius (m/m).
 pub const DEFAULT_ALERT_FRACTION: f64 = 0.01;
 /// Default number of steps between two rows of `series.csv`.

@@ -18,7 +18,7 @@ pub fn params(dt: f64) -> NscdParams {
             tolerance: 1e-10,
             min_iterations: 1,
             max_iterations: 5000,
-            max_factor: 16.0,
+            max_factor: 4.0,
             symmetric: false,
         },
     }
