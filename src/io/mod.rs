@@ -14,6 +14,7 @@
 pub mod checkpoint;
 pub mod final_state;
 pub mod series;
+pub mod vtk;
 
 use crate::error::{Error, Result};
 use serde::Serialize;

@@ -1,0 +1,555 @@
+//! VTK snapshots of an NSCD [`System`] for ParaView: the bodies, the contact
+//! force network, and a `.pvd` collection that animates them.
+//!
+//! # Files
+//!
+//! [`write_bodies`] and [`write_contacts`] pick the format from the extension:
+//!
+//! - `.vtp`: VTK XML PolyData, ASCII inline (`<DataArray format="ascii">`);
+//! - `.vtk`: legacy VTK, `# vtk DataFile Version 3.0`, `ASCII`, `DATASET POLYDATA`.
+//!
+//! Any other extension is an error. [`PvdCollection`] writes a ParaView `.pvd`
+//! collection (`<VTKFile type="Collection">`) of `.vtp` snapshots, one time step
+//! per snapshot, part 0 the bodies and part 1 the contacts: open the `.pvd` in
+//! ParaView and it plays the run.
+//!
+//! **Why XML for the animation.** ParaView reads a `.pvd` with
+//! `vtkXMLCollectionReader`, which picks the reader of each listed file from its
+//! extension among the XML formats only (`vtp`, `vtu`, `vti`, `vtr`, `vts`,
+//! `vtm` and their parallel forms); a legacy `.vtk` listed in a `.pvd` is not read.
+//! So [`PvdCollection::write_snapshot`] writes `.vtp` files. The legacy `.vtk`
+//! form holds exactly the same data and is there for single snapshots and for
+//! tools that read only legacy VTK.
+//!
+//! Floats are written with `{:e}`, the shortest text that reads back to the same
+//! `f64` (a non-finite value would be written `NaN` or `inf`, which VTK readers
+//! refuse; the stepper never leaves one in the state: it rolls back); integers
+//! as `Int32` (`int`), coordinates and floats as `Float64` (`double`).
+//! Everything is planar: z = 0 everywhere. Forces are the mean forces over the
+//! last step (N), for the out-of-plane thickness of the scene.
+//!
+//! # Bodies file
+//!
+//! One polygon cell per body (`POLYGONS` / `<Polys>`), in body order, whose
+//! points are the body's world vertices: centre of mass `(q[0], q[1])` plus the
+//! body-frame vertices rotated by `q[2]`, counter-clockwise. A disc is written as
+//! the inscribed polygon of [`DISC_VERTICES`] vertices on its circle, the first
+//! at angle `q[2]` (so that the spin shows). Points are not shared between cells.
+//! Cell data:
+//!
+//! | array      | kind                | unit  | meaning                                     |
+//! |------------|---------------------|-------|---------------------------------------------|
+//! | `body_id`  | int scalar          | –     | index of the body in the system             |
+//! | `fixed`    | int scalar          | –     | 1 for a fixed body, else 0                  |
+//! | `velocity` | vector (3)          | m/s   | velocity of the centre of mass, z = 0       |
+//! | `spin`     | float scalar        | rad/s | angular velocity, counter-clockwise         |
+//! | `radius`   | float scalar        | m     | bounding radius (disc radius, circumradius) |
+//!
+//! # Contacts file
+//!
+//! The force network of the last step ([`System::contact_forces`]): points are
+//! the centres of mass of all bodies (point `i` is body `i`), and each contact is
+//! one line cell (`LINES` / `<Lines>`) from its candidate's centre of mass to
+//! its antagonist's. No point data. Cell data:
+//!
+//! | array              | kind               | unit | meaning                                      |
+//! |--------------------|--------------------|------|----------------------------------------------|
+//! | `normal_force`     | float scalar       | N    | `r_n`, ≥ 0 (compression)                     |
+//! | `tangential_force` | float scalar       | N    | `r_t`, along `t`                             |
+//! | `gap`              | float scalar       | m    | gap at `q_m` (negative: overlap)             |
+//! | `force`            | vector (3)         | N    | `r_n n + r_t t` on the candidate, z = 0      |
+//! | `normal`           | field, 3 comps     | –    | unit normal `n`, towards the candidate       |
+//! | `point`            | field, 3 comps     | m    | contact point at `q_m`, z = 0                |
+//! | `candidate`        | int scalar         | –    | body on which `force` acts                   |
+//! | `antagonist`       | int scalar         | –    | the other body (it feels `-force`)           |
+//!
+//! `t` is `n` rotated by +90°; `q_m` is the intermediate configuration of the
+//! θ-method at which the contacts were detected. `normal_force` is the active
+//! scalar and `force` the active vector (ParaView colours and glyphs by them by
+//! default); in the bodies file they are `body_id` and `velocity`. In legacy
+//! files `normal` and `point` are the arrays of a `FIELD` block of the cell
+//! data; in `.vtp` files all arrays are plain `DataArray`s. A Threshold on
+//! `normal_force` and a Tube filter whose radius follows it give the usual
+//! force-chain picture; `point` locates the contacts themselves (the line's
+//! ends are the centres of mass).
+
+use super::io_error;
+use crate::error::Result;
+use crate::geometry::{perp, rotate, Shape, Vec2};
+use crate::nscd::System;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Number of vertices of the polygon that stands for a disc in the bodies file.
+pub const DISC_VERTICES: usize = 24;
+
+/// File format of a snapshot, chosen by [`Format::from_path`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Legacy VTK, ASCII (`.vtk`).
+    Legacy,
+    /// VTK XML PolyData, ASCII inline (`.vtp`), the format a `.pvd` can list.
+    Xml,
+}
+
+impl Format {
+    /// `.vtk` (legacy) or `.vtp` (XML), case-insensitive; any other extension is
+    /// an [`Error::Io`](crate::Error::Io) of kind `InvalidInput` naming the path.
+    pub fn from_path(path: &Path) -> Result<Format> {
+        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("vtk") => Ok(Format::Legacy),
+            Some("vtp") => Ok(Format::Xml),
+            _ => Err(io_error(
+                path,
+                "write",
+                std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    "unknown VTK extension, expected .vtk (legacy) or .vtp (XML PolyData)",
+                ),
+            )),
+        }
+    }
+}
+
+/// Writes the bodies of `sys` to `path`: one polygon cell per body with its world
+/// vertices (m) and the cell arrays `body_id`, `fixed`, `velocity` (m/s), `spin`
+/// (rad/s) and `radius` (m); see the [module documentation](self). The format
+/// follows the extension: `.vtk` legacy, `.vtp` XML.
+pub fn write_bodies(path: &Path, sys: &System) -> Result<()> {
+    let format = Format::from_path(path)?;
+    let title = format!("ballast NSCD bodies, step {}, time {:e} s", sys.step, sys.time);
+    write_file(path, &render(&bodies_data(sys), format, &title))
+}
+
+/// Writes the contacts of the last step of `sys` to `path`: one line cell per
+/// contact, from the candidate's centre of mass to the antagonist's, with the
+/// cell arrays `candidate`, `antagonist`, `normal_force` (N), `tangential_force`
+/// (N), `gap` (m), `force` (N), `normal` and `point` (m); see the
+/// [module documentation](self). The format follows the extension: `.vtk`
+/// legacy, `.vtp` XML.
+pub fn write_contacts(path: &Path, sys: &System) -> Result<()> {
+    let format = Format::from_path(path)?;
+    let title = format!("ballast NSCD contacts, step {}, time {:e} s", sys.step, sys.time);
+    write_file(path, &render(&contacts_data(sys), format, &title))
+}
+
+/// One time step of a [`PvdCollection`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PvdEntry {
+    /// Simulated time (s).
+    pub time: f64,
+    /// Bodies snapshot (`.vtp`), listed as part 0.
+    pub bodies: PathBuf,
+    /// Contacts snapshot (`.vtp`), listed as part 1.
+    pub contacts: PathBuf,
+}
+
+/// A ParaView `.pvd` collection of snapshots: each time step lists its bodies
+/// file as part 0 and its contacts file as part 1, so ParaView shows a
+/// two-block data set that it animates over the time steps.
+///
+/// ```no_run
+/// # fn main() -> ballast::Result<()> {
+/// use ballast::io::vtk::PvdCollection;
+/// let scene = ballast::scene::Scene::load("examples/block_on_floor.toml")?;
+/// let mut sys = scene.build()?;
+/// let dir = std::path::Path::new("out");
+/// std::fs::create_dir_all(dir)?;
+/// let mut pvd = PvdCollection::new();
+/// for k in 1..=scene.steps() {
+///     sys.step()?;
+///     if k % 10 == 0 {
+///         pvd.write_snapshot(dir, &sys)?; // out/bodies_000000010.vtp, out/contacts_000000010.vtp
+///         pvd.write(&dir.join("run.pvd"))?; // rewritten each time: valid even if the run stops
+///     }
+/// }
+/// # Ok(()) }
+/// ```
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PvdCollection {
+    entries: Vec<PvdEntry>,
+}
+
+impl PvdCollection {
+    /// An empty collection.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds the snapshot at `time` (s) made of the files `bodies` and `contacts`
+    /// (they should be `.vtp`: ParaView does not read legacy files from a `.pvd`).
+    /// Entries at a time not smaller than `time` are dropped first (a run resumed
+    /// from an earlier checkpoint rewrites them), so times are strictly
+    /// increasing.
+    pub fn push(&mut self, time: f64, bodies: impl Into<PathBuf>, contacts: impl Into<PathBuf>) {
+        self.entries.retain(|e| e.time < time);
+        self.entries.push(PvdEntry { time, bodies: bodies.into(), contacts: contacts.into() });
+    }
+
+    /// Writes `dir/bodies_SSSSSSSSS.vtp` and `dir/contacts_SSSSSSSSS.vtp` (`S`: the
+    /// step number, 9 digits or more) for the current state of `sys`, adds them
+    /// at time `sys.time` (s) and returns their paths. The `.pvd` itself is
+    /// written by [`PvdCollection::write`].
+    pub fn write_snapshot(&mut self, dir: &Path, sys: &System) -> Result<(PathBuf, PathBuf)> {
+        let bodies = dir.join(format!("bodies_{:09}.vtp", sys.step));
+        let contacts = dir.join(format!("contacts_{:09}.vtp", sys.step));
+        write_bodies(&bodies, sys)?;
+        write_contacts(&contacts, sys)?;
+        self.push(sys.time, bodies.clone(), contacts.clone());
+        Ok((bodies, contacts))
+    }
+
+    /// The time steps, in increasing time.
+    pub fn entries(&self) -> &[PvdEntry] {
+        &self.entries
+    }
+
+    /// Number of time steps.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// Whether there is no time step.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// The `.pvd` text, with the file names relative to the directory `base` when
+    /// they are inside it (ParaView resolves relative names from the `.pvd`'s
+    /// directory), else absolute when they exist, else as given.
+    pub fn to_xml(&self, base: &Path) -> String {
+        let mut s = String::from("<?xml version=\"1.0\"?>\n");
+        s.push_str("<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n");
+        for e in &self.entries {
+            for (part, name, file) in [(0, "bodies", &e.bodies), (1, "contacts", &e.contacts)] {
+                let file = relative_to(file, base);
+                let _ = writeln!(
+                    s,
+                    "    <DataSet timestep=\"{:e}\" group=\"\" part=\"{part}\" name=\"{name}\" file=\"{}\"/>",
+                    e.time,
+                    xml_escape(&file.to_string_lossy())
+                );
+            }
+        }
+        s.push_str("  </Collection>\n</VTKFile>\n");
+        s
+    }
+
+    /// Writes the collection to `path` (by convention `*.pvd`), file names
+    /// relative to its directory; returns `path`. The file is written to a
+    /// temporary name and renamed, so a reader never sees it half written.
+    pub fn write(&self, path: &Path) -> Result<PathBuf> {
+        let base = path.parent().unwrap_or(Path::new(""));
+        let tmp = path.with_extension("pvd.tmp");
+        write_file(&tmp, &self.to_xml(base))?;
+        std::fs::rename(&tmp, path).map_err(|e| io_error(path, "write", e))?;
+        Ok(path.to_path_buf())
+    }
+}
+
+/// `file` as the `.pvd` in directory `base` should name it: relative to `base`
+/// when it is inside it (as written, or once both paths are canonical), as given
+/// when it is a relative name of an existing file of `base`, else absolute when
+/// it exists, else as given.
+fn relative_to(file: &Path, base: &Path) -> PathBuf {
+    let base = if base == Path::new(".") { Path::new("") } else { base };
+    if let Ok(r) = file.strip_prefix(base) {
+        return r.to_path_buf();
+    }
+    if file.is_relative() && base.join(file).exists() {
+        return file.to_path_buf();
+    }
+    match (file.canonicalize(), base.canonicalize()) {
+        (Ok(f), Ok(b)) => f.strip_prefix(&b).map(Path::to_path_buf).unwrap_or(f),
+        (Ok(f), Err(_)) => f,
+        _ => file.to_path_buf(),
+    }
+}
+
+fn xml_escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+fn write_file(path: &Path, text: &str) -> Result<()> {
+    std::fs::write(path, text).map_err(|e| io_error(path, "write", e))
+}
+
+// ---------------------------------------------------------------------------
+// Format-neutral poly data, then its two serializations.
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum CellKind {
+    Polys,
+    Lines,
+}
+
+/// How a cell array is declared in a legacy file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Role {
+    Scalars,
+    Vectors,
+    Field,
+}
+
+#[derive(Debug, Clone)]
+enum Values {
+    Int(Vec<i64>),
+    Float(Vec<f64>),
+}
+
+#[derive(Debug, Clone)]
+struct Array {
+    name: &'static str,
+    role: Role,
+    components: usize,
+    values: Values,
+}
+
+impl Array {
+    fn int(name: &'static str, v: Vec<i64>) -> Self {
+        Self { name, role: Role::Scalars, components: 1, values: Values::Int(v) }
+    }
+
+    fn float(name: &'static str, v: Vec<f64>) -> Self {
+        Self { name, role: Role::Scalars, components: 1, values: Values::Float(v) }
+    }
+
+    fn vectors(name: &'static str, v: Vec<[f64; 3]>) -> Self {
+        Self { name, role: Role::Vectors, components: 3, values: Values::Float(v.concat()) }
+    }
+
+    fn field3(name: &'static str, v: Vec<[f64; 3]>) -> Self {
+        Self { name, role: Role::Field, components: 3, values: Values::Float(v.concat()) }
+    }
+
+    /// Writes tuple `i` as space-separated values.
+    fn write_tuple(&self, s: &mut String, i: usize) {
+        let k = self.components;
+        for c in 0..k {
+            if c > 0 {
+                s.push(' ');
+            }
+            let _ = match &self.values {
+                Values::Int(v) => write!(s, "{}", v[i * k + c]),
+                Values::Float(v) => write!(s, "{:e}", v[i * k + c]),
+            };
+        }
+        s.push('\n');
+    }
+}
+
+#[derive(Debug, Clone)]
+struct PolyData {
+    points: Vec<[f64; 3]>,
+    kind: CellKind,
+    /// Point indices of every cell, one after the other.
+    connectivity: Vec<usize>,
+    /// End of each cell in `connectivity` (the XML `offsets`).
+    offsets: Vec<usize>,
+    cell_data: Vec<Array>,
+}
+
+impl PolyData {
+    fn cells(&self) -> usize {
+        self.offsets.len()
+    }
+
+    fn cell(&self, i: usize) -> &[usize] {
+        let start = if i == 0 { 0 } else { self.offsets[i - 1] };
+        &self.connectivity[start..self.offsets[i]]
+    }
+}
+
+fn bodies_data(sys: &System) -> PolyData {
+    let b = &sys.bodies;
+    let mut d = PolyData {
+        points: Vec::new(),
+        kind: CellKind::Polys,
+        connectivity: Vec::new(),
+        offsets: Vec::with_capacity(b.len()),
+        cell_data: Vec::new(),
+    };
+    for (info, q) in b.info.iter().zip(&b.q) {
+        let centre = Vec2::new(q[0], q[1]);
+        let (sin, cos) = q[2].sin_cos();
+        let mut add = |v: Vec2| {
+            let w = centre + rotate(v, cos, sin);
+            d.connectivity.push(d.points.len());
+            d.points.push([w.x, w.y, 0.0]);
+        };
+        match &info.shape {
+            Shape::Polygon(p) => p.vertices.iter().for_each(|&v| add(v)),
+            Shape::Disc(r) => (0..DISC_VERTICES).for_each(|k| {
+                let a = std::f64::consts::TAU * k as f64 / DISC_VERTICES as f64;
+                add(Vec2::new(r * a.cos(), r * a.sin()))
+            }),
+        }
+        d.offsets.push(d.connectivity.len());
+    }
+    d.cell_data = vec![
+        Array::int("body_id", (0..b.len() as i64).collect()),
+        Array::int("fixed", b.info.iter().map(|i| i64::from(i.fixed)).collect()),
+        Array::vectors("velocity", b.u.iter().map(|u| [u[0], u[1], 0.0]).collect()),
+        Array::float("spin", b.u.iter().map(|u| u[2]).collect()),
+        Array::float("radius", b.info.iter().map(|i| i.shape.bounding_radius()).collect()),
+    ];
+    d
+}
+
+fn contacts_data(sys: &System) -> PolyData {
+    let contacts: Vec<_> = sys.contact_forces().collect();
+    let mut connectivity = Vec::with_capacity(2 * contacts.len());
+    for c in &contacts {
+        connectivity.extend([c.candidate, c.antagonist]);
+    }
+    let force = |c: &crate::nscd::ContactInfo| {
+        let n = Vec2::new(c.normal[0], c.normal[1]);
+        let f = n * c.r_n + perp(n) * c.r_t;
+        [f.x, f.y, 0.0]
+    };
+    PolyData {
+        points: sys.bodies.q.iter().map(|q| [q[0], q[1], 0.0]).collect(),
+        kind: CellKind::Lines,
+        connectivity,
+        offsets: (1..=contacts.len()).map(|k| 2 * k).collect(),
+        cell_data: vec![
+            Array::float("normal_force", contacts.iter().map(|c| c.r_n).collect()),
+            Array::float("tangential_force", contacts.iter().map(|c| c.r_t).collect()),
+            Array::float("gap", contacts.iter().map(|c| c.gap).collect()),
+            Array::vectors("force", contacts.iter().map(force).collect()),
+            Array::field3("normal", contacts.iter().map(|c| [c.normal[0], c.normal[1], 0.0]).collect()),
+            Array::field3("point", contacts.iter().map(|c| [c.point[0], c.point[1], 0.0]).collect()),
+            Array::int("candidate", contacts.iter().map(|c| c.candidate as i64).collect()),
+            Array::int("antagonist", contacts.iter().map(|c| c.antagonist as i64).collect()),
+        ],
+    }
+}
+
+fn render(d: &PolyData, format: Format, title: &str) -> String {
+    match format {
+        Format::Legacy => legacy(d, title),
+        Format::Xml => xml(d, title),
+    }
+}
+
+fn legacy(d: &PolyData, title: &str) -> String {
+    let mut s = String::new();
+    // The title line is at most 256 characters, without a newline.
+    let title: String = title.chars().filter(|c| *c != '\n' && *c != '\r').take(255).collect();
+    let _ =
+        write!(s, "# vtk DataFile Version 3.0\n{title}\nASCII\nDATASET POLYDATA\nPOINTS {} double\n", d.points.len());
+    for p in &d.points {
+        let _ = writeln!(s, "{:e} {:e} {:e}", p[0], p[1], p[2]);
+    }
+    let n = d.cells();
+    if n == 0 {
+        return s;
+    }
+    let keyword = match d.kind {
+        CellKind::Polys => "POLYGONS",
+        CellKind::Lines => "LINES",
+    };
+    let _ = writeln!(s, "{keyword} {n} {}", n + d.connectivity.len());
+    for i in 0..n {
+        let cell = d.cell(i);
+        let _ = write!(s, "{}", cell.len());
+        for p in cell {
+            let _ = write!(s, " {p}");
+        }
+        s.push('\n');
+    }
+    let _ = writeln!(s, "CELL_DATA {n}");
+    let type_name = |a: &Array| match a.values {
+        Values::Int(_) => "int",
+        Values::Float(_) => "double",
+    };
+    for a in d.cell_data.iter().filter(|a| a.role != Role::Field) {
+        if a.role == Role::Scalars {
+            let _ = write!(s, "SCALARS {} {} 1\nLOOKUP_TABLE default\n", a.name, type_name(a));
+        } else {
+            let _ = writeln!(s, "VECTORS {} {}", a.name, type_name(a));
+        }
+        (0..n).for_each(|i| a.write_tuple(&mut s, i));
+    }
+    let fields: Vec<&Array> = d.cell_data.iter().filter(|a| a.role == Role::Field).collect();
+    if !fields.is_empty() {
+        let _ = writeln!(s, "FIELD FieldData {}", fields.len());
+        for a in fields {
+            let _ = writeln!(s, "{} {} {n} {}", a.name, a.components, type_name(a));
+            (0..n).for_each(|i| a.write_tuple(&mut s, i));
+        }
+    }
+    s
+}
+
+fn xml(d: &PolyData, title: &str) -> String {
+    let n = d.cells();
+    let (lines, polys) = match d.kind {
+        CellKind::Lines => (n, 0),
+        CellKind::Polys => (0, n),
+    };
+    let mut s = String::from("<?xml version=\"1.0\"?>\n");
+    let _ = writeln!(s, "<!-- {} -->", title.replace("--", "- -"));
+    s.push_str("<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <PolyData>\n");
+    let _ = writeln!(
+        s,
+        "    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"0\" NumberOfLines=\"{lines}\" \
+         NumberOfStrips=\"0\" NumberOfPolys=\"{polys}\">",
+        d.points.len()
+    );
+    s.push_str("      <Points>\n        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    for p in &d.points {
+        let _ = writeln!(s, "{:e} {:e} {:e}", p[0], p[1], p[2]);
+    }
+    s.push_str("        </DataArray>\n      </Points>\n");
+    let active = |role: Role| d.cell_data.iter().find(|a| a.role == role).map(|a| a.name);
+    s.push_str("      <CellData");
+    if let Some(name) = active(Role::Scalars) {
+        let _ = write!(s, " Scalars=\"{name}\"");
+    }
+    if let Some(name) = active(Role::Vectors) {
+        let _ = write!(s, " Vectors=\"{name}\"");
+    }
+    s.push_str(">\n");
+    for a in &d.cell_data {
+        let ty = match a.values {
+            Values::Int(_) => "Int32",
+            Values::Float(_) => "Float64",
+        };
+        let _ = writeln!(
+            s,
+            "        <DataArray type=\"{ty}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">",
+            a.name, a.components
+        );
+        (0..n).for_each(|i| a.write_tuple(&mut s, i));
+        s.push_str("        </DataArray>\n");
+    }
+    s.push_str("      </CellData>\n");
+    let section = match d.kind {
+        CellKind::Polys => "Polys",
+        CellKind::Lines => "Lines",
+    };
+    let _ = writeln!(s, "      <{section}>");
+    s.push_str("        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
+    for i in 0..n {
+        let cell: Vec<String> = d.cell(i).iter().map(usize::to_string).collect();
+        let _ = writeln!(s, "{}", cell.join(" "));
+    }
+    s.push_str("        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
+    for o in &d.offsets {
+        let _ = writeln!(s, "{o}");
+    }
+    let _ = write!(s, "        </DataArray>\n      </{section}>\n    </Piece>\n  </PolyData>\n</VTKFile>\n");
+    s
+}
