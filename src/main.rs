@@ -6,12 +6,14 @@
 //! `scene.toml`, `final_scene.toml` and `run.json` in `DIR` (see [`ballast::io`]).
 //! Every `S` seconds of wall time (default 300) it writes `checkpoint.json`;
 //! `--resume` continues from it with the same numbers as an uninterrupted run;
-//! `--stop-after N` stops after N steps with a checkpoint.
+//! `--stop-after N` stops after N steps with a checkpoint; `--vtk-every N` writes
+//! ParaView snapshots every N steps (`DIR/vtk/*.vtp`, `DIR/run.pvd`).
 //!
 //! Exit codes: 0 on success; 2 for an invalid scene or command line (one line
 //! `error: …` on stderr); 1 if the run diverges (`series.csv` and `final.json`
 //! then hold the last good state) or an output file cannot be written.
 
+use ballast::io::vtk::PvdCollection;
 use ballast::io::{self, Checkpoint, FinalState, RunInfo, SeriesWriter, CHECKPOINT_FILE};
 use ballast::nscd::StepStats;
 use ballast::scene::Scene;
@@ -50,6 +52,9 @@ enum Command {
         /// Stop after this many steps in this invocation, with a checkpoint to resume from.
         #[arg(long, value_name = "STEPS")]
         stop_after: Option<u64>,
+        /// Write VTK snapshots (`DIR/vtk/*.vtp`, listed in `DIR/run.pvd`) every N steps; 0: none.
+        #[arg(long, value_name = "N", default_value_t = 0)]
+        vtk_every: u64,
     },
     /// Writes the scene of a loose pentagon deposit with the Saussine et al. (2006)
     /// grading (circumradii 5, 7.5, 10 mm in the numbers 361 : 242 : 121), ready for `run`.
@@ -86,8 +91,8 @@ enum Failure {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { scene, out, quiet, checkpoint_every, resume, stop_after } => {
-            run(&scene, &out, &RunOptions { quiet, checkpoint_every, resume, stop_after })
+        Command::Run { scene, out, quiet, checkpoint_every, resume, stop_after, vtk_every } => {
+            run(&scene, &out, &RunOptions { quiet, checkpoint_every, resume, stop_after, vtk_every })
         }
         Command::Deposit { grains, width, seed, dt, duration, out } => deposit(grains, width, seed, dt, duration, &out),
     };
@@ -142,6 +147,7 @@ struct RunOptions {
     checkpoint_every: f64,
     resume: bool,
     stop_after: Option<u64>,
+    vtk_every: u64,
 }
 
 /// `ballast run`.
@@ -158,12 +164,14 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
     }
 
     // A fresh run, or the continuation of a checkpointed one.
-    let (mut sys, mut series, mut max_overlap, mut unconverged) = if opts.resume {
+    let vtk_dir = out.join("vtk");
+    let pvd_path = out.join("run.pvd");
+    let (mut sys, mut series, mut max_overlap, mut unconverged, mut snapshots) = if opts.resume {
         let cp = Checkpoint::load(out, &scene_text).map_err(Failure::Input)?;
         let series =
             SeriesWriter::resume(&out.join("series.csv"), cp.series_bytes, cp.series_rows).map_err(Failure::Run)?;
         io::remove_stale(out, "final_scene.toml").map_err(Failure::Run)?;
-        (cp.system, series, cp.max_overlap, cp.unconverged)
+        (cp.system, series, cp.max_overlap, cp.unconverged, cp.snapshots)
     } else {
         let sys = scene.build().map_err(Failure::Input)?;
         io::create_output_dir(out).map_err(Failure::Run)?;
@@ -180,7 +188,14 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
         };
         info.write(out).map_err(Failure::Run)?;
         let series = SeriesWriter::create(&out.join("series.csv")).map_err(Failure::Run)?;
-        (sys, series, 0.0, 0)
+        let mut snapshots = PvdCollection::new();
+        if opts.vtk_every > 0 {
+            // The initial state is the first snapshot.
+            io::create_output_dir(&vtk_dir).map_err(Failure::Run)?;
+            snapshots.write_snapshot(&vtk_dir, &sys).map_err(Failure::Run)?;
+            snapshots.write(&pvd_path).map_err(Failure::Run)?;
+        }
+        (sys, series, 0.0, 0, snapshots)
     };
     let first = sys.step + 1;
     let last_step = opts.stop_after.map_or(steps, |n| steps.min(sys.step.saturating_add(n)));
@@ -192,7 +207,11 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
     let mut checkpointed = Instant::now();
     let mut last: Option<(StepStats, bool)> = None;
     let mut diverged = None;
-    let checkpoint = |sys: &ballast::nscd::System, series: &mut SeriesWriter, max_overlap: f64, unconverged: u64| {
+    let checkpoint = |sys: &ballast::nscd::System,
+                      series: &mut SeriesWriter,
+                      max_overlap: f64,
+                      unconverged: u64,
+                      snapshots: &PvdCollection| {
         let series_bytes = series.sync()?;
         Checkpoint {
             version: env!("CARGO_PKG_VERSION").to_string(),
@@ -202,6 +221,7 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
             max_overlap,
             unconverged,
             system: sys.clone(),
+            snapshots: snapshots.clone(),
         }
         .write(out)
     };
@@ -219,8 +239,13 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
                     pb.set_message(format!("t = {:.4} s, Ek = {:.3e} J", stats.time, stats.kinetic_energy));
                 }
                 pb.inc(1);
+                if opts.vtk_every > 0 && k % opts.vtk_every == 0 {
+                    io::create_output_dir(&vtk_dir).map_err(Failure::Run)?;
+                    snapshots.write_snapshot(&vtk_dir, &sys).map_err(Failure::Run)?;
+                    snapshots.write(&pvd_path).map_err(Failure::Run)?;
+                }
                 if opts.checkpoint_every > 0.0 && checkpointed.elapsed().as_secs_f64() >= opts.checkpoint_every {
-                    checkpoint(&sys, &mut series, max_overlap, unconverged).map_err(Failure::Run)?;
+                    checkpoint(&sys, &mut series, max_overlap, unconverged, &snapshots).map_err(Failure::Run)?;
                     checkpointed = Instant::now();
                 }
             }
@@ -233,7 +258,7 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
     pb.finish_and_clear();
     if diverged.is_none() && sys.step < steps {
         // Stopped on request: leave a checkpoint and nothing that looks final.
-        checkpoint(&sys, &mut series, max_overlap, unconverged).map_err(Failure::Run)?;
+        checkpoint(&sys, &mut series, max_overlap, unconverged, &snapshots).map_err(Failure::Run)?;
         series.finish().map_err(Failure::Run)?;
         println!(
             "stopped at step {} of {steps} (t = {:.6} s) after {:.2} s; continue with --resume",

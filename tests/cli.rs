@@ -224,17 +224,23 @@ fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
         String::from_utf8_lossy(&r.stdout).to_string()
     };
     let (whole, parts) = (dir.join("whole"), dir.join("parts"));
-    run(&whole, &[]);
+    run(&whole, &["--vtk-every", "10"]);
     // Stop at step 17 (between two series rows), again 20 steps later, then finish.
-    assert!(run(&parts, &["--stop-after", "17"]).contains("stopped at step 17"));
+    assert!(run(&parts, &["--stop-after", "17", "--vtk-every", "10"]).contains("stopped at step 17"));
     assert!(parts.join("checkpoint.json").is_file() && !parts.join("final.json").exists());
-    assert!(run(&parts, &["--resume", "--stop-after", "20"]).contains("stopped at step 37"));
+    assert!(run(&parts, &["--resume", "--stop-after", "20", "--vtk-every", "10"]).contains("stopped at step 37"));
     // A kill after the checkpoint leaves rows the checkpoint does not know: they go.
     let mut f = std::fs::OpenOptions::new().append(true).open(parts.join("series.csv")).unwrap();
     std::io::Write::write_all(&mut f, b"9e9,9e9,9,9,9,9e9,1,9e9,9e9\n").unwrap();
     drop(f);
-    run(&parts, &["--resume"]);
-    for f in ["series.csv", "final.json"] {
+    run(&parts, &["--resume", "--vtk-every", "10"]);
+    // Snapshots at steps 0, 10, …, 50 and their ParaView collection are identical too.
+    let mut files = vec!["series.csv".to_string(), "final.json".to_string(), "run.pvd".to_string()];
+    for step in (0..=50).step_by(10) {
+        files.push(format!("vtk/bodies_{step:09}.vtp"));
+        files.push(format!("vtk/contacts_{step:09}.vtp"));
+    }
+    for f in &files {
         assert_eq!(std::fs::read(whole.join(f)).unwrap(), std::fs::read(parts.join(f)).unwrap(), "{f} differs");
     }
     assert!(!parts.join("checkpoint.json").exists(), "a finished run leaves no checkpoint");

@@ -33,6 +33,9 @@ pub struct Checkpoint {
     pub unconverged: u64,
     /// The engine state.
     pub system: System,
+    /// Snapshots listed in `run.pvd` so far (empty without `--vtk-every`).
+    #[serde(default)]
+    pub snapshots: super::vtk::PvdCollection,
 }
 
 impl Checkpoint {

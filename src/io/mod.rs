@@ -7,7 +7,9 @@
 //! - `final_scene.toml`: the input scene with the final state, to restart from;
 //! - `run.json`: seed, engine, crate version, number of steps, time step ([`RunInfo`]);
 //! - `checkpoint.json`: the whole state, every few minutes, for `--resume`
-//!   ([`checkpoint::Checkpoint`]).
+//!   ([`checkpoint::Checkpoint`]);
+//! - with `--vtk-every N`: `vtk/bodies_*.vtp`, `vtk/contacts_*.vtp` and `run.pvd`,
+//!   snapshots that ParaView opens and animates ([`vtk`]).
 //!
 //! Every I/O error names the file it happened on.
 

@@ -134,7 +134,7 @@ pub fn write_contacts(path: &Path, sys: &System) -> Result<()> {
 }
 
 /// One time step of a [`PvdCollection`].
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PvdEntry {
     /// Simulated time (s).
     pub time: f64,
@@ -165,7 +165,7 @@ pub struct PvdEntry {
 /// }
 /// # Ok(()) }
 /// ```
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PvdCollection {
     entries: Vec<PvdEntry>,
 }
