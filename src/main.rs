@@ -14,7 +14,7 @@
 //! then hold the last good state) or an output file cannot be written.
 
 use ballast::io::vtk::PvdCollection;
-use ballast::io::{self, Checkpoint, FinalState, RunInfo, SeriesWriter, CHECKPOINT_FILE};
+use ballast::io::{self, Checkpoint, FinalState, RunInfo, RunSummary, SeriesWriter, CHECKPOINT_FILE};
 use ballast::nscd::StepStats;
 use ballast::scene::Scene;
 use ballast::Error;
@@ -166,12 +166,12 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
     // A fresh run, or the continuation of a checkpointed one.
     let vtk_dir = out.join("vtk");
     let pvd_path = out.join("run.pvd");
-    let (mut sys, mut series, mut max_overlap, mut unconverged, mut snapshots) = if opts.resume {
+    let (mut sys, mut series, mut summary, mut snapshots) = if opts.resume {
         let cp = Checkpoint::load(out, &scene_text).map_err(Failure::Input)?;
         let series =
             SeriesWriter::resume(&out.join("series.csv"), cp.series_bytes, cp.series_rows).map_err(Failure::Run)?;
         io::remove_stale(out, "final_scene.toml").map_err(Failure::Run)?;
-        (cp.system, series, cp.max_overlap, cp.unconverged, cp.snapshots)
+        (cp.system, series, cp.summary, cp.snapshots)
     } else {
         let sys = scene.build().map_err(Failure::Input)?;
         io::create_output_dir(out).map_err(Failure::Run)?;
@@ -195,7 +195,7 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
             snapshots.write_snapshot(&vtk_dir, &sys).map_err(Failure::Run)?;
             snapshots.write(&pvd_path).map_err(Failure::Run)?;
         }
-        (sys, series, 0.0, 0, snapshots)
+        (sys, series, RunSummary::default(), snapshots)
     };
     let first = sys.step + 1;
     let last_step = opts.stop_after.map_or(steps, |n| steps.min(sys.step.saturating_add(n)));
@@ -207,30 +207,31 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
     let mut checkpointed = Instant::now();
     let mut last: Option<(StepStats, bool)> = None;
     let mut diverged = None;
-    let checkpoint = |sys: &ballast::nscd::System,
-                      series: &mut SeriesWriter,
-                      max_overlap: f64,
-                      unconverged: u64,
-                      snapshots: &PvdCollection| {
-        let series_bytes = series.sync()?;
-        Checkpoint {
-            version: env!("CARGO_PKG_VERSION").to_string(),
-            scene: scene_text.clone(),
-            series_bytes,
-            series_rows: series.rows(),
-            max_overlap,
-            unconverged,
-            system: sys.clone(),
-            snapshots: snapshots.clone(),
-        }
-        .write(out)
-    };
+    let equilibrium = scene.simulation.equilibrium;
+    let mut at_equilibrium = false;
+    let checkpoint =
+        |sys: &ballast::nscd::System, series: &mut SeriesWriter, summary: RunSummary, snapshots: &PvdCollection| {
+            let series_bytes = series.sync()?;
+            Checkpoint {
+                version: env!("CARGO_PKG_VERSION").to_string(),
+                scene: scene_text.clone(),
+                series_bytes,
+                series_rows: series.rows(),
+                summary,
+                system: sys.clone(),
+                snapshots: snapshots.clone(),
+            }
+            .write(out)
+        };
     for k in first..=last_step {
         match sys.step() {
             Ok(stats) => {
-                max_overlap = max_overlap.max(stats.max_overlap);
-                unconverged += u64::from(!stats.converged);
-                let written = k % every == 0 || k == steps;
+                summary.max_overlap = summary.max_overlap.max(stats.max_overlap);
+                summary.unconverged += u64::from(!stats.converged);
+                let calm = equilibrium.is_some_and(|e| stats.kinetic_energy < e.kinetic_energy);
+                summary.calm_steps = if calm { summary.calm_steps + 1 } else { 0 };
+                at_equilibrium = equilibrium.is_some_and(|e| summary.calm_steps >= e.steps());
+                let written = k % every == 0 || k == steps || at_equilibrium;
                 if written {
                     series.write(&stats).map_err(Failure::Run)?;
                 }
@@ -245,7 +246,7 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
                     snapshots.write(&pvd_path).map_err(Failure::Run)?;
                 }
                 if opts.checkpoint_every > 0.0 && checkpointed.elapsed().as_secs_f64() >= opts.checkpoint_every {
-                    checkpoint(&sys, &mut series, max_overlap, unconverged, &snapshots).map_err(Failure::Run)?;
+                    checkpoint(&sys, &mut series, summary, &snapshots).map_err(Failure::Run)?;
                     checkpointed = Instant::now();
                 }
             }
@@ -254,11 +255,14 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
                 break;
             }
         }
+        if at_equilibrium {
+            break;
+        }
     }
     pb.finish_and_clear();
-    if diverged.is_none() && sys.step < steps {
+    if diverged.is_none() && sys.step < steps && !at_equilibrium {
         // Stopped on request: leave a checkpoint and nothing that looks final.
-        checkpoint(&sys, &mut series, max_overlap, unconverged, &snapshots).map_err(Failure::Run)?;
+        checkpoint(&sys, &mut series, summary, &snapshots).map_err(Failure::Run)?;
         series.finish().map_err(Failure::Run)?;
         println!(
             "stopped at step {} of {steps} (t = {:.6} s) after {:.2} s; continue with --resume",
@@ -292,15 +296,16 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
 
     let energy = last.map_or(0.0, |(s, _)| s.kinetic_energy);
     println!(
-        "{} steps to t = {:.6} s in {:.2} s: {} bodies, final kinetic energy {:.3e} J, max overlap {:.3e} m, {} \
+        "{} steps to t = {:.6} s{} in {:.2} s: {} bodies, final kinetic energy {:.3e} J, max overlap {:.3e} m, {} \
          steps not converged; outputs in {}",
         sys.step,
         sys.time,
+        if at_equilibrium { " (equilibrium reached)" } else { "" },
         started.elapsed().as_secs_f64(),
         sys.bodies.len(),
         energy,
-        max_overlap,
-        unconverged,
+        summary.max_overlap,
+        summary.unconverged,
         out.display()
     );
     Ok(())

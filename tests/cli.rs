@@ -259,3 +259,41 @@ fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
     let err = String::from_utf8_lossy(&r.stderr);
     assert!(err.starts_with("error:") && err.contains("another scene") && err.trim().lines().count() == 1, "{err}");
 }
+
+/// A deposit with `simulation.equilibrium` ends once the kinetic energy has stayed
+/// below the threshold for the window, with the usual final outputs; a run stopped
+/// inside that window and resumed ends at the same step with the same numbers.
+#[test]
+fn run_stops_at_equilibrium_and_resumes_into_the_same_stop() {
+    let dir = temp_dir("equilibrium");
+    let scene = dir.join("in.toml");
+    // 2 s of simulated time; the block and pebble settle within a fraction of it.
+    let text = SCENE
+        .replace("duration = 0.05", "duration = 2.0")
+        .replace("[output]", "equilibrium = { kinetic_energy = 1e-12, steps = 50 }\n\n[output]");
+    assert!(text.contains("equilibrium = "), "scene template changed");
+    std::fs::write(&scene, &text).unwrap();
+    let run = |out: &std::path::Path, extra: &[&str]| {
+        let r = ballast().arg("run").arg(&scene).arg("--out").arg(out).arg("--quiet").args(extra).output().unwrap();
+        assert!(r.status.success(), "stderr: {}", String::from_utf8_lossy(&r.stderr));
+        String::from_utf8_lossy(&r.stdout).to_string()
+    };
+    let whole = dir.join("whole");
+    assert!(run(&whole, &[]).contains("(equilibrium reached)"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(whole.join("final.json")).unwrap()).unwrap();
+    let stop = json["step"].as_u64().unwrap();
+    // The pebble drops 10 cm (0.14 s), the 50-step window follows: far before 2000 steps.
+    assert!((60..1000).contains(&stop), "stopped at step {stop}");
+    assert!(whole.join("final_scene.toml").is_file() && !whole.join("checkpoint.json").exists());
+    let series = std::fs::read_to_string(whole.join("series.csv")).unwrap();
+    let last_time: f64 = series.lines().last().unwrap().split(',').next().unwrap().parse().unwrap();
+    assert!((last_time - json["time"].as_f64().unwrap()).abs() < 1e-12, "the stop step is the last row");
+
+    let parts = dir.join("parts");
+    run(&parts, &["--stop-after", &(stop - 10).to_string()]);
+    run(&parts, &["--resume"]);
+    for f in ["series.csv", "final.json"] {
+        assert_eq!(std::fs::read(whole.join(f)).unwrap(), std::fs::read(parts.join(f)).unwrap(), "{f} differs");
+    }
+}

@@ -422,3 +422,16 @@ fn garbage_never_panics() {
         }
     }
 }
+
+#[test]
+fn equilibrium_criterion_is_validated_and_round_trips() {
+    let with = |eq: &str| edit("seed = 7\n", &format!("seed = 7\nequilibrium = {eq}\n"));
+    expect(&with("{ kinetic_energy = 0.0 }"), &["simulation.equilibrium.kinetic_energy", "positive"]);
+    expect(&with("{ kinetic_energy = 1e-9, steps = 0 }"), &["simulation.equilibrium.steps", "at least 1"]);
+    expect(&with("{ kinetic_energy = 1e-9, window = 3 }"), &["unknown field `window`"]);
+    let scene = Scene::from_toml_str(&with("{ kinetic_energy = 1e-9, steps = 30 }")).unwrap();
+    let eq = scene.simulation.equilibrium.unwrap();
+    assert_eq!((eq.kinetic_energy, eq.steps()), (1e-9, 30));
+    let again = Scene::from_toml_str(&scene.to_toml_string().unwrap()).unwrap();
+    assert_eq!(again.simulation.equilibrium, scene.simulation.equilibrium);
+}

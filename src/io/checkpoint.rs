@@ -18,6 +18,17 @@ use std::path::{Path, PathBuf};
 /// File name of the checkpoint in the output directory.
 pub const CHECKPOINT_FILE: &str = "checkpoint.json";
 
+/// What a run accumulates from step to step besides the engine state.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// Largest overlap so far (m).
+    pub max_overlap: f64,
+    /// Steps that hit the iteration cap.
+    pub unconverged: u64,
+    /// Consecutive steps so far with the kinetic energy below the equilibrium threshold.
+    pub calm_steps: u64,
+}
+
 /// Everything needed to continue a run.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Checkpoint {
@@ -28,9 +39,8 @@ pub struct Checkpoint {
     /// Length of `series.csv` (bytes) and rows in it when the checkpoint was written.
     pub series_bytes: u64,
     pub series_rows: u64,
-    /// Running summary: largest overlap so far (m), steps that hit the iteration cap.
-    pub max_overlap: f64,
-    pub unconverged: u64,
+    /// Running summary of the run so far.
+    pub summary: RunSummary,
     /// The engine state.
     pub system: System,
     /// Snapshots listed in `run.pvd` so far (empty without `--vtk-every`).

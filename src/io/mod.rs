@@ -22,7 +22,7 @@ use crate::error::{Error, Result};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
-pub use checkpoint::{Checkpoint, CHECKPOINT_FILE};
+pub use checkpoint::{Checkpoint, RunSummary, CHECKPOINT_FILE};
 pub use final_state::{BodyState, FinalState};
 pub use series::{SeriesWriter, SERIES_HEADER};
 

@@ -77,6 +77,29 @@ pub struct Simulation {
     /// Random seed, recorded in the outputs; default 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
+    /// Ends the run early at static equilibrium (a deposit): see [`Equilibrium`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub equilibrium: Option<Equilibrium>,
+}
+
+/// `simulation.equilibrium`: the run ends once the kinetic energy has stayed
+/// below `kinetic_energy` (J) for `steps` consecutive steps (default 100; a window,
+/// so that the momentary rest at the top of a bounce does not count).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Equilibrium {
+    /// Threshold on the kinetic energy of the non-fixed bodies (J), > 0.
+    pub kinetic_energy: f64,
+    /// Consecutive steps below the threshold, ≥ 1; default 100.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steps: Option<u64>,
+}
+
+impl Equilibrium {
+    /// Consecutive steps required.
+    pub fn steps(&self) -> u64 {
+        self.steps.unwrap_or(100)
+    }
 }
 
 impl Simulation {

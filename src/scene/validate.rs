@@ -199,6 +199,12 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
     }
     finite2("simulation.gravity", sim.gravity())?;
     let thickness = positive("simulation.thickness", sim.thickness())?;
+    if let Some(eq) = &sim.equilibrium {
+        positive("simulation.equilibrium.kinetic_energy", eq.kinetic_energy)?;
+        if eq.steps() == 0 {
+            return err("simulation.equilibrium.steps: must be at least 1, got 0".into());
+        }
+    }
 
     // [nscd]
     let ns = scene.nscd.clone().unwrap_or_default();

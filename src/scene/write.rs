@@ -117,6 +117,10 @@ pub(crate) fn to_toml(scene: &Scene) -> String {
     opt(&mut out, "gravity", sim.gravity, pair);
     opt(&mut out, "thickness", sim.thickness, float);
     opt(&mut out, "seed", sim.seed, |s| s.to_string());
+    opt(&mut out, "equilibrium", sim.equilibrium, |e| match e.steps {
+        Some(n) => format!("{{ kinetic_energy = {}, steps = {n} }}", float(e.kinetic_energy)),
+        None => format!("{{ kinetic_energy = {} }}", float(e.kinetic_energy)),
+    });
     if let Some(n) = &scene.nscd {
         out.push_str("\n[nscd]\n");
         opt(&mut out, "theta", n.theta, float);
