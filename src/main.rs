@@ -165,13 +165,18 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
 
     // A fresh run, or the continuation of a checkpointed one.
     let vtk_dir = out.join("vtk");
+    let cycles_path = out.join("cycles.csv");
     let pvd_path = out.join("run.pvd");
-    let (mut sys, mut series, mut summary, mut snapshots) = if opts.resume {
+    let (mut sys, mut series, mut summary, mut snapshots, mut cycles) = if opts.resume {
         let cp = Checkpoint::load(out, &scene_text).map_err(Failure::Input)?;
         let series =
             SeriesWriter::resume(&out.join("series.csv"), cp.series_bytes, cp.series_rows).map_err(Failure::Run)?;
         io::remove_stale(out, "final_scene.toml").map_err(Failure::Run)?;
-        (cp.system, series, cp.summary, cp.snapshots)
+        let cycles = cp.cycles;
+        if let Some(c) = &cycles {
+            io::cycles::truncate_rows(&cycles_path, c.cycle).map_err(Failure::Run)?;
+        }
+        (cp.system, series, cp.summary, cp.snapshots, cycles)
     } else {
         let sys = scene.build().map_err(Failure::Input)?;
         io::create_output_dir(out).map_err(Failure::Run)?;
@@ -195,7 +200,9 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
             snapshots.write_snapshot(&vtk_dir, &sys).map_err(Failure::Run)?;
             snapshots.write(&pvd_path).map_err(Failure::Run)?;
         }
-        (sys, series, RunSummary::default(), snapshots)
+        io::remove_stale(out, "cycles.csv").map_err(Failure::Run)?;
+        let cycles = scene.output_cycles().map(|(f, body)| io::cycles::CycleRecorder::new(&sys, f, body));
+        (sys, series, RunSummary::default(), snapshots, cycles)
     };
     let first = sys.step + 1;
     let last_step = opts.stop_after.map_or(steps, |n| steps.min(sys.step.saturating_add(n)));
@@ -209,20 +216,24 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
     let mut diverged = None;
     let equilibrium = scene.simulation.equilibrium;
     let mut at_equilibrium = false;
-    let checkpoint =
-        |sys: &ballast::nscd::System, series: &mut SeriesWriter, summary: RunSummary, snapshots: &PvdCollection| {
-            let series_bytes = series.sync()?;
-            Checkpoint {
-                version: env!("CARGO_PKG_VERSION").to_string(),
-                scene: scene_text.clone(),
-                series_bytes,
-                series_rows: series.rows(),
-                summary,
-                system: sys.clone(),
-                snapshots: snapshots.clone(),
-            }
-            .write(out)
-        };
+    let checkpoint = |sys: &ballast::nscd::System,
+                      series: &mut SeriesWriter,
+                      summary: RunSummary,
+                      snapshots: &PvdCollection,
+                      cycles: &Option<io::cycles::CycleRecorder>| {
+        let series_bytes = series.sync()?;
+        Checkpoint {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            scene: scene_text.clone(),
+            series_bytes,
+            series_rows: series.rows(),
+            summary,
+            system: sys.clone(),
+            snapshots: snapshots.clone(),
+            cycles: cycles.clone(),
+        }
+        .write(out)
+    };
     for k in first..=last_step {
         match sys.step() {
             Ok(stats) => {
@@ -232,6 +243,9 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
                 summary.calm_steps = if calm { summary.calm_steps + 1 } else { 0 };
                 at_equilibrium = equilibrium.is_some_and(|e| summary.calm_steps >= e.steps());
                 let written = k % every == 0 || k == steps || at_equilibrium;
+                if let Some(row) = cycles.as_mut().and_then(|c| c.record(&sys, &stats)) {
+                    io::cycles::append_row(&cycles_path, &row).map_err(Failure::Run)?;
+                }
                 if written {
                     series.write(&stats).map_err(Failure::Run)?;
                 }
@@ -246,7 +260,7 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
                     snapshots.write(&pvd_path).map_err(Failure::Run)?;
                 }
                 if opts.checkpoint_every > 0.0 && checkpointed.elapsed().as_secs_f64() >= opts.checkpoint_every {
-                    checkpoint(&sys, &mut series, summary, &snapshots).map_err(Failure::Run)?;
+                    checkpoint(&sys, &mut series, summary, &snapshots, &cycles).map_err(Failure::Run)?;
                     checkpointed = Instant::now();
                 }
             }
@@ -262,7 +276,7 @@ fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> 
     pb.finish_and_clear();
     if diverged.is_none() && sys.step < steps && !at_equilibrium {
         // Stopped on request: leave a checkpoint and nothing that looks final.
-        checkpoint(&sys, &mut series, summary, &snapshots).map_err(Failure::Run)?;
+        checkpoint(&sys, &mut series, summary, &snapshots, &cycles).map_err(Failure::Run)?;
         series.finish().map_err(Failure::Run)?;
         println!(
             "stopped at step {} of {steps} (t = {:.6} s) after {:.2} s; continue with --resume",

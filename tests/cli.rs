@@ -217,7 +217,10 @@ fn diverging_run_exits_with_code_1_and_keeps_the_last_good_state() {
 fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
     let dir = temp_dir("resume");
     let scene = dir.join("in.toml");
-    std::fs::write(&scene, SCENE).unwrap();
+    // With per-cycle statistics (5 cycles of 10 ms over the 50 steps).
+    let text = SCENE.replace("every = 7", "every = 7\ncycles = { frequency = 100.0, body = \"block\" }");
+    assert!(text.contains("cycles = "), "scene template changed");
+    std::fs::write(&scene, &text).unwrap();
     let run = |out: &std::path::Path, extra: &[&str]| {
         let r = ballast().arg("run").arg(&scene).arg("--out").arg(out).arg("--quiet").args(extra).output().unwrap();
         assert!(r.status.success(), "stderr: {}", String::from_utf8_lossy(&r.stderr));
@@ -235,7 +238,8 @@ fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
     drop(f);
     run(&parts, &["--resume", "--vtk-every", "10"]);
     // Snapshots at steps 0, 10, …, 50 and their ParaView collection are identical too.
-    let mut files = vec!["series.csv".to_string(), "final.json".to_string(), "run.pvd".to_string()];
+    let mut files = ["series.csv", "final.json", "run.pvd", "cycles.csv"].map(String::from).to_vec();
+    assert_eq!(std::fs::read_to_string(whole.join("cycles.csv")).unwrap().lines().count(), 6, "header + 5 cycles");
     for step in (0..=50).step_by(10) {
         files.push(format!("vtk/bodies_{step:09}.vtp"));
         files.push(format!("vtk/contacts_{step:09}.vtp"));
@@ -253,7 +257,7 @@ fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
 
     // A checkpoint of another scene is refused with a one-line input error.
     run(&parts, &["--stop-after", "5"]);
-    std::fs::write(&scene, SCENE.replace("every = 7", "every = 8")).unwrap();
+    std::fs::write(&scene, text.replace("every = 7", "every = 8")).unwrap();
     let r = ballast().arg("run").arg(&scene).arg("--out").arg(&parts).arg("--resume").output().unwrap();
     assert_eq!(r.status.code(), Some(2));
     let err = String::from_utf8_lossy(&r.stderr);

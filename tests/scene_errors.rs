@@ -435,3 +435,15 @@ fn equilibrium_criterion_is_validated_and_round_trips() {
     let again = Scene::from_toml_str(&scene.to_toml_string().unwrap()).unwrap();
     assert_eq!(again.simulation.equilibrium, scene.simulation.equilibrium);
 }
+
+#[test]
+fn cycle_output_is_validated_and_round_trips() {
+    let with = |c: &str| edit("every = 2\n", &format!("every = 2\ncycles = {c}\n"));
+    expect(&with("{ frequency = 20.0, body = \"nobody\" }"), &["output.cycles.body", "unknown body 'nobody'"]);
+    expect(&with("{ frequency = -1.0, body = \"block\" }"), &["output.cycles.frequency", "positive"]);
+    expect(&with("{ frequency = 20.0 }"), &["missing field `body`"]);
+    let scene = Scene::from_toml_str(&with("{ frequency = 20.0, body = \"block\" }")).unwrap();
+    assert_eq!(scene.output_cycles(), Some((20.0, 1)));
+    let again = Scene::from_toml_str(&scene.to_toml_string().unwrap()).unwrap();
+    assert_eq!(again.output_cycles(), Some((20.0, 1)));
+}

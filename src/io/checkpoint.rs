@@ -46,6 +46,9 @@ pub struct Checkpoint {
     /// Snapshots listed in `run.pvd` so far (empty without `--vtk-every`).
     #[serde(default)]
     pub snapshots: super::vtk::PvdCollection,
+    /// The per-cycle recorder (with `output.cycles`).
+    #[serde(default)]
+    pub cycles: Option<super::cycles::CycleRecorder>,
 }
 
 impl Checkpoint {

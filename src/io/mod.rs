@@ -6,6 +6,7 @@
 //! - `scene.toml`: a byte copy of the input scene ([`copy_scene`]);
 //! - `final_scene.toml`: the input scene with the final state, to restart from;
 //! - `run.json`: seed, engine, crate version, number of steps, time step ([`RunInfo`]);
+//! - `cycles.csv`: per-cycle settlement statistics with `output.cycles` ([`cycles`]);
 //! - `checkpoint.json`: the whole state, every few minutes, for `--resume`
 //!   ([`checkpoint::Checkpoint`]);
 //! - with `--vtk-every N`: `vtk/bodies_*.vtp`, `vtk/contacts_*.vtp` and `run.pvd`,
@@ -14,6 +15,7 @@
 //! Every I/O error names the file it happened on.
 
 pub mod checkpoint;
+pub mod cycles;
 pub mod final_state;
 pub mod series;
 pub mod vtk;

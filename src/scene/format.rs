@@ -152,6 +152,20 @@ pub struct OutputSection {
     /// Steps between two rows of `series.csv`, ≥ 1 (the last step always has a row).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub every: Option<u64>,
+    /// Per-cycle statistics of a cyclically loaded run (`cycles.csv`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycles: Option<CyclesSpec>,
+}
+
+/// `output.cycles`: one row of `cycles.csv` per loading cycle of `frequency` (Hz),
+/// following the body named `body` (the sleeper).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CyclesSpec {
+    /// Loading frequency (Hz), > 0: a cycle lasts `1/frequency` s from t = 0.
+    pub frequency: f64,
+    /// Name of the followed body.
+    pub body: String,
 }
 
 /// `[[material]]`.

@@ -88,6 +88,13 @@ impl Scene {
     }
 
     /// Number of steps between two rows of `series.csv` (default 1, never 0).
+    /// The per-cycle output, if any: `(frequency Hz, index of the followed body)`.
+    pub fn output_cycles(&self) -> Option<(f64, usize)> {
+        let c = self.output.as_ref()?.cycles.as_ref()?;
+        let body = self.bodies.iter().position(|b| b.name == c.body)?;
+        Some((c.frequency, body))
+    }
+
     pub fn output_every(&self) -> u64 {
         self.output.as_ref().and_then(|o| o.every).unwrap_or(DEFAULT_OUTPUT_EVERY).max(1)
     }

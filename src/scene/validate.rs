@@ -434,5 +434,12 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
         }
     };
 
+    if let Some(c) = scene.output.as_ref().and_then(|o| o.cycles.as_ref()) {
+        positive("output.cycles.frequency", c.frequency)?;
+        if !names.contains_key(c.body.as_str()) || c.body.is_empty() {
+            return err(format!("output.cycles.body: unknown body '{}'", c.body));
+        }
+    }
+
     Ok(Checked { nlgs, theta, alert_distance, bodies, springs })
 }

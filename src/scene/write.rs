@@ -135,6 +135,9 @@ pub(crate) fn to_toml(scene: &Scene) -> String {
     if let Some(o) = &scene.output {
         out.push_str("\n[output]\n");
         opt(&mut out, "every", o.every, |e| e.to_string());
+        opt(&mut out, "cycles", o.cycles.as_ref(), |c| {
+            format!("{{ frequency = {}, body = {} }}", float(c.frequency), string(&c.body))
+        });
     }
     for m in &scene.materials {
         out.push_str("\n[[material]]\n");
