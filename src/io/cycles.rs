@@ -90,8 +90,8 @@ impl CycleRecorder {
         self.sum_contacts += stats.contacts as f64;
         self.sum_iterations += stats.iterations as f64;
         self.max_overlap = self.max_overlap.max(stats.max_overlap);
-        // The step ends the cycle when the next step would end past its end
-        // (half a step of tolerance against round-off of the clock).
+        // This step closes the cycle if it ends within half a step of the cycle's
+        // end or past it (the half step absorbs the round-off of the clock).
         let end = (self.cycle + 1) as f64 / self.frequency;
         if sys.time + 0.5 * sys.params.dt < end {
             return None;
