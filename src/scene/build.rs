@@ -11,7 +11,7 @@ use super::format::Scene;
 use super::validate::{check, shape_of};
 use crate::error::Result;
 use crate::geometry::{perp, rotate, Vec2};
-use crate::nscd::{BodyInfo, ContactLaw, Imposed, Load, NscdParams, Spring, System};
+use crate::nscd::{BodyInfo, ContactLaw, Imposed, NscdParams, Spring, System};
 
 impl Scene {
     /// Validates the scene and builds the NSCD system at time 0.
@@ -42,22 +42,7 @@ impl Scene {
                     imposed.dof[d] = drive.map(|x| x.to_harmonic());
                 }
             }
-            let loads = spec
-                .load
-                .iter()
-                .map(|l| {
-                    let n = l.direction[0].hypot(l.direction[1]);
-                    Load {
-                        direction: [l.direction[0] / n, l.direction[1] / n],
-                        force: crate::nscd::Harmonic {
-                            mean: l.mean,
-                            amplitude: l.amplitude,
-                            frequency: l.frequency,
-                            phase: l.phase,
-                        },
-                    }
-                })
-                .collect();
+            let loads = spec.load.iter().map(|l| l.to_load()).collect();
             let angle = spec.angle();
             let (s, c) = angle.sin_cos();
             let rc = rotate(body.centroid, c, s);

@@ -385,6 +385,23 @@ pub struct LoadSpec {
     pub phase: f64,
 }
 
+impl LoadSpec {
+    /// As the engine's load: unit direction and harmonic magnitude (N). The
+    /// direction must be non-zero (checked by the validation).
+    pub fn to_load(&self) -> crate::nscd::Load {
+        let n = self.direction[0].hypot(self.direction[1]);
+        crate::nscd::Load {
+            direction: [self.direction[0] / n, self.direction[1] / n],
+            force: crate::nscd::Harmonic {
+                mean: self.mean,
+                amplitude: self.amplitude,
+                frequency: self.frequency,
+                phase: self.phase,
+            },
+        }
+    }
+}
+
 /// `[[spring]]`: a viscoelastic sublayer spring (law (17), see
 /// [`crate::nscd::sublayer`]) between a point of `body` and either a world
 /// `anchor` or a point of the body `other`.
