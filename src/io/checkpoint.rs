@@ -55,10 +55,8 @@ impl Checkpoint {
     /// Writes `DIR/checkpoint.json` atomically.
     pub fn write(&self, dir: &Path) -> Result<PathBuf> {
         let path = dir.join(CHECKPOINT_FILE);
-        let tmp = dir.join(format!("{CHECKPOINT_FILE}.tmp"));
         let text = serde_json::to_string(self).map_err(|e| Error::Io(std::io::Error::other(e)))?;
-        std::fs::write(&tmp, text).map_err(|e| io_error(&tmp, "write", e))?;
-        std::fs::rename(&tmp, &path).map_err(|e| io_error(&path, "write", e))?;
+        super::write_atomic(&path, &text)?;
         Ok(path)
     }
 

@@ -54,6 +54,16 @@ pub fn write_text(dir: &Path, name: &str, text: &str) -> Result<PathBuf> {
     Ok(path)
 }
 
+/// Writes `text` to `path` through a temporary file `path.tmp` renamed over it, so a
+/// reader (or a run killed during the write) never sees a half-written file.
+pub fn write_atomic(path: &Path, text: &str) -> Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    std::fs::write(&tmp, text).map_err(|e| io_error(&tmp, "write", e))?;
+    std::fs::rename(&tmp, path).map_err(|e| io_error(path, "write", e))
+}
+
 /// Copies the scene file `scene` byte for byte to `dir/scene.toml`.
 pub fn copy_scene(scene: &Path, dir: &Path) -> Result<PathBuf> {
     let bytes = std::fs::read(scene).map_err(|e| io_error(scene, "read", e))?;

@@ -240,9 +240,7 @@ impl PvdCollection {
     /// temporary name and renamed, so a reader never sees it half written.
     pub fn write(&self, path: &Path) -> Result<PathBuf> {
         let base = path.parent().unwrap_or(Path::new(""));
-        let tmp = path.with_extension("pvd.tmp");
-        write_file(&tmp, &self.to_xml(base))?;
-        std::fs::rename(&tmp, path).map_err(|e| io_error(path, "write", e))?;
+        super::write_atomic(path, &self.to_xml(base))?;
         Ok(path.to_path_buf())
     }
 }
