@@ -24,6 +24,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+#[path = "cli/saussine.rs"]
+mod saussine;
+
 #[derive(Debug, Parser)]
 #[command(name = "ballast", version, about = "Granular mechanics under cyclic loading (railway ballast settlement)")]
 struct Cli {
@@ -78,10 +81,13 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         out: PathBuf,
     },
+    /// The numerical experiments of Saussine et al. (2006): sample, loaded scenes, studies.
+    #[command(subcommand)]
+    Saussine(saussine::SaussineCommand),
 }
 
 /// Why a command failed, and its exit code.
-enum Failure {
+pub(crate) enum Failure {
     /// Invalid input: exit code 2.
     Input(Error),
     /// The run or its outputs failed: exit code 1.
@@ -95,6 +101,7 @@ fn main() -> ExitCode {
             run(&scene, &out, &RunOptions { quiet, checkpoint_every, resume, stop_after, vtk_every })
         }
         Command::Deposit { grains, width, seed, dt, duration, out } => deposit(grains, width, seed, dt, duration, &out),
+        Command::Saussine(cmd) => saussine::main(cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -142,16 +149,16 @@ fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
 }
 
 /// Options of `ballast run` besides the scene and the output directory.
-struct RunOptions {
-    quiet: bool,
-    checkpoint_every: f64,
-    resume: bool,
-    stop_after: Option<u64>,
-    vtk_every: u64,
+pub(crate) struct RunOptions {
+    pub quiet: bool,
+    pub checkpoint_every: f64,
+    pub resume: bool,
+    pub stop_after: Option<u64>,
+    pub vtk_every: u64,
 }
 
 /// `ballast run`.
-fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> {
+pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> {
     let scene_text = Scene::read_text(scene_path).map_err(Failure::Input)?;
     let scene = Scene::from_toml_str_named(&scene_text, &scene_path.display().to_string()).map_err(Failure::Input)?;
     let steps = scene.steps();

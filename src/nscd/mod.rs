@@ -14,6 +14,7 @@ pub mod coulomb;
 pub mod criterion;
 pub mod detection;
 pub mod loads;
+pub mod measure;
 pub mod narrow_phase;
 pub mod nlgs;
 pub mod shadow_overlap;

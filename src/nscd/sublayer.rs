@@ -108,6 +108,13 @@ impl Spring {
         }
     }
 
+    /// Unit axis from the second end to the first (`a`) in configuration `q`: a
+    /// positive `R_N` pushes `a` along it.
+    pub fn axis(&self, q: &[[f64; 3]]) -> [f64; 2] {
+        let n = self.geometry(q).0;
+        [n.x, n.y]
+    }
+
     /// Current length (m).
     pub fn length(&self, q: &[[f64; 3]]) -> f64 {
         self.geometry(q).1

@@ -1,0 +1,295 @@
+//! `ballast saussine …`: the numerical experiments of Saussine et al. (2006),
+//! each from scene files that are written into the output folder and run with
+//! the same loop as `ballast run` (progress, checkpoints, `--resume`).
+//!
+//! - `sample`: generate and deposit the sample (stage 1, and 1b for a free bank),
+//!   save it as `sample.toml`, measure its balance, solid fraction and
+//!   coordination number (`sample.json`);
+//! - `load`: write the loaded scene (sleeper with bars, load, sublayer stiffness,
+//!   solver, time step, number of cycles) from a deposited sample.
+
+use crate::{run, Failure, RunOptions};
+use ballast::nscd::measure;
+use ballast::scenarios::saussine::{
+    loaded_scene, open_bank, sample_scene, Guide, LoadingSpec, SampleSpec, GRAIN_PREFIX,
+};
+use ballast::scene::Scene;
+use ballast::Error;
+use clap::Subcommand;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Subcommand)]
+pub enum SaussineCommand {
+    /// Generates the sample (361 + 242 + 121 pentagons on the viscoelastic sublayer),
+    /// deposits it under gravity until equilibrium and saves it as DIR/sample.toml.
+    Sample {
+        /// Seed of the grains' order, positions, orientations and velocities.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Free bank: deposit in a mould, remove it and let the layer settle again.
+        #[arg(long)]
+        bank: bool,
+        /// Scale the grading to about this many grains (and the width with it).
+        #[arg(long)]
+        grains: Option<usize>,
+        /// Time step of the deposit (s).
+        #[arg(long, default_value_t = 2e-4)]
+        dt: f64,
+        /// Output directory.
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Continue an interrupted deposit.
+        #[arg(long)]
+        resume: bool,
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Writes the loaded scene: the sample with the sleeper (and its bars) on top under
+    /// F = A + B cos(2π f t − φ), ready for `ballast run`.
+    Load {
+        /// A deposited sample (`sample.toml` of `ballast saussine sample`).
+        #[arg(long, value_name = "FILE")]
+        sample: PathBuf,
+        /// Output scene file.
+        #[arg(long, value_name = "FILE")]
+        out: PathBuf,
+        #[command(flatten)]
+        loading: LoadingArgs,
+    },
+}
+
+/// Settings of the loaded stage shared by the subcommands.
+#[derive(Debug, Clone, clap::Args)]
+pub struct LoadingArgs {
+    /// Number of loading cycles.
+    #[arg(long, default_value_t = 100)]
+    pub cycles: u64,
+    /// Angle of the load from the vertical (degrees).
+    #[arg(long, default_value_t = 0.0)]
+    pub inclination: f64,
+    /// Sleeper guide: vertical (vx, spin imposed), level (spin imposed) or free;
+    /// default: vertical for a vertical load, level otherwise.
+    #[arg(long)]
+    pub guide: Option<String>,
+    /// Factor on the sublayer stiffness k_N (§4.2: 1, 100, 1000).
+    #[arg(long, default_value_t = 1.0)]
+    pub stiffness_factor: f64,
+    /// Time step (s).
+    #[arg(long, default_value_t = 2e-4)]
+    pub dt: f64,
+    /// Convergence policy: strict, quad, quad_max, energy.
+    #[arg(long, default_value = "quad_max")]
+    pub criterion: String,
+    /// Tolerance of the policy.
+    #[arg(long, default_value_t = 1e-4)]
+    pub tolerance: f64,
+    #[arg(long, default_value_t = 1)]
+    pub min_iterations: usize,
+    #[arg(long, default_value_t = 2000)]
+    pub max_iterations: usize,
+    /// Square bars under the sleeper (0: a flat sleeper).
+    #[arg(long, default_value_t = 2)]
+    pub bars: usize,
+}
+
+impl LoadingArgs {
+    pub fn spec(&self) -> Result<LoadingSpec, Failure> {
+        let guide = match self.guide.as_deref() {
+            None if self.inclination == 0.0 => Guide::Vertical,
+            None => Guide::Level,
+            Some("vertical") => Guide::Vertical,
+            Some("level") => Guide::Level,
+            Some("free") => Guide::Free,
+            Some(g) => return Err(input(format!("--guide: expected vertical, level or free, got '{g}'"))),
+        };
+        if !(self.stiffness_factor.is_finite() && self.stiffness_factor > 0.0) {
+            return Err(input(format!("--stiffness-factor: must be positive, got {}", self.stiffness_factor)));
+        }
+        if !(self.inclination.is_finite() && self.inclination.abs() < 90.0) {
+            return Err(input(format!("--inclination: must be in (-90, 90) degrees, got {}", self.inclination)));
+        }
+        if self.cycles == 0 {
+            return Err(input("--cycles: must be at least 1".into()));
+        }
+        Ok(LoadingSpec {
+            inclination_deg: self.inclination,
+            guide,
+            stiffness_factor: self.stiffness_factor,
+            dt: self.dt,
+            criterion: self.criterion.clone(),
+            tolerance: self.tolerance,
+            min_iterations: self.min_iterations,
+            max_iterations: self.max_iterations,
+            bars: self.bars,
+            ..LoadingSpec::saussine(self.cycles)
+        })
+    }
+}
+
+fn input(msg: String) -> Failure {
+    Failure::Input(Error::Scene(msg))
+}
+
+fn io(e: std::io::Error) -> Failure {
+    Failure::Run(Error::Io(e))
+}
+
+pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
+    match cmd {
+        SaussineCommand::Sample { seed, bank, grains, dt, out, resume, quiet } => {
+            let mut spec = SampleSpec { bank, dt, ..SampleSpec::saussine(seed) };
+            if let Some(n) = grains {
+                if n == 0 {
+                    return Err(input("--grains: must be at least 1".into()));
+                }
+                spec = spec.scaled(n);
+            }
+            sample(&spec, &out, resume, quiet)
+        }
+        SaussineCommand::Load { sample, out, loading } => {
+            let scene = Scene::load(&sample).map_err(Failure::Input)?;
+            let loaded = loaded_scene(&scene, &loading.spec()?).map_err(Failure::Input)?;
+            write_scene(&out, &loaded, &format!("loaded from {}", sample.display()))?;
+            println!("wrote {}", out.display());
+            Ok(())
+        }
+    }
+}
+
+/// Writes `scene` to `path` with a header line.
+fn write_scene(path: &Path, scene: &Scene, what: &str) -> Result<(), Failure> {
+    let text = format!(
+        "# Written by ballast {} (Saussine et al. 2006 experiments): {}.\n\n{}",
+        env!("CARGO_PKG_VERSION"),
+        what.replace(char::is_control, "?"),
+        scene.to_toml_string().map_err(Failure::Run)?
+    );
+    std::fs::write(path, text).map_err(io)
+}
+
+/// Runs `scene_path` into `dir` unless a finished run is there already.
+fn run_stage(scene_path: &Path, dir: &Path, resume: bool, quiet: bool) -> Result<Scene, Failure> {
+    let final_scene = dir.join("final_scene.toml");
+    let done = final_scene.exists() && !dir.join(ballast::io::CHECKPOINT_FILE).exists();
+    if !(resume && done) {
+        let resume = resume && dir.join(ballast::io::CHECKPOINT_FILE).exists();
+        let opts = RunOptions { quiet, checkpoint_every: 300.0, resume, stop_after: None, vtk_every: 0 };
+        run(scene_path, dir, &opts)?;
+    }
+    Scene::load(&final_scene).map_err(Failure::Run)
+}
+
+/// What `sample.json` records about a deposited sample.
+#[derive(Debug, Serialize)]
+pub struct SampleReport {
+    pub seed: u64,
+    pub grains: usize,
+    /// Vertical balance over 20 steps at rest (N).
+    pub weight_n: f64,
+    pub sublayer_reaction_n: f64,
+    pub floor_reaction_n: f64,
+    pub wall_friction_n: f64,
+    /// (springs + floors + walls − weight) / weight.
+    pub balance_error: f64,
+    pub mean_overlap_m: f64,
+    pub max_overlap_m: f64,
+    /// Window of the solid fraction (m): x0, x1, y0, y1.
+    pub window_m: [f64; 4],
+    pub solid_fraction: f64,
+    pub coordination: f64,
+    pub rattler_fraction: f64,
+    /// Mean height of the layer's top surface above the sublayer (m).
+    pub thickness_m: f64,
+}
+
+/// Measures a deposited sample: 20 steps at rest, then balance, overlaps,
+/// solid fraction in a window away from the walls, floor and surface, coordination.
+pub fn measure_sample(scene: &Scene) -> ballast::Result<SampleReport> {
+    let mut sys = scene.build()?;
+    let mut st = sys.step()?;
+    for _ in 1..20 {
+        st = sys.step()?;
+    }
+    let grains: Vec<usize> =
+        scene.bodies.iter().enumerate().filter(|(_, b)| b.name.starts_with(GRAIN_PREFIX)).map(|(i, _)| i).collect();
+    let polys: Vec<Vec<[f64; 2]>> = grains.iter().map(|&i| measure::world_polygon(&sys, i)).collect();
+    let (mut x0, mut x1, mut d) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+    for p in &polys {
+        for v in p {
+            x0 = x0.min(v[0]);
+            x1 = x1.max(v[0]);
+        }
+        let (lo, hi) = p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v[1]), h.max(v[1])));
+        d = d.max(hi - lo);
+    }
+    // Top surface: highest vertex in bins one largest grain wide; thickness = mean.
+    let bins = (((x1 - x0) / d).floor() as usize).max(1);
+    let mut surf = vec![f64::NEG_INFINITY; bins];
+    for p in &polys {
+        for v in p {
+            let k = (((v[0] - x0) / d) as usize).min(bins - 1);
+            surf[k] = surf[k].max(v[1]);
+        }
+    }
+    // Only the middle half of the bins: the banks (if any) are lower.
+    let mid = &surf[bins / 4..bins - bins / 4];
+    let thickness = mid.iter().sum::<f64>() / mid.len() as f64;
+    let low = mid.iter().copied().fold(f64::INFINITY, f64::min);
+    let window = [-0.25 * (x1 - x0) + 0.5 * (x0 + x1), 0.25 * (x1 - x0) + 0.5 * (x0 + x1), d, low - d];
+    let phi = if window[3] > window[2] { measure::solid_fraction(&sys, &grains, window) } else { f64::NAN };
+    let z = measure::coordination(&sys, &grains, 0.0);
+    let b = measure::vertical_balance(&sys);
+    Ok(SampleReport {
+        seed: scene.seed(),
+        grains: grains.len(),
+        weight_n: b.weight,
+        sublayer_reaction_n: b.springs,
+        floor_reaction_n: b.floors,
+        wall_friction_n: b.walls,
+        balance_error: b.residual() / b.weight,
+        mean_overlap_m: st.mean_overlap,
+        max_overlap_m: st.max_overlap,
+        window_m: window,
+        solid_fraction: phi,
+        coordination: z.z,
+        rattler_fraction: z.rattlers,
+        thickness_m: thickness,
+    })
+}
+
+fn sample(spec: &SampleSpec, out: &Path, resume: bool, quiet: bool) -> Result<(), Failure> {
+    let text = sample_scene(spec);
+    Scene::from_toml_str(&text).map_err(Failure::Input)?;
+    ballast::io::create_output_dir(out).map_err(Failure::Run)?;
+    let deposit = out.join("deposit.toml");
+    std::fs::write(&deposit, &text).map_err(io)?;
+    let mut settled = run_stage(&deposit, &out.join("deposit"), resume, quiet)?;
+    if spec.bank {
+        let opened = open_bank(&settled).map_err(Failure::Run)?;
+        let bank = out.join("bank.toml");
+        write_scene(&bank, &opened, "the deposited sample without its mould, to settle into free banks")?;
+        settled = run_stage(&bank, &out.join("bank"), resume, quiet)?;
+    }
+    let path = out.join("sample.toml");
+    write_scene(&path, &settled, &format!("deposited sample, seed {}", spec.seed))?;
+    let report = measure_sample(&settled).map_err(Failure::Run)?;
+    ballast::io::write_json(&out.join("sample.json"), &report).map_err(Failure::Run)?;
+    println!(
+        "sample {}: {} grains, layer {:.1} mm thick; weight {:.2} N, sublayer {:.2} N, walls {:.2} N (balance error \
+         {:.2e}); mean overlap {:.2e} m, max {:.2e} m; solid fraction {:.3}, coordination {:.2} ({:.0} % rattlers)",
+        path.display(),
+        report.grains,
+        1e3 * report.thickness_m,
+        report.weight_n,
+        report.sublayer_reaction_n,
+        report.wall_friction_n,
+        report.balance_error,
+        report.mean_overlap_m,
+        report.max_overlap_m,
+        report.solid_fraction,
+        report.coordination,
+        100.0 * report.rattler_fraction
+    );
+    Ok(())
+}

@@ -1,0 +1,411 @@
+//! The ballast sample of Saussine et al. (2006), §3–4: a pentagon layer
+//! deposited under gravity on a viscoelastic sublayer, then a rigid sleeper with
+//! bars under its lower face, loaded by `F = A + B cos(2π f t − φ)`.
+//!
+//! Two stages, each a plain scene (TOML text) run by `ballast run`, so that every
+//! stage is saved, validated and rerun like a hand-written scene:
+//! 1. [`sample_scene`]: the loose sample above the sublayer, between two side
+//!    walls, to deposit until equilibrium. With [`SampleSpec::bank`] the side walls
+//!    of the deposit are a mould that [`open_bank`] removes afterwards, so the
+//!    layer ends with a free bank formed by the grains themselves (a second run
+//!    to equilibrium), inside a wider frame.
+//! 2. [`loaded_scene`]: the deposited sample with the sleeper placed on top and
+//!    loaded, the sublayer stiffness scaled, the solver and step set for a study.
+//!
+//! The geometry and its reasoning are in `data/saussine2006/README.md`:
+//! "diameter" of the paper's grading is the circumscribed diameter (circumradii
+//! 5, 7.5, 10 mm); the out-of-plane thickness is 1 m (LMGC90's 2D convention, so
+//! the paper's force and sublayer values apply as printed); each sublayer pad
+//! is a 20 × 10 mm rigid block on one spring of law (17) of rest length 10 mm
+//! with `k_N` = 4100 N per unit strain and `ν` = 80 N·s, moving vertically only.
+
+use crate::error::{Error, Result};
+use crate::scene::{BodySpec, Scene};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::f64::consts::PI;
+use std::fmt::Write;
+
+/// Names of the bodies the stages look for.
+pub const SLEEPER: &str = "sleeper";
+/// Prefix of the sublayer pads' names (`pad0`, `pad1`, …).
+pub const PAD_PREFIX: &str = "pad";
+/// Prefix of the grains' names (`g0`, `g1`, …).
+pub const GRAIN_PREFIX: &str = "g";
+/// Names of the mould walls removed by [`open_bank`].
+pub const MOULD: [&str; 2] = ["mould_left", "mould_right"];
+
+/// The sample of stage 1.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampleSpec {
+    /// `(circumradius m, count)` of each grain class.
+    pub grading: Vec<(f64, usize)>,
+    /// Inner width between the side walls of the deposit (m).
+    pub width: f64,
+    /// The deposit walls are a mould removed after deposition (free banks).
+    pub bank: bool,
+    /// With `bank`: extent of the sublayer and frame beyond the mould on each side (m).
+    pub bank_margin: f64,
+    /// Sublayer pads: width and height (m), gap between neighbours (m).
+    pub pad_width: f64,
+    pub pad_height: f64,
+    pub pad_gap: f64,
+    /// Rest length `L0` of the pad springs (m).
+    pub spring_length: f64,
+    /// Law (17): force per unit strain `k_N` (N) and per unit strain rate `ν` (N·s).
+    pub k_n: f64,
+    pub nu: f64,
+    /// Grain density (kg/m³) and friction coefficient (all contacts).
+    pub density: f64,
+    pub friction: f64,
+    pub seed: u64,
+    /// Time step (s) and longest deposit (s): the run stops at equilibrium before.
+    pub dt: f64,
+    pub max_duration: f64,
+}
+
+impl SampleSpec {
+    /// The paper's sample: 361 pentagons of 1 cm, 242 of 1.5 cm, 121 of 2 cm
+    /// (circumscribed diameters), ρ = 2367 kg/m³, μ = 0.5, e = 0, between walls 1 m
+    /// apart (a layer about 10 cm thick), on pads with k_N = 4100 N, ν = 80 N·s.
+    pub fn saussine(seed: u64) -> Self {
+        Self {
+            grading: vec![(0.005, 361), (0.0075, 242), (0.01, 121)],
+            width: 1.0,
+            bank: false,
+            bank_margin: 0.25,
+            pad_width: 0.02,
+            pad_height: 0.01,
+            pad_gap: 0.001,
+            spring_length: 0.01,
+            k_n: 4100.0,
+            nu: 80.0,
+            density: 2367.0,
+            friction: 0.5,
+            seed,
+            dt: 2e-4,
+            max_duration: 4.0,
+        }
+    }
+
+    /// The same grading scaled to about `n` grains in the proportions 361 : 242 : 121,
+    /// and the width scaled to keep the layer's thickness (for quick tests).
+    pub fn scaled(mut self, n: usize) -> Self {
+        let total: usize = self.grading.iter().map(|g| g.1).sum();
+        let f = n as f64 / total as f64;
+        self.grading.iter_mut().for_each(|g| g.1 = ((g.1 as f64 * f).round() as usize).max(1));
+        self.width *= f;
+        self
+    }
+
+    /// Total solid area of the grains (m²): a regular pentagon of circumradius r has area (5/2) r² sin 72°.
+    pub fn solid_area(&self) -> f64 {
+        self.grading.iter().map(|&(r, n)| n as f64 * 2.5 * r * r * (0.4 * PI).sin()).sum()
+    }
+}
+
+/// One rectangle `[x0, x1] × [y0, y1]` as a counter-clockwise polygon literal.
+fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> String {
+    format!("[[{x0:?}, {y0:?}], [{x1:?}, {y0:?}], [{x1:?}, {y1:?}], [{x0:?}, {y1:?}]]")
+}
+
+/// The stage-1 scene: loose grains above the sublayer, to deposit until
+/// equilibrium (kinetic energy below 1e-11 J per grain for 500 steps).
+pub fn sample_scene(spec: &SampleSpec) -> String {
+    let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
+    let mut radii: Vec<f64> = spec.grading.iter().flat_map(|&(r, n)| std::iter::repeat_n(r, n)).collect();
+    for i in (1..radii.len()).rev() {
+        let j = rng.random_range(0..=i);
+        radii.swap(i, j);
+    }
+    let n = radii.len();
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# Saussine et al. (2006) ballast sample, stage 1 (deposit): {n} pentagons, seed {}, {}.\n\
+         # Geometry and reasoning: data/saussine2006/README.md.\n",
+        spec.seed,
+        if spec.bank { "mould for a free bank" } else { "between side walls" }
+    );
+    let _ = writeln!(
+        s,
+        "[simulation]\nengine = \"nscd\"\ndt = {:?}\nduration = {:?}\ngravity = [0.0, -9.81]\nthickness = 1.0\n\
+         seed = {}\nequilibrium = {{ kinetic_energy = {:?}, steps = 500 }}\n",
+        spec.dt,
+        spec.max_duration,
+        spec.seed,
+        1e-11 * n as f64
+    );
+    let _ = writeln!(
+        s,
+        "[nscd]\ntheta = 0.5\ncriterion = \"quad_max\"\ntolerance = 1.0e-4\nmax_iterations = 2000\n\n\
+         [output]\nevery = 50\n"
+    );
+    for (name, rho) in [("ballast", spec.density), ("elastomer", 1100.0), ("frame", 2400.0)] {
+        let _ = writeln!(s, "[[material]]\nname = \"{name}\"\ndensity = {rho:?}\n");
+    }
+    // Grain–grain and grain–sublayer contacts have the paper's μ; the frame's side
+    // walls are smooth (μ = 0), so that the sublayer alone carries the weight (no
+    // Janssen share on the walls; measured with μ = 0.5 walls: −1.3 % of the weight,
+    // held down by the walls after the sublayer's rebound).
+    for (other, mu) in [("ballast", spec.friction), ("elastomer", spec.friction), ("frame", 0.0)] {
+        let _ = writeln!(s, "[[contact]]\nbetween = [\"ballast\", \"{other}\"]\nfriction = {mu:?}\n");
+    }
+
+    // Sublayer: pads side by side over the frame's width, top faces at y = 0.
+    let frame = if spec.bank { spec.width + 2.0 * spec.bank_margin } else { spec.width };
+    let pitch = spec.pad_width + spec.pad_gap;
+    let pads = ((frame + spec.pad_gap) / pitch).floor().max(1.0) as usize;
+    let pad_w = (frame - spec.pad_gap * (pads as f64 + 1.0)) / pads as f64;
+    let (ph, l0) = (spec.pad_height, spec.spring_length);
+    let y_anchor = -ph / 2.0 - l0;
+
+    // Grains: rows filled left to right inside the deposit walls, each grain
+    // 1 mm from its neighbours, rows one largest diameter + 1 mm apart: a loose
+    // but compact start, so the layer falls only a few centimetres.
+    let clearance = 0.001;
+    let (left, right) = (-spec.width / 2.0, spec.width / 2.0);
+    let mut placed = Vec::with_capacity(n);
+    let (mut x, mut y_row, mut row_r) = (left, ph.max(0.0) + clearance, 0.0f64);
+    let mut row: Vec<(f64, f64)> = Vec::new();
+    let flush = |row: &mut Vec<(f64, f64)>, y_row: f64, row_r: f64, placed: &mut Vec<(f64, f64, f64)>| {
+        for &(xc, r) in row.iter() {
+            placed.push((xc, y_row + row_r, r));
+        }
+        row.clear();
+    };
+    for &r in &radii {
+        if x + 2.0 * r + clearance > right {
+            flush(&mut row, y_row, row_r, &mut placed);
+            y_row += 2.0 * row_r + clearance;
+            x = left;
+            row_r = 0.0;
+        }
+        row.push((x + clearance + r, r));
+        x += 2.0 * r + clearance;
+        row_r = row_r.max(r);
+    }
+    flush(&mut row, y_row, row_r, &mut placed);
+    let top = placed.iter().map(|p| p.1 + p.2).fold(0.0, f64::max);
+    let wall_top = top + 0.05;
+
+    // Frame: side walls down past the pads (the sublayer stands in the frame).
+    let t = 0.05;
+    let bottom = y_anchor - 0.01;
+    let (fl, fr) = (-frame / 2.0, frame / 2.0);
+    for (name, poly) in [("left_wall", rect(fl - t, bottom, fl, wall_top)), ("right_wall", rect(fr, bottom, fr + t, wall_top))]
+    {
+        let _ = writeln!(s, "[[body]]\nname = \"{name}\"\nmaterial = \"frame\"\npolygon = {poly}\nposition = [0.0, 0.0]\nfixed = true\n");
+    }
+    if spec.bank {
+        // The mould stands 1 mm above the pads (grains, inradius ≥ 4 mm, cannot pass).
+        for (name, poly) in [(MOULD[0], rect(left - t, 0.001, left, wall_top)), (MOULD[1], rect(right, 0.001, right + t, wall_top))] {
+            let _ = writeln!(s, "[[body]]\nname = \"{name}\"\nmaterial = \"frame\"\npolygon = {poly}\nposition = [0.0, 0.0]\nfixed = true\n");
+        }
+    }
+    for k in 0..pads {
+        let xc = fl + spec.pad_gap + pad_w / 2.0 + k as f64 * (pad_w + spec.pad_gap);
+        let poly = rect(-pad_w / 2.0, -ph / 2.0, pad_w / 2.0, ph / 2.0);
+        let _ = writeln!(
+            s,
+            "[[body]]\nname = \"{PAD_PREFIX}{k}\"\nmaterial = \"elastomer\"\npolygon = {poly}\nposition = [{xc:?}, {:?}]\n\
+             imposed = {{ vx = 0.0, spin = 0.0 }}\n",
+            -ph / 2.0
+        );
+    }
+    for (k, &(xc, yc, r)) in placed.iter().enumerate() {
+        let angle = 2.0 * PI * rng.random::<f64>();
+        let v = [0.02 * rng.random_range(-1.0..1.0), 0.02 * rng.random_range(-1.0..1.0)];
+        let _ = writeln!(
+            s,
+            "[[body]]\nname = \"{GRAIN_PREFIX}{k}\"\nmaterial = \"ballast\"\nregular = {{ sides = 5, radius = {r:?} }}\n\
+             position = [{xc:?}, {yc:?}]\nangle = {angle:?}\nvelocity = [{:?}, {:?}]\n",
+            v[0], v[1]
+        );
+    }
+    for k in 0..pads {
+        let xc = fl + spec.pad_gap + pad_w / 2.0 + k as f64 * (pad_w + spec.pad_gap);
+        let _ = writeln!(
+            s,
+            "[[spring]]\nbody = \"{PAD_PREFIX}{k}\"\nanchor = [{xc:?}, {y_anchor:?}]\nk_n = {:?}\nnu = {:?}\nrest_length = {l0:?}\n",
+            spec.k_n, spec.nu
+        );
+    }
+    s
+}
+
+/// Stage 1b of a free-bank sample: the deposited sample without its mould, to be
+/// run to equilibrium again (the grains slump into their own bank slope).
+pub fn open_bank(sample: &Scene) -> Result<Scene> {
+    let mut out = sample.clone();
+    let before = out.bodies.len();
+    out.bodies.retain(|b| !MOULD.contains(&b.name.as_str()));
+    if out.bodies.len() == before {
+        return Err(Error::Scene("open_bank: the sample has no mould walls (it was not made with a bank)".into()));
+    }
+    Ok(out)
+}
+
+/// How the sleeper is guided by the loading frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Guide {
+    /// Only vertical motion (vx and spin imposed to 0): the jack of a vertical test.
+    Vertical,
+    /// Translations free, spin imposed to 0: the jack keeps the sleeper level and
+    /// the lateral component of an inclined load can shift it.
+    Level,
+    /// No constraint.
+    Free,
+}
+
+/// The loading stage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadingSpec {
+    /// Sleeper block: width and height (m), density (kg/m³, aluminium).
+    pub sleeper_width: f64,
+    pub sleeper_height: f64,
+    pub sleeper_density: f64,
+    /// Square bars under the sleeper: side (m) and number (evenly spread, the
+    /// outer ones `bar_size` from the ends; 0: a flat sleeper).
+    pub bar_size: f64,
+    pub bars: usize,
+    /// `F = A + B cos(2π f t − φ)` (N, N, Hz, rad), A < 0 pushes down.
+    pub mean: f64,
+    pub amplitude: f64,
+    pub frequency: f64,
+    pub phase: f64,
+    /// Angle of the load from the vertical (degrees, towards +x).
+    pub inclination_deg: f64,
+    pub guide: Guide,
+    /// Factor on the sublayer's `k_N` (1, 100, 1000 in §4.2).
+    pub stiffness_factor: f64,
+    /// Number of loading cycles.
+    pub cycles: u64,
+    /// Time step (s), convergence policy, tolerance, sweep bounds.
+    pub dt: f64,
+    pub criterion: String,
+    pub tolerance: f64,
+    pub min_iterations: usize,
+    pub max_iterations: usize,
+    /// Steps between rows of `series.csv`.
+    pub output_every: u64,
+}
+
+impl LoadingSpec {
+    /// The paper's load (A = −1000 N, B = −500 N, f = 20 Hz, φ = −π), vertical, on
+    /// a 100 × 40 mm aluminium sleeper with two 10 mm bars; dt = 2e-4 s, `quad_max`
+    /// 1e-4 (factor 4), at most 2000 sweeps.
+    pub fn saussine(cycles: u64) -> Self {
+        Self {
+            sleeper_width: 0.1,
+            sleeper_height: 0.04,
+            sleeper_density: 2700.0,
+            bar_size: 0.01,
+            bars: 2,
+            mean: -1000.0,
+            amplitude: -500.0,
+            frequency: 20.0,
+            phase: -PI,
+            inclination_deg: 0.0,
+            guide: Guide::Vertical,
+            stiffness_factor: 1.0,
+            cycles,
+            dt: 2e-4,
+            criterion: "quad_max".into(),
+            tolerance: 1e-4,
+            min_iterations: 1,
+            max_iterations: 2000,
+            output_every: 10,
+        }
+    }
+}
+
+/// The highest point (m) of the grains whose x range meets `[x0, x1]`, from the
+/// scene's bodies (built to get exact world vertices).
+fn surface_under(sample: &Scene, x0: f64, x1: f64) -> Result<f64> {
+    let sys = sample.build()?;
+    let mut top = f64::NEG_INFINITY;
+    for (i, b) in sample.bodies.iter().enumerate() {
+        if !b.name.starts_with(GRAIN_PREFIX) {
+            continue;
+        }
+        let poly = crate::nscd::measure::world_polygon(&sys, i);
+        let (lo, hi) = poly.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p[0]), h.max(p[0])));
+        if hi >= x0 && lo <= x1 {
+            top = poly.iter().map(|p| p[1]).fold(top, f64::max);
+        }
+    }
+    if top.is_finite() {
+        Ok(top)
+    } else {
+        Err(Error::Scene(format!("loaded_scene: no grain under the sleeper's footprint [{x0}, {x1}] m")))
+    }
+}
+
+/// The stage-2 scene: `sample` (a deposited sample, e.g. the `final_scene.toml`
+/// of stage 1) with the sleeper on top at x = 0, its bars resting on the highest
+/// grain under it, loaded for `spec.cycles` cycles.
+pub fn loaded_scene(sample: &Scene, spec: &LoadingSpec) -> Result<Scene> {
+    if sample.bodies.iter().any(|b| b.name == SLEEPER) {
+        return Err(Error::Scene("loaded_scene: the sample already has a sleeper".into()));
+    }
+    if sample.bodies.iter().any(|b| MOULD.contains(&b.name.as_str())) {
+        return Err(Error::Scene("loaded_scene: the sample still has its mould; run open_bank first".into()));
+    }
+    let (w, h, b) = (spec.sleeper_width, spec.sleeper_height, spec.bar_size);
+    let top = surface_under(sample, -w / 2.0, w / 2.0)?;
+    let mut out = sample.clone();
+    out.simulation.equilibrium = None;
+    out.simulation.dt = spec.dt;
+    out.simulation.duration = spec.cycles as f64 / spec.frequency;
+    let nscd = out.nscd.get_or_insert_with(Default::default);
+    nscd.criterion = Some(spec.criterion.clone());
+    nscd.tolerance = Some(spec.tolerance);
+    nscd.min_iterations = Some(spec.min_iterations);
+    nscd.max_iterations = Some(spec.max_iterations);
+    let output = out.output.get_or_insert_with(Default::default);
+    output.every = Some(spec.output_every);
+    output.cycles = Some(crate::scene::CyclesSpec { frequency: spec.frequency, body: SLEEPER.into() });
+    for s in out.springs.iter_mut() {
+        s.k_n *= spec.stiffness_factor;
+    }
+    if !out.materials.iter().any(|m| m.name == "aluminium") {
+        out.materials.push(crate::scene::Material { name: "aluminium".into(), density: spec.sleeper_density });
+    }
+    let friction = out.contacts.iter().find(|c| c.between == ["ballast".to_string(), "ballast".to_string()]).map_or(0.5, |c| c.friction);
+    out.contacts.push(crate::scene::ContactEntry {
+        between: ["ballast".into(), "aluminium".into()],
+        friction,
+        restitution: None,
+        tangential_restitution: None,
+    });
+    // Body frame: origin at the middle of the bars' lower faces.
+    let lift = if spec.bars == 0 { 0.0 } else { b };
+    let mut parts = vec![rect(-w / 2.0, lift, w / 2.0, lift + h)];
+    for k in 0..spec.bars {
+        let x0 = if spec.bars == 1 { -b / 2.0 } else { -w / 2.0 + b + k as f64 * (w - 3.0 * b) / (spec.bars - 1) as f64 };
+        parts.push(rect(x0, 0.0, x0 + b, b));
+    }
+    let imposed = match spec.guide {
+        Guide::Vertical => "imposed = { vx = 0.0, spin = 0.0 }\n",
+        Guide::Level => "imposed = { spin = 0.0 }\n",
+        Guide::Free => "",
+    };
+    let a = spec.inclination_deg.to_radians();
+    // F (negative: downwards) along (−sin a, cos a): the lateral part points to +x.
+    let shape = if spec.bars == 0 { format!("polygon = {}", parts[0]) } else { format!("parts = [{}]", parts.join(", ")) };
+    let text = format!(
+        "name = \"{SLEEPER}\"\nmaterial = \"aluminium\"\n{shape}\nposition = [0.0, {top:?}]\n{imposed}\
+         load = {{ direction = [{:?}, {:?}], mean = {:?}, amplitude = {:?}, frequency = {:?}, phase = {:?} }}\n",
+        -a.sin(),
+        a.cos(),
+        spec.mean,
+        spec.amplitude,
+        spec.frequency,
+        spec.phase
+    );
+    let body: BodySpec = toml::from_str(&text).map_err(|e| Error::Scene(format!("loaded_scene: sleeper: {e}")))?;
+    out.bodies.push(body);
+    // The whole scene goes through the usual validation.
+    Scene::from_toml_str(&out.to_toml_string()?)
+}
