@@ -258,7 +258,17 @@ pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<()
                 }
                 last = Some((stats, written));
                 if k % message_every == 0 {
-                    pb.set_message(format!("t = {:.4} s, Ek = {:.3e} J", stats.time, stats.kinetic_energy));
+                    let per_cycle = cycles.as_ref().map(|c| {
+                        let y = sys.bodies.q[c.body][1];
+                        let total = (steps as f64 * scene.simulation.dt * c.frequency).round();
+                        format!(", cycle {} of {total}, settlement {:.3} mm", c.cycle, 1e3 * (c.y0 - y))
+                    });
+                    pb.set_message(format!(
+                        "t = {:.4} s, Ek = {:.3e} J{}",
+                        stats.time,
+                        stats.kinetic_energy,
+                        per_cycle.unwrap_or_default()
+                    ));
                 }
                 pb.inc(1);
                 if opts.vtk_every > 0 && k % opts.vtk_every == 0 {

@@ -9,14 +9,12 @@
 //!   solver, time step, number of cycles) from a deposited sample.
 
 use crate::{run, Failure, RunOptions};
-use ballast::nscd::measure;
 use ballast::scenarios::saussine::{
-    loaded_scene, open_bank, sample_scene, Guide, LoadingSpec, SampleSpec, GRAIN_PREFIX,
+    loaded_scene, measure_sample, open_bank, sample_scene, Guide, LoadingSpec, SampleSpec,
 };
 use ballast::scene::Scene;
 use ballast::Error;
 use clap::Subcommand;
-use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, Subcommand)]
@@ -91,6 +89,9 @@ pub struct LoadingArgs {
     /// Square bars under the sleeper (0: a flat sleeper).
     #[arg(long, default_value_t = 2)]
     pub bars: usize,
+    /// Width of the sleeper (m).
+    #[arg(long)]
+    pub sleeper_width: Option<f64>,
 }
 
 impl LoadingArgs {
@@ -122,6 +123,7 @@ impl LoadingArgs {
             min_iterations: self.min_iterations,
             max_iterations: self.max_iterations,
             bars: self.bars,
+            sleeper_width: self.sleeper_width.unwrap_or(LoadingSpec::saussine(1).sleeper_width),
             ..LoadingSpec::saussine(self.cycles)
         })
     }
@@ -178,84 +180,6 @@ fn run_stage(scene_path: &Path, dir: &Path, resume: bool, quiet: bool) -> Result
         run(scene_path, dir, &opts)?;
     }
     Scene::load(&final_scene).map_err(Failure::Run)
-}
-
-/// What `sample.json` records about a deposited sample.
-#[derive(Debug, Serialize)]
-pub struct SampleReport {
-    pub seed: u64,
-    pub grains: usize,
-    /// Vertical balance over 20 steps at rest (N).
-    pub weight_n: f64,
-    pub sublayer_reaction_n: f64,
-    pub floor_reaction_n: f64,
-    pub wall_friction_n: f64,
-    /// (springs + floors + walls − weight) / weight.
-    pub balance_error: f64,
-    pub mean_overlap_m: f64,
-    pub max_overlap_m: f64,
-    /// Window of the solid fraction (m): x0, x1, y0, y1.
-    pub window_m: [f64; 4],
-    pub solid_fraction: f64,
-    pub coordination: f64,
-    pub rattler_fraction: f64,
-    /// Mean height of the layer's top surface above the sublayer (m).
-    pub thickness_m: f64,
-}
-
-/// Measures a deposited sample: 20 steps at rest, then balance, overlaps,
-/// solid fraction in a window away from the walls, floor and surface, coordination.
-pub fn measure_sample(scene: &Scene) -> ballast::Result<SampleReport> {
-    let mut sys = scene.build()?;
-    let mut st = sys.step()?;
-    for _ in 1..20 {
-        st = sys.step()?;
-    }
-    let grains: Vec<usize> =
-        scene.bodies.iter().enumerate().filter(|(_, b)| b.name.starts_with(GRAIN_PREFIX)).map(|(i, _)| i).collect();
-    let polys: Vec<Vec<[f64; 2]>> = grains.iter().map(|&i| measure::world_polygon(&sys, i)).collect();
-    let (mut x0, mut x1, mut d) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
-    for p in &polys {
-        for v in p {
-            x0 = x0.min(v[0]);
-            x1 = x1.max(v[0]);
-        }
-        let (lo, hi) = p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v[1]), h.max(v[1])));
-        d = d.max(hi - lo);
-    }
-    // Top surface: highest vertex in bins one largest grain wide; thickness = mean.
-    let bins = (((x1 - x0) / d).floor() as usize).max(1);
-    let mut surf = vec![f64::NEG_INFINITY; bins];
-    for p in &polys {
-        for v in p {
-            let k = (((v[0] - x0) / d) as usize).min(bins - 1);
-            surf[k] = surf[k].max(v[1]);
-        }
-    }
-    // Only the middle half of the bins: the banks (if any) are lower.
-    let mid = &surf[bins / 4..bins - bins / 4];
-    let thickness = mid.iter().sum::<f64>() / mid.len() as f64;
-    let low = mid.iter().copied().fold(f64::INFINITY, f64::min);
-    let window = [-0.25 * (x1 - x0) + 0.5 * (x0 + x1), 0.25 * (x1 - x0) + 0.5 * (x0 + x1), d, low - d];
-    let phi = if window[3] > window[2] { measure::solid_fraction(&sys, &grains, window) } else { f64::NAN };
-    let z = measure::coordination(&sys, &grains, 0.0);
-    let b = measure::vertical_balance(&sys);
-    Ok(SampleReport {
-        seed: scene.seed(),
-        grains: grains.len(),
-        weight_n: b.weight,
-        sublayer_reaction_n: b.springs,
-        floor_reaction_n: b.floors,
-        wall_friction_n: b.walls,
-        balance_error: b.residual() / b.weight,
-        mean_overlap_m: st.mean_overlap,
-        max_overlap_m: st.max_overlap,
-        window_m: window,
-        solid_fraction: phi,
-        coordination: z.z,
-        rattler_fraction: z.rattlers,
-        thickness_m: thickness,
-    })
 }
 
 fn sample(spec: &SampleSpec, out: &Path, resume: bool, quiet: bool) -> Result<(), Failure> {

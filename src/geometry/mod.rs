@@ -1,5 +1,6 @@
-//! Shared 2D geometry: convex polygons and discs in their body frame, their
-//! validation (convexity, orientation, degeneracy) and their mass properties.
+//! Shared 2D geometry: convex polygons, discs and compounds (rigid unions of
+//! convex polygons) in their body frame, their validation (convexity,
+//! orientation, degeneracy, non-overlapping parts) and their mass properties.
 //!
 //! 2D bodies stand for prisms of out-of-plane `thickness` (m), so a body of
 //! area `A` (m²) and density `ρ` (kg/m³) has mass `ρ A t` (kg) and polar inertia
@@ -8,7 +9,7 @@
 
 mod polygon;
 
-pub use polygon::{ConvexPolygon, GeometryError, Shape};
+pub use polygon::{Compound, ConvexPolygon, GeometryError, Shape};
 
 /// A 2D vector in SI units (m, m/s, N, …).
 pub type Vec2 = nalgebra::Vector2<f64>;

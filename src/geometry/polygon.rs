@@ -1,4 +1,5 @@
-//! Convex polygons and discs (body frame, centroid at the origin).
+//! Convex polygons, discs and compounds (rigid unions of convex polygons), in
+//! the body frame with the centroid of the whole shape at the origin.
 
 use super::{cross, Vec2};
 use parry2d_f64::mass_properties::MassProperties;
@@ -22,9 +23,22 @@ pub enum GeometryError {
     BadRadius(f64),
     #[error("a regular polygon needs at least 3 sides, got {0}")]
     BadSides(usize),
+    #[error("a compound needs at least one part")]
+    NoParts,
+    #[error("a compound has at most {max} parts, got {0}", max = Compound::MAX_PARTS)]
+    TooManyParts(usize),
+    /// Part `index` of a compound is refused.
+    #[error("parts[{index}]: {source}")]
+    Part { index: usize, source: Box<GeometryError> },
+    #[error("parts[{0}]: a part has at most {max} vertices, got {1}", max = Compound::MAX_PART_VERTICES)]
+    PartTooManyVertices(usize, usize),
+    /// Parts `.1` and `.0` (`.0 < .1`) overlap by a depth `.2` (m).
+    #[error("parts[{1}]: overlaps parts[{0}] by {2:e} m (parts may share edges but not overlap)")]
+    PartsOverlap(usize, usize, f64),
 }
 
-/// A convex polygon in its body frame, centroid at the origin, vertices counter-clockwise.
+/// A convex polygon in its body frame, centroid at the origin, vertices counter-clockwise
+/// (except as a part of a [`Compound`], whose vertices are in the compound's body frame).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ConvexPolygon {
     /// Vertices (m), counter-clockwise, centroid at the origin.
@@ -114,7 +128,8 @@ impl ConvexPolygon {
             })
             .collect();
         let circumradius = vertices.iter().map(|p| p.norm()).fold(0.0, f64::max);
-        let inradius = (0..n).map(|k| -vertices[k].dot(&normals[k])).fold(f64::INFINITY, f64::min).abs();
+        // Distance from the centroid to the line of edge `k` (positive: the centroid is inside).
+        let inradius = (0..n).map(|k| vertices[k].dot(&normals[k])).fold(f64::INFINITY, f64::min);
         Self { vertices, normals, circumradius, inradius }
     }
 
@@ -127,12 +142,131 @@ impl ConvexPolygon {
     }
 }
 
+/// A rigid union of convex polygons (a non-convex body, e.g. a sleeper with
+/// bars under it), in the body frame: the centroid of the whole union is the
+/// origin.
+///
+/// Each part is a [`ConvexPolygon`] whose `vertices` and `normals` are in the
+/// body frame (so, unlike a lone polygon, a part is *not* centred on the
+/// origin); its `circumradius` is the largest distance from the **body**
+/// centroid to its vertices (what a bounding box needs) and its `inradius` is
+/// the part's **own** inradius about its own centroid `offsets[k]` (the size
+/// scale of the shadow-overlap test). Parts may share edges but not overlap.
+///
+/// Contact detection runs part by part; the dynamics sees one rigid body.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Compound {
+    /// The parts, vertices and normals in the body frame.
+    pub parts: Vec<ConvexPolygon>,
+    /// Centroid of each part in the body frame (m).
+    pub offsets: Vec<Vec2>,
+    /// Largest distance from the body centroid to a vertex of any part (m).
+    pub circumradius: f64,
+}
+
+impl Compound {
+    /// Largest number of parts (contact keys give a part index 8 bits).
+    pub const MAX_PARTS: usize = 256;
+    /// Largest number of vertices of one part (contact keys give a vertex or edge index 6 bits).
+    pub const MAX_PART_VERTICES: usize = 64;
+
+    /// Validates `parts` (each a vertex list in one common frame, counter-clockwise,
+    /// strictly convex, checked like [`ConvexPolygon::new`]; the error names the
+    /// part index), checks that no two parts overlap (a shared edge is allowed),
+    /// and re-centres the union on its centroid. Returns the compound and the
+    /// union centroid's position in the given frame (m).
+    ///
+    /// Overlap test: separating axes over the edge normals of both parts. Two
+    /// parts pass when along some axis their penetration depth is at most
+    /// `1e-9` times the larger part size (circumradius about its own centroid),
+    /// so parts that share an edge, given with rounded coordinates, pass, and the
+    /// overlap area this lets through is below `1e-9 ×` size × edge length.
+    pub fn new(parts: &[Vec<[f64; 2]>]) -> Result<(Self, Vec2), GeometryError> {
+        if parts.is_empty() {
+            return Err(GeometryError::NoParts);
+        }
+        if parts.len() > Self::MAX_PARTS {
+            return Err(GeometryError::TooManyParts(parts.len()));
+        }
+        let mut centred = Vec::with_capacity(parts.len());
+        for (index, p) in parts.iter().enumerate() {
+            let (poly, c) = ConvexPolygon::new(p).map_err(|e| GeometryError::Part { index, source: Box::new(e) })?;
+            if p.len() > Self::MAX_PART_VERTICES {
+                return Err(GeometryError::PartTooManyVertices(index, p.len()));
+            }
+            centred.push((poly, c));
+        }
+        // Pairwise overlap, in the given frame.
+        for j in 1..centred.len() {
+            for i in 0..j {
+                let (pi, ci) = &centred[i];
+                let (pj, cj) = &centred[j];
+                let depth = penetration(pi, *ci, pj, *cj);
+                if depth > 1e-9 * pi.circumradius.max(pj.circumradius) {
+                    return Err(GeometryError::PartsOverlap(i, j, depth));
+                }
+            }
+        }
+        // Union centroid: area-weighted mean of the part centroids.
+        let areas: Vec<f64> = centred.iter().map(|(p, _)| p.area_and_polar_moment().0).collect();
+        let total: f64 = areas.iter().sum();
+        let c = centred.iter().zip(&areas).fold(Vec2::zeros(), |acc, ((_, ck), a)| acc + ck * *a) / total;
+        let mut out = Self { parts: Vec::with_capacity(parts.len()), offsets: Vec::new(), circumradius: 0.0 };
+        for (poly, ck) in centred {
+            let off = ck - c;
+            let vertices: Vec<Vec2> = poly.vertices.iter().map(|v| v + off).collect();
+            let circumradius = vertices.iter().map(|p| p.norm()).fold(0.0, f64::max);
+            out.circumradius = out.circumradius.max(circumradius);
+            out.parts.push(ConvexPolygon { vertices, normals: poly.normals, circumradius, inradius: poly.inradius });
+            out.offsets.push(off);
+        }
+        Ok((out, c))
+    }
+
+    /// Area (m²) and polar second moment of area about the union centroid (m⁴):
+    /// the sums over the parts, each part's own moment moved to the union
+    /// centroid by the parallel-axis theorem `J = Σ (J_k + A_k |c_k|²)`.
+    pub fn area_and_polar_moment(&self) -> (f64, f64) {
+        let (mut area, mut polar) = (0.0, 0.0);
+        for (p, off) in self.parts.iter().zip(&self.offsets) {
+            let pts: Vec<PVec> = p.vertices.iter().map(|v| PVec::new(v.x - off.x, v.y - off.y)).collect();
+            let mp = MassProperties::from_convex_polygon(1.0, &pts);
+            let a = mp.mass();
+            area += a;
+            polar += mp.principal_inertia() + a * off.norm_squared();
+        }
+        (area, polar)
+    }
+
+    /// Smallest inradius of the parts (m).
+    pub fn min_inradius(&self) -> f64 {
+        self.parts.iter().map(|p| p.inradius).fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// Penetration depth (m) of two convex polygons given centred with their
+/// centroids `ca`, `cb`: the smallest, over the edge normals of both, of the
+/// overlap of their projections (≤ 0 when an axis separates them).
+fn penetration(a: &ConvexPolygon, ca: Vec2, b: &ConvexPolygon, cb: Vec2) -> f64 {
+    let mut depth = f64::INFINITY;
+    for (p, cp, q, cq) in [(a, ca, b, cb), (b, cb, a, ca)] {
+        for (v, n) in p.vertices.iter().zip(&p.normals) {
+            let edge = (v + cp).dot(n);
+            let deepest = q.vertices.iter().map(|w| (w + cq).dot(n)).fold(f64::INFINITY, f64::min);
+            depth = depth.min(edge - deepest);
+        }
+    }
+    depth
+}
+
 /// A 2D body shape in its body frame (centroid at the origin).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub enum Shape {
     Polygon(ConvexPolygon),
     /// A disc of the given radius (m).
     Disc(f64),
+    /// A rigid union of convex polygons.
+    Compound(Compound),
 }
 
 impl Shape {
@@ -152,6 +286,7 @@ impl Shape {
                 let mp = MassProperties::from_ball(1.0, *r);
                 (mp.mass(), mp.principal_inertia())
             }
+            Shape::Compound(c) => c.area_and_polar_moment(),
         }
     }
 
@@ -160,15 +295,18 @@ impl Shape {
         match self {
             Shape::Polygon(p) => p.circumradius,
             Shape::Disc(r) => *r,
+            Shape::Compound(c) => c.circumradius,
         }
     }
 
     /// Radius of the largest centred circle inside the shape (m): the depth of
-    /// overlap beyond which a contact is certainly a blow-up.
+    /// overlap beyond which a contact is certainly a blow-up. For a compound, the
+    /// smallest inradius of its parts (each about its own centroid).
     pub fn inner_radius(&self) -> f64 {
         match self {
             Shape::Polygon(p) => p.inradius,
             Shape::Disc(r) => *r,
+            Shape::Compound(c) => c.min_inradius(),
         }
     }
 }
@@ -186,6 +324,9 @@ mod tests {
         assert!((a - 1.0).abs() < 1e-12);
         assert!((j - 1.0 / 6.0).abs() < 1e-12);
         assert!((p.inradius - 0.5).abs() < 1e-12);
+        // A 0.1 × 0.02 rectangle: the nearest edge line is 0.01 from the centroid.
+        let (p, _) = ConvexPolygon::new(&[[0.0, 0.0], [0.1, 0.0], [0.1, 0.02], [0.0, 0.02]]).unwrap();
+        assert!((p.inradius - 0.01).abs() < 1e-15, "{}", p.inradius);
     }
 
     #[test]

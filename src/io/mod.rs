@@ -10,12 +10,15 @@
 //! - `checkpoint.json`: the whole state, every few minutes, for `--resume`
 //!   ([`checkpoint::Checkpoint`]);
 //! - with `--vtk-every N`: `vtk/bodies_*.vtp`, `vtk/contacts_*.vtp` and `run.pvd`,
-//!   snapshots that ParaView opens and animates ([`vtk`]).
+//!   snapshots that ParaView opens and animates ([`vtk`]);
+//! - figures as `<stem>.png` + `<stem>.svg`: curves, force chains, displacement
+//!   fields ([`figures`]).
 //!
 //! Every I/O error names the file it happened on.
 
 pub mod checkpoint;
 pub mod cycles;
+pub mod figures;
 pub mod final_state;
 pub mod series;
 pub mod vtk;

@@ -34,7 +34,12 @@
 //! points are the body's world vertices: centre of mass `(q[0], q[1])` plus the
 //! body-frame vertices rotated by `q[2]`, counter-clockwise. A disc is written as
 //! the inscribed polygon of [`DISC_VERTICES`] vertices on its circle, the first
-//! at angle `q[2]` (so that the spin shows). Points are not shared between cells.
+//! at angle `q[2]` (so that the spin shows). A compound body (a rigid union of
+//! convex parts) is written as one polygon cell per part, consecutive, in part
+//! order; each cell data array has one value per **cell**, the body's value
+//! repeated for each of its parts (so `body_id` tells which cells make one body,
+//! and the number of cells exceeds the number of bodies when there are
+//! compounds). Points are not shared between cells.
 //! Cell data:
 //!
 //! | array      | kind                | unit  | meaning                                     |
@@ -378,29 +383,35 @@ fn bodies_data(sys: &System) -> PolyData {
         offsets: Vec::with_capacity(b.len()),
         cell_data: Vec::new(),
     };
-    for (info, q) in b.info.iter().zip(&b.q) {
+    // Body of each cell: a compound has one cell per part.
+    let mut owner: Vec<usize> = Vec::with_capacity(b.len());
+    for (i, (info, q)) in b.info.iter().zip(&b.q).enumerate() {
         let centre = Vec2::new(q[0], q[1]);
         let (sin, cos) = q[2].sin_cos();
-        let mut add = |v: Vec2| {
-            let w = centre + rotate(v, cos, sin);
-            d.connectivity.push(d.points.len());
-            d.points.push([w.x, w.y, 0.0]);
+        let mut cell = |vertices: &mut dyn Iterator<Item = Vec2>| {
+            for v in vertices {
+                let w = centre + rotate(v, cos, sin);
+                d.connectivity.push(d.points.len());
+                d.points.push([w.x, w.y, 0.0]);
+            }
+            d.offsets.push(d.connectivity.len());
+            owner.push(i);
         };
         match &info.shape {
-            Shape::Polygon(p) => p.vertices.iter().for_each(|&v| add(v)),
-            Shape::Disc(r) => (0..DISC_VERTICES).for_each(|k| {
+            Shape::Polygon(p) => cell(&mut p.vertices.iter().copied()),
+            Shape::Disc(r) => cell(&mut (0..DISC_VERTICES).map(|k| {
                 let a = std::f64::consts::TAU * k as f64 / DISC_VERTICES as f64;
-                add(Vec2::new(r * a.cos(), r * a.sin()))
-            }),
+                Vec2::new(r * a.cos(), r * a.sin())
+            })),
+            Shape::Compound(c) => c.parts.iter().for_each(|p| cell(&mut p.vertices.iter().copied())),
         }
-        d.offsets.push(d.connectivity.len());
     }
     d.cell_data = vec![
-        Array::int("body_id", (0..b.len() as i64).collect()),
-        Array::int("fixed", b.info.iter().map(|i| i64::from(i.fixed)).collect()),
-        Array::vectors("velocity", b.u.iter().map(|u| [u[0], u[1], 0.0]).collect()),
-        Array::float("spin", b.u.iter().map(|u| u[2]).collect()),
-        Array::float("radius", b.info.iter().map(|i| i.shape.bounding_radius()).collect()),
+        Array::int("body_id", owner.iter().map(|&i| i as i64).collect()),
+        Array::int("fixed", owner.iter().map(|&i| i64::from(b.info[i].fixed)).collect()),
+        Array::vectors("velocity", owner.iter().map(|&i| [b.u[i][0], b.u[i][1], 0.0]).collect()),
+        Array::float("spin", owner.iter().map(|&i| b.u[i][2]).collect()),
+        Array::float("radius", owner.iter().map(|&i| b.info[i].shape.bounding_radius()).collect()),
     ];
     d
 }

@@ -63,13 +63,7 @@ pub fn vertical_balance(sys: &System) -> Balance {
             walls += up;
         }
     }
-    let loads = b
-        .info
-        .iter()
-        .filter(|i| !i.fixed)
-        .flat_map(|i| i.loads.iter())
-        .map(|l| l.at(sys.time)[1])
-        .sum();
+    let loads = b.info.iter().filter(|i| !i.fixed).flat_map(|i| i.loads.iter()).map(|l| l.at(sys.time)[1]).sum();
     Balance { weight, springs, floors, walls, loads }
 }
 

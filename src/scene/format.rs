@@ -206,7 +206,10 @@ pub struct RegularSpec {
     pub radius: f64,
 }
 
-/// `[[body]]`: one rigid body. Exactly one of `polygon`, `regular`, `disc`.
+/// A vertex list `[[x, y], …]` (m).
+pub type VertexList = Vec<[f64; 2]>;
+
+/// `[[body]]`: one rigid body. Exactly one of `polygon`, `regular`, `disc`, `parts`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
@@ -225,6 +228,11 @@ pub struct BodySpec {
     /// Disc of this radius (m) centred on the body-frame origin.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub disc: Option<f64>,
+    /// Compound body: a rigid union of convex polygons, each a vertex list (m)
+    /// in the body frame, counter-clockwise; parts may share edges but not overlap.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "opt_parts")]
+    pub parts: Option<Vec<VertexList>>,
     /// World position of the body-frame origin (m).
     #[serde(deserialize_with = "pair")]
     pub position: [f64; 2],
@@ -485,4 +493,9 @@ fn opt_pair<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Erro
 
 fn opt_points<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<[f64; 2]>>, D::Error> {
     Vec::<Pair<f64>>::deserialize(d).map(|v| Some(v.into_iter().map(|p| p.0).collect()))
+}
+
+fn opt_parts<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<VertexList>>, D::Error> {
+    Vec::<Vec<Pair<f64>>>::deserialize(d)
+        .map(|v| Some(v.into_iter().map(|p| p.into_iter().map(|q| q.0).collect()).collect()))
 }

@@ -1,14 +1,15 @@
 //! Validation of a parsed scene: every value is checked (finite, in range,
 //! names resolved, shapes convex) and resolved into the data needed to build a
 //! system. Each error is one line naming the section or body and the field, e.g.
-//! `body[3] 'block': polygon: non-convex polygon: the turn at vertex 2 is clockwise`.
+//! `body[3] 'block': polygon: non-convex polygon: the turn at vertex 2 is clockwise`
+//! or, for a compound body, `body[3] 'sleeper': parts[1]: non-convex polygon: …`.
 
 use super::format::{
     BodySpec, Drive, Scene, DEFAULT_ALERT_FRACTION, DEFAULT_CRITERION, DEFAULT_MAX_FACTOR, DEFAULT_MAX_ITERATIONS,
     DEFAULT_MIN_ITERATIONS, DEFAULT_THETA, DEFAULT_TOLERANCE,
 };
 use crate::error::{Error, Result};
-use crate::geometry::{rotate, ConvexPolygon, Shape, Vec2};
+use crate::geometry::{rotate, Compound, ConvexPolygon, GeometryError, Shape, Vec2};
 use crate::nscd::{NlgsSettings, Policy};
 use std::collections::HashMap;
 
@@ -136,13 +137,21 @@ pub(crate) fn body_label(i: usize, b: &BodySpec) -> String {
 /// The shape of a body (centred on its centroid) and its centroid in the
 /// scene's body frame, or the message of why the shape is refused.
 pub(crate) fn shape_of(b: &BodySpec) -> std::result::Result<(Shape, Vec2), String> {
-    let given = [b.polygon.is_some(), b.regular.is_some(), b.disc.is_some()];
+    let given = [b.polygon.is_some(), b.regular.is_some(), b.disc.is_some(), b.parts.is_some()];
     match given.iter().filter(|&&x| x).count() {
-        0 => return Err("shape: missing, give exactly one of polygon, regular, disc".into()),
+        0 => return Err("shape: missing, give exactly one of polygon, regular, disc, parts".into()),
         1 => {}
-        _ => return Err("shape: give exactly one of polygon, regular, disc, not several".into()),
+        _ => return Err("shape: give exactly one of polygon, regular, disc, parts, not several".into()),
     }
-    if let Some(p) = &b.polygon {
+    if let Some(parts) = &b.parts {
+        // Errors about one part read `parts[1]: non-convex polygon: …`.
+        Compound::new(parts).map(|(c, g)| (Shape::Compound(c), g)).map_err(|e| match e {
+            GeometryError::Part { .. } | GeometryError::PartTooManyVertices(..) | GeometryError::PartsOverlap(..) => {
+                e.to_string()
+            }
+            _ => format!("parts: {e}"),
+        })
+    } else if let Some(p) = &b.polygon {
         ConvexPolygon::new(p).map(|(p, c)| (Shape::Polygon(p), c)).map_err(|e| format!("polygon: {e}"))
     } else if let Some(r) = &b.regular {
         if r.sides > MAX_SIDES {

@@ -78,6 +78,10 @@ fn body(out: &mut String, b: &BodySpec) {
     });
     opt(out, "regular", b.regular, |r| format!("{{ sides = {}, radius = {} }}", r.sides, float(r.radius)));
     opt(out, "disc", b.disc, float);
+    opt(out, "parts", b.parts.as_ref(), |parts| {
+        let part = |p: &Vec<[f64; 2]>| format!("[{}]", p.iter().map(|&v| pair(v)).collect::<Vec<_>>().join(", "));
+        format!("[{}]", parts.iter().map(part).collect::<Vec<_>>().join(", "))
+    });
     let _ = writeln!(out, "position = {}", pair(b.position));
     opt(out, "angle", b.angle, float);
     opt(out, "velocity", b.velocity, pair);
