@@ -19,7 +19,6 @@
 
 use super::io_error;
 use crate::error::Result;
-use crate::geometry::{rotate, Shape, Vec2};
 use crate::nscd::System;
 use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::types::RangedCoordf64;
@@ -38,8 +37,6 @@ pub const CHART_SIZE: (u32, u32) = (1200, 800);
 pub const SAMPLE_WIDTH: u32 = 1600;
 /// Smallest and largest height of a sample figure (px).
 pub const SAMPLE_HEIGHT: (u32, u32) = (300, 1600);
-/// Vertices of the polygon drawn for a disc.
-const DISC_VERTICES: usize = 24;
 const MARGIN: u32 = 20;
 const X_LABEL_AREA: u32 = 60;
 const Y_LABEL_AREA: u32 = 100;
@@ -155,29 +152,13 @@ pub fn displacement_field(
 }
 
 /// World vertices (m) of the bodies of `sys` and whether each is fixed: one
-/// polygon per body (a disc as a 24-gon), except a compound, which gives one per
+/// polygon per body (a disc as a 32-gon), except a compound, which gives one per
 /// part (so the lists follow the bodies' order but not their indices).
-#[allow(unreachable_patterns)] // the fallback arm is for shapes added later
 pub fn polygons_of(sys: &System) -> (Vec<Vec<[f64; 2]>>, Vec<bool>) {
-    let circle = |r: f64| {
-        (0..DISC_VERTICES)
-            .map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / DISC_VERTICES as f64;
-                Vec2::new(r * a.cos(), r * a.sin())
-            })
-            .collect::<Vec<_>>()
-    };
     let (mut polygons, mut fixed) = (Vec::new(), Vec::new());
-    for (info, q) in sys.bodies.info.iter().zip(&sys.bodies.q) {
-        let local = match &info.shape {
-            Shape::Polygon(p) => vec![p.vertices.clone()],
-            Shape::Disc(r) => vec![circle(*r)],
-            Shape::Compound(c) => c.parts.iter().map(|p| p.vertices.clone()).collect(),
-            other => vec![circle(other.bounding_radius())],
-        };
-        let (sin, cos) = q[2].sin_cos();
-        for part in local {
-            polygons.push(part.into_iter().map(|v| rotate(v, cos, sin)).map(|w| [q[0] + w.x, q[1] + w.y]).collect());
+    for (i, info) in sys.bodies.info.iter().enumerate() {
+        for part in crate::nscd::measure::world_parts(sys, i) {
+            polygons.push(part);
             fixed.push(info.fixed);
         }
     }

@@ -67,26 +67,32 @@ pub fn vertical_balance(sys: &System) -> Balance {
     Balance { weight, springs, floors, walls, loads }
 }
 
-/// World vertices of body `i` (a disc as a 32-gon), counter-clockwise.
-pub fn world_polygon(sys: &System, i: usize) -> Vec<[f64; 2]> {
+/// World vertices of the convex pieces of body `i`, each counter-clockwise: one
+/// polygon, a disc as a 32-gon, or one polygon per part of a compound.
+pub fn world_parts(sys: &System, i: usize) -> Vec<Vec<[f64; 2]>> {
     let q = sys.bodies.q[i];
     let (c, s) = (q[2].cos(), q[2].sin());
     let g = Vec2::new(q[0], q[1]);
-    let place = |v: Vec2| {
-        let w = g + rotate(v, c, s);
+    let place = |v: &Vec2| {
+        let w = g + rotate(*v, c, s);
         [w.x, w.y]
     };
     match &sys.bodies.info[i].shape {
-        Shape::Polygon(p) => p.vertices.iter().map(|&v| place(v)).collect(),
-        Shape::Disc(r) => (0..32)
+        Shape::Polygon(p) => vec![p.vertices.iter().map(place).collect()],
+        Shape::Disc(r) => vec![(0..32)
             .map(|k| {
                 let a = std::f64::consts::TAU * k as f64 / 32.0;
-                place(Vec2::new(r * a.cos(), r * a.sin()))
+                place(&Vec2::new(r * a.cos(), r * a.sin()))
             })
-            .collect(),
-        #[allow(unreachable_patterns)]
-        _ => Vec::new(),
+            .collect()],
+        Shape::Compound(cmp) => cmp.parts.iter().map(|p| p.vertices.iter().map(place).collect()).collect(),
     }
+}
+
+/// All world vertices of body `i` (its parts' vertices one after the other; a
+/// single convex polygon for a polygon or a disc).
+pub fn world_polygon(sys: &System, i: usize) -> Vec<[f64; 2]> {
+    world_parts(sys, i).concat()
 }
 
 /// Area (m²) of the convex polygon `poly` (counter-clockwise) inside the
@@ -121,7 +127,8 @@ pub fn clipped_area(poly: &[[f64; 2]], [x0, x1, y0, y1]: [f64; 4]) -> f64 {
 /// the area of the grains inside it over its area.
 pub fn solid_fraction(sys: &System, grains: &[usize], window: [f64; 4]) -> f64 {
     let area = (window[1] - window[0]) * (window[3] - window[2]);
-    grains.iter().map(|&i| clipped_area(&world_polygon(sys, i), window)).sum::<f64>() / area
+    let parts = grains.iter().flat_map(|&i| world_parts(sys, i));
+    parts.map(|p| clipped_area(&p, window)).sum::<f64>() / area
 }
 
 /// Coordination of a set of grains.
