@@ -49,15 +49,21 @@ impl DepositSpec {
     }
 }
 
-/// The scene TOML of a loose deposit (see `docs/scene-format.md`).
-pub fn pentagon_deposit(spec: &DepositSpec) -> String {
-    let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
-    let mut radii: Vec<f64> = spec.grading.iter().flat_map(|&(r, n)| std::iter::repeat_n(r, n)).collect();
-    // Fisher–Yates shuffle so sizes are mixed through the height.
+/// The radii of a grading `(radius m, count)` in a random order drawn from `rng`
+/// (Fisher–Yates), so that the sizes are mixed through the height of a deposit.
+pub(crate) fn shuffled_radii(grading: &[(f64, usize)], rng: &mut ChaCha8Rng) -> Vec<f64> {
+    let mut radii: Vec<f64> = grading.iter().flat_map(|&(r, n)| std::iter::repeat_n(r, n)).collect();
     for i in (1..radii.len()).rev() {
         let j = rng.random_range(0..=i);
         radii.swap(i, j);
     }
+    radii
+}
+
+/// The scene TOML of a loose deposit (see `docs/scene-format.md`).
+pub fn pentagon_deposit(spec: &DepositSpec) -> String {
+    let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
+    let radii = shuffled_radii(&spec.grading, &mut rng);
     let r_max = radii.iter().copied().fold(0.0, f64::max);
     let pitch = 2.2 * r_max;
     let cols = ((spec.width / pitch).floor() as usize).max(1);

@@ -113,11 +113,7 @@ fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> String {
 /// equilibrium (kinetic energy below 1e-11 J per grain for 500 steps).
 pub fn sample_scene(spec: &SampleSpec) -> String {
     let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
-    let mut radii: Vec<f64> = spec.grading.iter().flat_map(|&(r, n)| std::iter::repeat_n(r, n)).collect();
-    for i in (1..radii.len()).rev() {
-        let j = rng.random_range(0..=i);
-        radii.swap(i, j);
-    }
+    let radii = super::deposit::shuffled_radii(&spec.grading, &mut rng);
     let n = radii.len();
     let mut s = String::new();
     let _ = writeln!(
