@@ -113,6 +113,7 @@ impl LoadingArgs {
         if self.cycles == 0 {
             return Err(input("--cycles: must be at least 1".into()));
         }
+        let base = LoadingSpec::saussine(self.cycles);
         Ok(LoadingSpec {
             inclination_deg: self.inclination,
             guide,
@@ -123,8 +124,8 @@ impl LoadingArgs {
             min_iterations: self.min_iterations,
             max_iterations: self.max_iterations,
             bars: self.bars,
-            sleeper_width: self.sleeper_width.unwrap_or(LoadingSpec::saussine(1).sleeper_width),
-            ..LoadingSpec::saussine(self.cycles)
+            sleeper_width: self.sleeper_width.unwrap_or(base.sleeper_width),
+            ..base
         })
     }
 }
@@ -133,8 +134,9 @@ fn input(msg: String) -> Failure {
     Failure::Input(Error::Scene(msg))
 }
 
-fn io(e: std::io::Error) -> Failure {
-    Failure::Run(Error::Io(e))
+/// Writes `text` to `path`; the error names the file.
+fn write(path: &Path, text: &str) -> Result<(), Failure> {
+    std::fs::write(path, text).map_err(|e| Failure::Run(ballast::io::io_error(path, "write", e)))
 }
 
 pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
@@ -167,7 +169,7 @@ fn write_scene(path: &Path, scene: &Scene, what: &str) -> Result<(), Failure> {
         what.replace(char::is_control, "?"),
         scene.to_toml_string().map_err(Failure::Run)?
     );
-    std::fs::write(path, text).map_err(io)
+    write(path, &text)
 }
 
 /// Runs `scene_path` into `dir` unless a finished run is there already.
@@ -187,7 +189,7 @@ fn sample(spec: &SampleSpec, out: &Path, resume: bool, quiet: bool) -> Result<()
     Scene::from_toml_str(&text).map_err(Failure::Input)?;
     ballast::io::create_output_dir(out).map_err(Failure::Run)?;
     let deposit = out.join("deposit.toml");
-    std::fs::write(&deposit, &text).map_err(io)?;
+    write(&deposit, &text)?;
     let mut settled = run_stage(&deposit, &out.join("deposit"), resume, quiet)?;
     if spec.bank {
         let opened = open_bank(&settled).map_err(Failure::Run)?;

@@ -153,6 +153,7 @@ pub fn sample_scene(spec: &SampleSpec) -> String {
     let pitch = spec.pad_width + spec.pad_gap;
     let pads = ((frame + spec.pad_gap) / pitch).floor().max(1.0) as usize;
     let pad_w = (frame - spec.pad_gap * (pads as f64 + 1.0)) / pads as f64;
+    let pad_x = |k: usize| -frame / 2.0 + spec.pad_gap + pad_w / 2.0 + k as f64 * (pad_w + spec.pad_gap);
     let (ph, l0) = (spec.pad_height, spec.spring_length);
     let y_anchor = -ph / 2.0 - l0;
 
@@ -189,21 +190,18 @@ pub fn sample_scene(spec: &SampleSpec) -> String {
     let t = 0.05;
     let bottom = y_anchor - 0.01;
     let (fl, fr) = (-frame / 2.0, frame / 2.0);
-    for (name, poly) in
-        [("left_wall", rect(fl - t, bottom, fl, wall_top)), ("right_wall", rect(fr, bottom, fr + t, wall_top))]
-    {
-        let _ = writeln!(s, "[[body]]\nname = \"{name}\"\nmaterial = \"frame\"\npolygon = {poly}\nposition = [0.0, 0.0]\nfixed = true\n");
-    }
+    let mut walls =
+        vec![("left_wall", rect(fl - t, bottom, fl, wall_top)), ("right_wall", rect(fr, bottom, fr + t, wall_top))];
     if spec.bank {
         // The mould stands 1 mm above the pads (grains, inradius ≥ 4 mm, cannot pass).
-        for (name, poly) in
-            [(MOULD[0], rect(left - t, 0.001, left, wall_top)), (MOULD[1], rect(right, 0.001, right + t, wall_top))]
-        {
-            let _ = writeln!(s, "[[body]]\nname = \"{name}\"\nmaterial = \"frame\"\npolygon = {poly}\nposition = [0.0, 0.0]\nfixed = true\n");
-        }
+        walls.push((MOULD[0], rect(left - t, 0.001, left, wall_top)));
+        walls.push((MOULD[1], rect(right, 0.001, right + t, wall_top)));
+    }
+    for (name, poly) in walls {
+        let _ = writeln!(s, "[[body]]\nname = \"{name}\"\nmaterial = \"frame\"\npolygon = {poly}\nposition = [0.0, 0.0]\nfixed = true\n");
     }
     for k in 0..pads {
-        let xc = fl + spec.pad_gap + pad_w / 2.0 + k as f64 * (pad_w + spec.pad_gap);
+        let xc = pad_x(k);
         let poly = rect(-pad_w / 2.0, -ph / 2.0, pad_w / 2.0, ph / 2.0);
         let _ = writeln!(
             s,
@@ -223,7 +221,7 @@ pub fn sample_scene(spec: &SampleSpec) -> String {
         );
     }
     for k in 0..pads {
-        let xc = fl + spec.pad_gap + pad_w / 2.0 + k as f64 * (pad_w + spec.pad_gap);
+        let xc = pad_x(k);
         let _ = writeln!(
             s,
             "[[spring]]\nbody = \"{PAD_PREFIX}{k}\"\nanchor = [{xc:?}, {y_anchor:?}]\nk_n = {:?}\nnu = {:?}\nrest_length = {l0:?}\n",
@@ -318,9 +316,7 @@ impl LoadingSpec {
             output_every: 10,
         }
     }
-}
 
-impl LoadingSpec {
     /// For a sample scaled by `f` in width ([`SampleSpec::scaled`]): the sleeper's
     /// width and the load scaled by `f`, so the pressure under the sleeper is the same.
     pub fn scaled(mut self, f: f64) -> Self {
@@ -331,16 +327,15 @@ impl LoadingSpec {
     }
 }
 
-/// The highest point (m) of the grains whose x range meets `[x0, x1]`, from the
-/// scene's bodies (built to get exact world vertices).
-fn surface_under(sample: &Scene, x0: f64, x1: f64) -> Result<f64> {
-    let sys = sample.build()?;
+/// The highest point (m) of the grains of `sample` (built as `sys`) whose x range
+/// meets `[x0, x1]`.
+fn surface_under(sample: &Scene, sys: &crate::nscd::System, x0: f64, x1: f64) -> Result<f64> {
     let mut top = f64::NEG_INFINITY;
     for (i, b) in sample.bodies.iter().enumerate() {
         if !b.name.starts_with(GRAIN_PREFIX) {
             continue;
         }
-        let poly = crate::nscd::measure::world_polygon(&sys, i);
+        let poly = crate::nscd::measure::world_polygon(sys, i);
         let (lo, hi) = poly.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p[0]), h.max(p[0])));
         if hi >= x0 && lo <= x1 {
             top = poly.iter().map(|p| p[1]).fold(top, f64::max);
@@ -364,7 +359,8 @@ pub fn loaded_scene(sample: &Scene, spec: &LoadingSpec) -> Result<Scene> {
         return Err(Error::Scene("loaded_scene: the sample still has its mould; run open_bank first".into()));
     }
     let (w, h, b) = (spec.sleeper_width, spec.sleeper_height, spec.bar_size);
-    let top = surface_under(sample, -w / 2.0, w / 2.0)?;
+    let sys = sample.build()?;
+    let top = surface_under(sample, &sys, -w / 2.0, w / 2.0)?;
     let mut out = sample.clone();
     out.simulation.equilibrium = None;
     out.simulation.dt = spec.dt;
@@ -380,7 +376,6 @@ pub fn loaded_scene(sample: &Scene, spec: &LoadingSpec) -> Result<Scene> {
     // A stiffer sublayer carries the same static load: each spring's prestrain is
     // reset so that its force at the current length is unchanged (scaling k_N alone
     // would release the stored compression and launch the layer).
-    let sys = sample.build()?;
     for (s, spring) in out.springs.iter_mut().zip(&sys.springs) {
         let stretch = (spring.length(&sys.bodies.q) - spring.rest_length) / spring.rest_length;
         let eps = stretch - spring.prestrain;
