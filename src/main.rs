@@ -3,7 +3,8 @@
 //! `ballast run SCENE.toml --out DIR [--quiet] [--checkpoint-every S] [--resume]
 //! [--stop-after N]` loads and validates the scene, builds the system, makes
 //! `round(duration / dt)` steps and writes `series.csv`, `final.json`,
-//! `scene.toml`, `final_scene.toml` and `run.json` in `DIR` (see [`ballast::io`]).
+//! `summary.json`, `scene.toml`, `final_scene.toml` and `run.json` in `DIR` (see
+//! [`ballast::io`]); `--figures` draws the run's figures at the end.
 //! Every `S` seconds of wall time (default 300) it writes `checkpoint.json`;
 //! `--resume` continues from it with the same numbers as an uninterrupted run;
 //! `--stop-after N` stops after N steps with a checkpoint; `--vtk-every N` writes
@@ -14,7 +15,7 @@
 //! then hold the last good state) or an output file cannot be written.
 
 use ballast::io::vtk::PvdCollection;
-use ballast::io::{self, Checkpoint, FinalState, RunInfo, RunSummary, SeriesWriter, CHECKPOINT_FILE};
+use ballast::io::{self, Checkpoint, FinalState, RunInfo, RunReport, RunSummary, SeriesWriter, CHECKPOINT_FILE};
 use ballast::nscd::StepStats;
 use ballast::scene::Scene;
 use ballast::Error;
@@ -26,6 +27,8 @@ use std::time::Instant;
 
 #[path = "cli/saussine.rs"]
 mod saussine;
+#[path = "cli/studies.rs"]
+mod studies;
 
 #[derive(Debug, Parser)]
 #[command(name = "ballast", version, about = "Granular mechanics under cyclic loading (railway ballast settlement)")]
@@ -58,6 +61,10 @@ enum Command {
         /// Write VTK snapshots (`DIR/vtk/*.vtp`, listed in `DIR/run.pvd`) every N steps; 0: none.
         #[arg(long, value_name = "N", default_value_t = 0)]
         vtk_every: u64,
+        /// At the end, draw the run's figures (PNG + SVG): settlement and interpenetration
+        /// curves, force chains, displacement field.
+        #[arg(long)]
+        figures: bool,
     },
     /// Writes the scene of a loose pentagon deposit with the Saussine et al. (2006)
     /// grading (circumradii 5, 7.5, 10 mm in the numbers 361 : 242 : 121), ready for `run`.
@@ -97,9 +104,11 @@ pub(crate) enum Failure {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { scene, out, quiet, checkpoint_every, resume, stop_after, vtk_every } => {
-            run(&scene, &out, &RunOptions { quiet, checkpoint_every, resume, stop_after, vtk_every })
-        }
+        Command::Run { scene, out, quiet, checkpoint_every, resume, stop_after, vtk_every, figures } => run(
+            &scene,
+            &out,
+            &RunOptions { quiet, checkpoint_every, resume, stop_after, vtk_every, figures, progress: None },
+        ),
         Command::Deposit { grains, width, seed, dt, duration, out } => deposit(grains, width, seed, dt, duration, &out),
         Command::Saussine(cmd) => saussine::main(cmd),
     };
@@ -142,19 +151,26 @@ fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let pb = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr());
-    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} steps, {msg} [{elapsed_precise} < {eta}]") {
+    if let Ok(style) =
+        ProgressStyle::with_template("{prefix} {bar:40} {pos}/{len} steps, {msg} [{elapsed_precise} < {eta}]")
+    {
         pb.set_style(style);
     }
     pb
 }
 
 /// Options of `ballast run` besides the scene and the output directory.
+#[derive(Default)]
 pub(crate) struct RunOptions {
     pub quiet: bool,
     pub checkpoint_every: f64,
     pub resume: bool,
     pub stop_after: Option<u64>,
     pub vtk_every: u64,
+    /// Draw the run's figures at the end (`io::run_figures`).
+    pub figures: bool,
+    /// Show the progress bar in this group (runs of a study side by side), with a label.
+    pub progress: Option<(indicatif::MultiProgress, String)>,
 }
 
 /// `ballast run`.
@@ -214,8 +230,12 @@ pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<()
     let first = sys.step + 1;
     let last_step = opts.stop_after.map_or(steps, |n| steps.min(sys.step.saturating_add(n)));
 
-    let pb = progress_bar(steps, opts.quiet);
+    let mut pb = progress_bar(steps, opts.quiet);
+    if let (Some((group, label)), false) = (&opts.progress, opts.quiet) {
+        pb = group.add(pb.with_prefix(label.clone()));
+    }
     pb.set_position(sys.step);
+    let wall0 = summary.wall_time_s;
     let message_every = (steps / 1000).max(1);
     let started = Instant::now();
     let mut checkpointed = Instant::now();
@@ -244,8 +264,7 @@ pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<()
     for k in first..=last_step {
         match sys.step() {
             Ok(stats) => {
-                summary.max_overlap = summary.max_overlap.max(stats.max_overlap);
-                summary.unconverged += u64::from(!stats.converged);
+                summary.add(&stats);
                 let calm = equilibrium.is_some_and(|e| stats.kinetic_energy < e.kinetic_energy);
                 summary.calm_steps = if calm { summary.calm_steps + 1 } else { 0 };
                 at_equilibrium = equilibrium.is_some_and(|e| summary.calm_steps >= e.steps());
@@ -277,6 +296,7 @@ pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<()
                     snapshots.write(&pvd_path).map_err(Failure::Run)?;
                 }
                 if opts.checkpoint_every > 0.0 && checkpointed.elapsed().as_secs_f64() >= opts.checkpoint_every {
+                    summary.wall_time_s = wall0 + started.elapsed().as_secs_f64();
                     checkpoint(&sys, &mut series, summary, &snapshots, &cycles).map_err(Failure::Run)?;
                     checkpointed = Instant::now();
                 }
@@ -291,6 +311,7 @@ pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<()
         }
     }
     pb.finish_and_clear();
+    summary.wall_time_s = wall0 + started.elapsed().as_secs_f64();
     if diverged.is_none() && sys.step < steps && !at_equilibrium {
         // Stopped on request: leave a checkpoint and nothing that looks final.
         checkpoint(&sys, &mut series, summary, &snapshots, &cycles).map_err(Failure::Run)?;
@@ -309,6 +330,13 @@ pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<()
     }
     series.finish().map_err(Failure::Run)?;
     FinalState::of(&sys).write(&out.join("final.json")).map_err(Failure::Run)?;
+    let report =
+        RunReport::new(&summary, scene.simulation.dt, sys.time, cycles.as_ref().map(|c| c.cycle), at_equilibrium);
+    io::write_json(&out.join("summary.json"), &report).map_err(Failure::Run)?;
+    if opts.figures {
+        let first = cycles.as_ref().and_then(|c| c.first_cycle_q.as_deref());
+        io::run_figures::write_run_figures(out, &sys, first).map_err(Failure::Run)?;
+    }
     if let Some(e) = diverged {
         return Err(Failure::Run(e));
     }

@@ -73,12 +73,21 @@ fn run_writes_the_outputs() {
     let series = std::fs::read_to_string(out.join("series.csv")).unwrap();
     let mut lines = series.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    for col in ["time", "kinetic_energy", "contacts", "iterations", "criterion", "mean_overlap", "max_overlap"] {
+    for col in [
+        "time_s",
+        "kinetic_energy_J",
+        "contacts",
+        "iterations",
+        "criterion",
+        "mean_overlap_m",
+        "max_overlap_m",
+        "total_overlap_m",
+    ] {
         assert!(header.contains(&col), "column {col} missing from {header:?}");
     }
     let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()).collect()).collect();
     assert_eq!(rows.len(), 8);
-    let t = header.iter().position(|&c| c == "time").unwrap();
+    let t = header.iter().position(|&c| c == "time_s").unwrap();
     assert!((rows[0][t] - 0.007).abs() < 1e-12);
     assert!((rows[7][t] - 0.05).abs() < 1e-12);
     for r in &rows {

@@ -6,8 +6,16 @@
 //!   save it as `sample.toml`, measure its balance, solid fraction and
 //!   coordination number (`sample.json`);
 //! - `load`: write the loaded scene (sleeper with bars, load, sublayer stiffness,
-//!   solver, time step, number of cycles) from a deposited sample.
+//!   solver, time step, number of cycles) from a deposited sample;
+//! - `settle`: load a sample and run N cycles (§4): `cycles.csv`, `summary.json`,
+//!   VTK snapshots every few cycles, figures;
+//! - `convergence`, `steps`, `ensemble`: the studies of §3.2, §3.3 and §4.2
+//!   (`studies.rs`).
+//!
+//! A sample scaled to fewer grains (`--grains`) is loaded with the sleeper's width
+//! and the load scaled alike (same pressure), unless `--sleeper-width` is given.
 
+use crate::studies::{self, loading_for, StudyArgs};
 use crate::{run, Failure, RunOptions};
 use ballast::scenarios::saussine::{
     loaded_scene, measure_sample, open_bank, sample_scene, Guide, LoadingSpec, SampleSpec,
@@ -54,6 +62,82 @@ pub enum SaussineCommand {
         out: PathBuf,
         #[command(flatten)]
         loading: LoadingArgs,
+    },
+    /// Loads a deposited sample and runs the cycles (§4): per-cycle settlement, mean
+    /// grain speed, contacts and iterations (`cycles.csv`), VTK snapshots, figures.
+    Settle {
+        /// A deposited sample (`sample.toml` of `ballast saussine sample`).
+        #[arg(long, value_name = "FILE")]
+        sample: PathBuf,
+        /// Output directory (the loaded scene is written there as `loaded.toml`).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        #[command(flatten)]
+        loading: LoadingArgs,
+        /// VTK snapshot (bodies and contact forces) every this many cycles; 0: none.
+        #[arg(long, value_name = "CYCLES", default_value_t = 10)]
+        snapshot_every: u64,
+        /// Wall-clock seconds between checkpoints.
+        #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
+        checkpoint_every: f64,
+        /// Continue a killed run from its checkpoint.
+        #[arg(long)]
+        resume: bool,
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// §3.2: the same cycles with each convergence policy and tolerance of the paper's
+    /// table; mean NLGS iterations, wall time and interpenetration per run.
+    /// (--criterion and --tolerance are replaced by those of each run.)
+    Convergence {
+        #[arg(long, value_name = "FILE")]
+        sample: PathBuf,
+        /// Runs as POLICY:TOLERANCE, comma separated (default: the paper's table).
+        #[arg(long, value_delimiter = ',')]
+        policies: Vec<String>,
+        #[command(flatten)]
+        loading: LoadingArgs,
+        #[command(flatten)]
+        study: StudyArgs,
+    },
+    /// §3.3: the same cycles with each time step, at each inclination; mean and max
+    /// interpenetration over time. (--dt and --inclination are replaced by those of each run.)
+    Steps {
+        #[arg(long, value_name = "FILE")]
+        sample: PathBuf,
+        /// Time steps (s), comma separated.
+        #[arg(long, value_delimiter = ',', default_value = "1e-4,2e-4,3e-4,4e-4,5e-4,6e-4,7e-4,8e-4,9e-4,1e-3")]
+        dts: Vec<f64>,
+        /// Inclinations of the load (degrees), comma separated.
+        #[arg(long, value_delimiter = ',', default_value = "0,5")]
+        inclinations: Vec<f64>,
+        #[command(flatten)]
+        loading: LoadingArgs,
+        #[command(flatten)]
+        study: StudyArgs,
+    },
+    /// §4.2: samples that differ only by their seed, each on sublayers of several
+    /// stiffnesses, run in parallel; mean and spread of the settlement per stiffness.
+    /// (--stiffness-factor is replaced by those of each run.)
+    Ensemble {
+        /// Number of samples (seeds first-seed, first-seed + 1, …).
+        #[arg(long, default_value_t = 8)]
+        samples: u64,
+        #[arg(long, default_value_t = 1)]
+        first_seed: u64,
+        /// Factors on the sublayer stiffness k_N, comma separated.
+        #[arg(long, value_delimiter = ',', default_value = "1,100,1000")]
+        factors: Vec<f64>,
+        /// Scale the grading to about this many grains (and the width with it).
+        #[arg(long)]
+        grains: Option<usize>,
+        /// Time step of the deposits (s).
+        #[arg(long, default_value_t = 2e-4)]
+        sample_dt: f64,
+        #[command(flatten)]
+        loading: LoadingArgs,
+        #[command(flatten)]
+        study: StudyArgs,
     },
 }
 
@@ -149,20 +233,49 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                 }
                 spec = spec.scaled(n);
             }
-            sample(&spec, &out, resume, quiet)
+            sample(&spec, &out, resume, quiet, None)
         }
         SaussineCommand::Load { sample, out, loading } => {
             let scene = Scene::load(&sample).map_err(Failure::Input)?;
-            let loaded = loaded_scene(&scene, &loading.spec()?).map_err(Failure::Input)?;
+            let loaded = loaded_scene(&scene, &loading_for(&scene, &loading)?).map_err(Failure::Input)?;
             write_scene(&out, &loaded, &format!("loaded from {}", sample.display()))?;
             println!("wrote {}", out.display());
             Ok(())
+        }
+        SaussineCommand::Settle { sample, out, loading, snapshot_every, checkpoint_every, resume, quiet } => {
+            let scene = Scene::load(&sample).map_err(Failure::Input)?;
+            let spec = loading_for(&scene, &loading)?;
+            let loaded = loaded_scene(&scene, &spec).map_err(Failure::Input)?;
+            ballast::io::create_output_dir(&out).map_err(Failure::Run)?;
+            let path = out.join("loaded.toml");
+            if !resume {
+                write_scene(&path, &loaded, &format!("loaded from {}", sample.display()))?;
+            }
+            let steps_per_cycle = (1.0 / (spec.frequency * spec.dt)).round().max(1.0) as u64;
+            let opts = RunOptions {
+                quiet,
+                checkpoint_every,
+                resume,
+                vtk_every: snapshot_every.saturating_mul(steps_per_cycle),
+                figures: true,
+                ..RunOptions::default()
+            };
+            run(&path, &out, &opts)
+        }
+        SaussineCommand::Convergence { sample, policies, loading, study } => {
+            studies::convergence(&sample, &policies, &loading, &study)
+        }
+        SaussineCommand::Steps { sample, dts, inclinations, loading, study } => {
+            studies::steps(&sample, &dts, &inclinations, &loading, &study)
+        }
+        SaussineCommand::Ensemble { samples, first_seed, factors, grains, sample_dt, loading, study } => {
+            studies::ensemble(samples, first_seed, &factors, grains, sample_dt, &loading, &study)
         }
     }
 }
 
 /// Writes `scene` to `path` with a header line.
-fn write_scene(path: &Path, scene: &Scene, what: &str) -> Result<(), Failure> {
+pub(crate) fn write_scene(path: &Path, scene: &Scene, what: &str) -> Result<(), Failure> {
     let text = format!(
         "# Written by ballast {} (Saussine et al. 2006 experiments): {}.\n\n{}",
         env!("CARGO_PKG_VERSION"),
@@ -172,30 +285,40 @@ fn write_scene(path: &Path, scene: &Scene, what: &str) -> Result<(), Failure> {
     write(path, &text)
 }
 
+/// Progress bars of a run inside a group, with a label.
+type Progress = Option<(indicatif::MultiProgress, String)>;
+
 /// Runs `scene_path` into `dir` unless a finished run is there already.
-fn run_stage(scene_path: &Path, dir: &Path, resume: bool, quiet: bool) -> Result<Scene, Failure> {
+fn run_stage(scene_path: &Path, dir: &Path, resume: bool, quiet: bool, progress: Progress) -> Result<Scene, Failure> {
     let final_scene = dir.join("final_scene.toml");
     let done = final_scene.exists() && !dir.join(ballast::io::CHECKPOINT_FILE).exists();
     if !(resume && done) {
         let resume = resume && dir.join(ballast::io::CHECKPOINT_FILE).exists();
-        let opts = RunOptions { quiet, checkpoint_every: 300.0, resume, stop_after: None, vtk_every: 0 };
+        let opts = RunOptions { quiet, checkpoint_every: 300.0, resume, progress, ..RunOptions::default() };
         run(scene_path, dir, &opts)?;
     }
     Scene::load(&final_scene).map_err(Failure::Run)
 }
 
-fn sample(spec: &SampleSpec, out: &Path, resume: bool, quiet: bool) -> Result<(), Failure> {
+/// Deposits the sample of `spec` into `out` (`sample.toml`, `sample.json`).
+pub(crate) fn sample(
+    spec: &SampleSpec,
+    out: &Path,
+    resume: bool,
+    quiet: bool,
+    progress: Progress,
+) -> Result<(), Failure> {
     let text = sample_scene(spec);
     Scene::from_toml_str(&text).map_err(Failure::Input)?;
     ballast::io::create_output_dir(out).map_err(Failure::Run)?;
     let deposit = out.join("deposit.toml");
     write(&deposit, &text)?;
-    let mut settled = run_stage(&deposit, &out.join("deposit"), resume, quiet)?;
+    let mut settled = run_stage(&deposit, &out.join("deposit"), resume, quiet, progress.clone())?;
     if spec.bank {
         let opened = open_bank(&settled).map_err(Failure::Run)?;
         let bank = out.join("bank.toml");
         write_scene(&bank, &opened, "the deposited sample without its mould, to settle into free banks")?;
-        settled = run_stage(&bank, &out.join("bank"), resume, quiet)?;
+        settled = run_stage(&bank, &out.join("bank"), resume, quiet, progress)?;
     }
     let path = out.join("sample.toml");
     write_scene(&path, &settled, &format!("deposited sample, seed {}", spec.seed))?;

@@ -10,6 +10,7 @@
 //! renamed, so a kill during the write leaves the previous checkpoint intact.
 
 use super::io_error;
+use super::RunSummary;
 use crate::error::{Error, Result};
 use crate::nscd::System;
 use serde::{Deserialize, Serialize};
@@ -17,17 +18,6 @@ use std::path::{Path, PathBuf};
 
 /// File name of the checkpoint in the output directory.
 pub const CHECKPOINT_FILE: &str = "checkpoint.json";
-
-/// What a run accumulates from step to step besides the engine state.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct RunSummary {
-    /// Largest overlap so far (m).
-    pub max_overlap: f64,
-    /// Steps that hit the iteration cap.
-    pub unconverged: u64,
-    /// Consecutive steps so far with the kinetic energy below the equilibrium threshold.
-    pub calm_steps: u64,
-}
 
 /// Everything needed to continue a run.
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -44,6 +44,10 @@ pub struct CycleRecorder {
     sum_contacts: f64,
     sum_iterations: f64,
     max_overlap: f64,
+    /// Positions of every body at the end of the first cycle (for the
+    /// displacement field from cycle 1 to the end of the run).
+    #[serde(default)]
+    pub first_cycle_q: Option<Vec<[f64; 3]>>,
 }
 
 impl CycleRecorder {
@@ -62,6 +66,7 @@ impl CycleRecorder {
             sum_contacts: 0.0,
             sum_iterations: 0.0,
             max_overlap: 0.0,
+            first_cycle_q: None,
         }
     }
 
@@ -109,7 +114,8 @@ impl CycleRecorder {
             self.max_overlap
         );
         let (y0, cycle) = (self.y0, self.cycle + 1);
-        *self = Self { y0, cycle, ..Self::new(sys, self.frequency, self.body) };
+        let first_cycle_q = self.first_cycle_q.take().or_else(|| Some(sys.bodies.q.clone()));
+        *self = Self { y0, cycle, first_cycle_q, ..Self::new(sys, self.frequency, self.body) };
         Some(row)
     }
 }
@@ -135,4 +141,22 @@ pub fn append_row(path: &Path, row: &str) -> Result<()> {
         writeln!(f, "{CYCLES_HEADER}").map_err(|e| io_error(path, "write", e))?;
     }
     writeln!(f, "{row}").map_err(|e| io_error(path, "write", e))
+}
+
+/// One row of `cycles.csv`, as read back by [`read`].
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+pub struct CycleRow {
+    pub cycle: u64,
+    pub time_s: f64,
+    pub settlement_mean_m: f64,
+    pub settlement_at_min_load_m: f64,
+    pub mean_grain_speed_m_s: f64,
+    pub contacts: f64,
+    pub iterations: f64,
+    pub max_overlap_m: f64,
+}
+
+/// Reads a `cycles.csv`; the error names the file and the row.
+pub fn read(path: &Path) -> Result<Vec<CycleRow>> {
+    super::read_csv(path)
 }

@@ -6,6 +6,8 @@
 //! - `scene.toml`: a byte copy of the input scene ([`copy_scene`]);
 //! - `final_scene.toml`: the input scene with the final state, to restart from;
 //! - `run.json`: seed, engine, crate version, number of steps, time step ([`RunInfo`]);
+//! - `summary.json`: wall time, mean iterations and contacts per step, overlaps
+//!   ([`summary::RunReport`]);
 //! - `cycles.csv`: per-cycle settlement statistics with `output.cycles` ([`cycles`]);
 //! - `checkpoint.json`: the whole state, every few minutes, for `--resume`
 //!   ([`checkpoint::Checkpoint`]);
@@ -20,16 +22,19 @@ pub mod checkpoint;
 pub mod cycles;
 pub mod figures;
 pub mod final_state;
+pub mod run_figures;
 pub mod series;
+pub mod summary;
 pub mod vtk;
 
 use crate::error::{Error, Result};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
-pub use checkpoint::{Checkpoint, RunSummary, CHECKPOINT_FILE};
+pub use checkpoint::{Checkpoint, CHECKPOINT_FILE};
 pub use final_state::{BodyState, FinalState};
 pub use series::{SeriesWriter, SERIES_HEADER};
+pub use summary::{RunReport, RunSummary};
 
 /// An I/O error with the path it happened on in its message.
 pub fn io_error(path: &Path, what: &str, e: std::io::Error) -> Error {
@@ -95,6 +100,18 @@ impl RunInfo {
     pub fn write(&self, dir: &Path) -> Result<PathBuf> {
         write_json(&dir.join("run.json"), self)
     }
+}
+
+/// Reads the rows of a CSV file with a header into `T` (columns by name); the
+/// error names the file and the line.
+pub fn read_csv<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>> {
+    let mut reader = csv::Reader::from_path(path).map_err(|e| csv_error(path, e))?;
+    reader.deserialize().map(|row| row.map_err(|e| csv_error(path, e))).collect()
+}
+
+fn csv_error(path: &Path, e: csv::Error) -> Error {
+    let line = e.position().map(|p| format!(" (line {})", p.line())).unwrap_or_default();
+    io_error(path, &format!("read{line}"), std::io::Error::other(e.to_string()))
 }
 
 /// Writes `value` as pretty JSON (with a final newline) to `path`.

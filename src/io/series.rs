@@ -1,9 +1,10 @@
 //! `series.csv`: one row of [`StepStats`] per output step.
 //!
-//! Columns ([`SERIES_HEADER`]): `time` (s), `kinetic_energy` (J), `contacts`,
-//! `active_contacts`, `iterations` (NLGS sweeps), `criterion` (final value of
-//! the convergence norm), `converged` (1 or 0), `mean_overlap` (m),
-//! `max_overlap` (m). Floats are written with `{:e}`, the shortest text that
+//! Columns ([`SERIES_HEADER`], units in the names): `time_s`, `kinetic_energy_J`,
+//! `contacts`, `active_contacts`, `iterations` (NLGS sweeps), `criterion` (final
+//! value of the convergence norm), `converged` (1 or 0), `mean_overlap_m` (mean
+//! over the active contacts), `max_overlap_m`, `total_overlap_m` (sum over the
+//! contacts: the cumulated interpenetration of Saussine et al. 2006, Fig. 2). Floats are written with `{:e}`, the shortest text that
 //! reads back to the same `f64`.
 
 use super::io_error;
@@ -15,7 +16,8 @@ use std::path::{Path, PathBuf};
 
 /// Header line of `series.csv` (without the newline).
 pub const SERIES_HEADER: &str =
-    "time,kinetic_energy,contacts,active_contacts,iterations,criterion,converged,mean_overlap,max_overlap";
+    "time_s,kinetic_energy_J,contacts,active_contacts,iterations,criterion,converged,mean_overlap_m,max_overlap_m,\
+total_overlap_m";
 
 /// Buffered writer of `series.csv`.
 #[derive(Debug)]
@@ -65,7 +67,7 @@ impl SeriesWriter {
     pub fn write(&mut self, s: &StepStats) -> Result<()> {
         writeln!(
             self.out,
-            "{:e},{:e},{},{},{},{:e},{},{:e},{:e}",
+            "{:e},{:e},{},{},{},{:e},{},{:e},{:e},{:e}",
             s.time,
             s.kinetic_energy,
             s.contacts,
@@ -74,7 +76,8 @@ impl SeriesWriter {
             s.criterion,
             u8::from(s.converged),
             s.mean_overlap,
-            s.max_overlap
+            s.max_overlap,
+            s.total_overlap
         )
         .map_err(|e| io_error(&self.path, "write", e))?;
         self.rows += 1;
@@ -90,4 +93,25 @@ impl SeriesWriter {
     pub fn finish(mut self) -> Result<()> {
         self.out.flush().map_err(|e| io_error(&self.path, "write", e))
     }
+}
+
+/// One row of `series.csv`, as read back by [`read`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+pub struct SeriesRow {
+    pub time_s: f64,
+    #[serde(rename = "kinetic_energy_J")]
+    pub kinetic_energy_j: f64,
+    pub contacts: usize,
+    pub active_contacts: usize,
+    pub iterations: usize,
+    pub criterion: f64,
+    pub converged: u8,
+    pub mean_overlap_m: f64,
+    pub max_overlap_m: f64,
+    pub total_overlap_m: f64,
+}
+
+/// Reads a `series.csv` written by [`SeriesWriter`]; the error names the file and the row.
+pub fn read(path: &Path) -> Result<Vec<SeriesRow>> {
+    super::read_csv(path)
 }

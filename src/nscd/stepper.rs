@@ -147,6 +147,7 @@ impl System {
                 failure = Some((culprit as usize, format!("runaway overlap {overlap:.3e} m with body {other}")));
             }
         }
+        stats.total_overlap = sum_overlap;
         if stats.active_contacts > 0 {
             stats.mean_overlap = sum_overlap / stats.active_contacts as f64;
         }

@@ -71,6 +71,9 @@ pub struct StepStats {
     pub mean_overlap: f64,
     /// Largest overlap at the end of the step (m).
     pub max_overlap: f64,
+    /// Sum of the overlaps of all contacts at the end of the step (m): the
+    /// "cumulated interpenetration" of Saussine et al. (2006), Fig. 2.
+    pub total_overlap: f64,
     /// Kinetic energy at the end of the step (J).
     pub kinetic_energy: f64,
 }
