@@ -243,7 +243,7 @@ fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
     assert!(run(&parts, &["--resume", "--stop-after", "20", "--vtk-every", "10"]).contains("stopped at step 37"));
     // A kill after the checkpoint leaves rows the checkpoint does not know: they go.
     let mut f = std::fs::OpenOptions::new().append(true).open(parts.join("series.csv")).unwrap();
-    std::io::Write::write_all(&mut f, b"9e9,9e9,9,9,9,9e9,1,9e9,9e9\n").unwrap();
+    std::io::Write::write_all(&mut f, b"9e9,9e9,9,9,9,9e9,1,9e9,9e9,9e9\n").unwrap();
     drop(f);
     run(&parts, &["--resume", "--vtk-every", "10"]);
     // Snapshots at steps 0, 10, …, 50 and their ParaView collection are identical too.
@@ -257,6 +257,25 @@ fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
         assert_eq!(std::fs::read(whole.join(f)).unwrap(), std::fs::read(parts.join(f)).unwrap(), "{f} differs");
     }
     assert!(!parts.join("checkpoint.json").exists(), "a finished run leaves no checkpoint");
+    // summary.json: the same sums over the 50 steps; only the wall time may differ.
+    let summary = |dir: &std::path::Path| {
+        let mut v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+        for k in ["wall_time_s", "wall_time_per_step_s", "wall_time_per_cycle_s"] {
+            assert!(v[k].as_f64().unwrap() > 0.0, "{k}");
+            v.as_object_mut().unwrap().remove(k);
+        }
+        v
+    };
+    let s = summary(&whole);
+    assert_eq!(s, summary(&parts));
+    assert_eq!((s["steps"].as_u64(), s["cycles"].as_u64()), (Some(50), Some(5)));
+    // Its mean sweeps per step are those of the per-cycle means (5 cycles of 10 steps).
+    let cycles = std::fs::read_to_string(whole.join("cycles.csv")).unwrap();
+    let col = cycles.lines().next().unwrap().split(',').position(|c| c == "iterations").unwrap();
+    let per_cycle: Vec<f64> = cycles.lines().skip(1).map(|l| l.split(',').nth(col).unwrap().parse().unwrap()).collect();
+    let mean = per_cycle.iter().sum::<f64>() / per_cycle.len() as f64;
+    assert!((s["mean_iterations"].as_f64().unwrap() - mean).abs() < 1e-12 * mean);
     // Checkpoints written by the clock (here after every step) change no number.
     let clocked = dir.join("clocked");
     run(&clocked, &["--checkpoint-every", "1e-9"]);

@@ -250,8 +250,6 @@ pub fn convergence(
     loading: &LoadingArgs,
     study: &StudyArgs,
 ) -> Result<(), Failure> {
-    let sample_scene = Scene::load(sample_path).map_err(Failure::Input)?;
-    let base = loading_for(&sample_scene, loading)?;
     let mut runs: Vec<(String, f64)> = Vec::new();
     if policies.is_empty() {
         runs.extend(PAPER_POLICIES.iter().map(|&(p, t)| (p.to_string(), t)));
@@ -263,6 +261,8 @@ pub fn convergence(
         let tol: f64 = tol.parse().map_err(|_| input(format!("--policies: '{tol}' in '{p}' is not a number")))?;
         runs.push((name.to_string(), tol));
     }
+    let sample_scene = Scene::load(sample_path).map_err(Failure::Input)?;
+    let base = loading_for(&sample_scene, loading)?;
     let jobs: Vec<Job> = runs
         .iter()
         .map(|(policy, tol)| Job {

@@ -359,6 +359,14 @@ pub fn loaded_scene(sample: &Scene, spec: &LoadingSpec) -> Result<Scene> {
         return Err(Error::Scene("loaded_scene: the sample still has its mould; run open_bank first".into()));
     }
     let (w, h, b) = (spec.sleeper_width, spec.sleeper_height, spec.bar_size);
+    if spec.bars > 0 && w < (spec.bars + 2) as f64 * b {
+        // Bars one bar width in from the ends and at least one bar width apart.
+        return Err(Error::Scene(format!(
+            "loaded_scene: a sleeper {w} m wide is too narrow for {} bars of {b} m (at least {} m); use fewer bars",
+            spec.bars,
+            (spec.bars + 2) as f64 * b
+        )));
+    }
     let sys = sample.build()?;
     let top = surface_under(sample, &sys, -w / 2.0, w / 2.0)?;
     let mut out = sample.clone();
