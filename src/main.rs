@@ -61,6 +61,10 @@ enum Command {
         /// Write VTK snapshots (`DIR/vtk/*.vtp`, listed in `DIR/run.pvd`) every N steps; 0: none.
         #[arg(long, value_name = "N", default_value_t = 0)]
         vtk_every: u64,
+        /// Threads of the NLGS sweeps: large problems are swept as two halves side by
+        /// side (the numbers do not depend on it). Default: 2 if the machine has 2 cores.
+        #[arg(long)]
+        threads: Option<usize>,
         /// At the end, draw the run's figures (PNG + SVG): settlement and interpenetration
         /// curves, force chains, displacement field.
         #[arg(long)]
@@ -104,11 +108,12 @@ pub(crate) enum Failure {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { scene, out, quiet, checkpoint_every, resume, stop_after, vtk_every, figures } => run(
-            &scene,
-            &out,
-            &RunOptions { quiet, checkpoint_every, resume, stop_after, vtk_every, figures, progress: None },
-        ),
+        Command::Run { scene, out, quiet, checkpoint_every, resume, stop_after, vtk_every, threads, figures } => {
+            let threads = threads.unwrap_or_else(default_threads);
+            let opts =
+                RunOptions { quiet, checkpoint_every, resume, stop_after, vtk_every, figures, threads, progress: None };
+            run(&scene, &out, &opts)
+        }
         Command::Deposit { grains, width, seed, dt, duration, out } => deposit(grains, width, seed, dt, duration, &out),
         Command::Saussine(cmd) => saussine::main(cmd),
     };
@@ -123,6 +128,12 @@ fn main() -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+/// Threads of the NLGS sweeps of a single run: 2 when the machine has 2 cores
+/// (the split solver uses at most 2).
+pub(crate) fn default_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get()).min(2)
 }
 
 /// `ballast deposit`: generates, validates and writes a loose deposit scene.
@@ -169,6 +180,8 @@ pub(crate) struct RunOptions {
     pub vtk_every: u64,
     /// Draw the run's figures at the end (`io::run_figures`).
     pub figures: bool,
+    /// Threads of the NLGS sweeps (the numbers do not depend on it).
+    pub threads: usize,
     /// Show the progress bar in this group (runs of a study side by side), with a label.
     pub progress: Option<(indicatif::MultiProgress, String)>,
 }
@@ -227,6 +240,7 @@ pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<()
         let cycles = scene.output_cycles().map(|(f, body)| io::cycles::CycleRecorder::new(&sys, f, body));
         (sys, series, RunSummary::default(), snapshots, cycles)
     };
+    sys.set_threads(opts.threads);
     let first = sys.step + 1;
     let last_step = opts.stop_after.map_or(steps, |n| steps.min(sys.step.saturating_add(n)));
 

@@ -258,6 +258,7 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                 resume,
                 vtk_every: snapshot_every.saturating_mul(steps_per_cycle),
                 figures: true,
+                threads: crate::default_threads(),
                 ..RunOptions::default()
             };
             run(&path, &out, &opts)
@@ -294,7 +295,9 @@ fn run_stage(scene_path: &Path, dir: &Path, resume: bool, quiet: bool, progress:
     let done = final_scene.exists() && !dir.join(ballast::io::CHECKPOINT_FILE).exists();
     if !(resume && done) {
         let resume = resume && dir.join(ballast::io::CHECKPOINT_FILE).exists();
-        let opts = RunOptions { quiet, checkpoint_every: 300.0, resume, progress, ..RunOptions::default() };
+        // One sweep thread per run when deposits run side by side (an ensemble).
+        let threads = if progress.is_some() { 1 } else { crate::default_threads() };
+        let opts = RunOptions { quiet, checkpoint_every: 300.0, resume, progress, threads, ..RunOptions::default() };
         run(scene_path, dir, &opts)?;
     }
     Scene::load(&final_scene).map_err(Failure::Run)

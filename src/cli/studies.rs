@@ -167,6 +167,8 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
                     checkpoint_every: study.checkpoint_every,
                     resume: study.resume && checkpoint,
                     figures: true,
+                    // Several runs at once: one sweep thread each, unless one job.
+                    threads: if threads == 1 { crate::default_threads() } else { 1 },
                     progress: Some((group.clone(), job.label.clone())),
                     ..RunOptions::default()
                 };

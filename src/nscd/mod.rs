@@ -5,7 +5,8 @@
 //!
 //! Data flow of a step: [`stepper`] (θ-method) → [`detection`] ([`broad_phase`]
 //! grid, [`shadow_overlap`] / [`narrow_phase`]) → [`contact`] rows → [`nlgs`]
-//! ([`coulomb`] local solver, [`sublayer`] springs, [`criterion`]).
+//! ([`coulomb`] local solver, [`sublayer`] springs, [`criterion`]; [`split`]:
+//! two halves swept side by side on large problems).
 
 pub mod bodies;
 pub mod broad_phase;
@@ -18,6 +19,7 @@ pub mod measure;
 pub mod narrow_phase;
 pub mod nlgs;
 pub mod shadow_overlap;
+pub mod split;
 pub mod stepper;
 pub mod sublayer;
 pub mod system;

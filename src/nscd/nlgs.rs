@@ -18,6 +18,7 @@
 use super::contact::{dot3, ContactRow};
 use super::coulomb::solve;
 use super::criterion::{evaluate, Policy, SweepNorms};
+use super::split::SplitWorkspace;
 use super::sublayer::SpringRow;
 
 /// NLGS settings.
@@ -31,6 +32,18 @@ pub struct NlgsSettings {
     pub max_factor: f64,
     /// Alternate forward and backward sweeps (symmetric Gauss–Seidel).
     pub symmetric: bool,
+    /// Problems of at least this many rows (contacts + springs) are solved split
+    /// in two halves swept side by side ([`super::split`]); 0: never.
+    #[serde(default = "default_split_min_rows")]
+    pub split_min_rows: usize,
+}
+
+/// Default of [`NlgsSettings::split_min_rows`]: below it a sweep is too short
+/// (a few µs) for two threads to pay for their synchronisation.
+pub const DEFAULT_SPLIT_MIN_ROWS: usize = 512;
+
+fn default_split_min_rows() -> usize {
+    DEFAULT_SPLIT_MIN_ROWS
 }
 
 impl Default for NlgsSettings {
@@ -42,6 +55,7 @@ impl Default for NlgsSettings {
             max_iterations: 1000,
             max_factor: 4.0,
             symmetric: false,
+            split_min_rows: DEFAULT_SPLIT_MIN_ROWS,
         }
     }
 }
@@ -183,11 +197,40 @@ pub fn solve_nlgs(
     if rows.is_empty() && springs.is_empty() {
         return NlgsReport { iterations: 0, criterion: 0.0, converged: true };
     }
+    iterate(settings, |backwards| sweep(u, inv_m, rows, springs, backwards))
+}
+
+/// [`solve_nlgs`], split in two halves at the median abscissa of the mobile
+/// bodies' centres `q` when the problem has at least `settings.split_min_rows`
+/// rows ([`super::split`]), the halves swept side by side when `threads ≥ 2`
+/// (same numbers as with one); `ws` keeps the buffers from call to call.
+#[allow(clippy::too_many_arguments)]
+pub fn solve_nlgs_split(
+    settings: &NlgsSettings,
+    ws: &mut SplitWorkspace,
+    threads: usize,
+    q: &[[f64; 3]],
+    u: &mut [[f64; 3]],
+    inv_m: &[[f64; 3]],
+    rows: &mut [ContactRow],
+    springs: &mut [SpringRow],
+) -> NlgsReport {
+    let n = rows.len() + springs.len();
+    if settings.split_min_rows == 0 || n < settings.split_min_rows {
+        return solve_nlgs(settings, u, inv_m, rows, springs);
+    }
+    ws.load(q, u, inv_m, rows, springs);
+    let report = ws.run(threads, |sweep| iterate(settings, sweep));
+    ws.store(u, rows, springs);
+    report
+}
+
+fn iterate(settings: &NlgsSettings, mut sweep: impl FnMut(bool) -> SweepNorms) -> NlgsReport {
     let mut previous_wpp = 0.0;
     let mut report = NlgsReport::default();
     for it in 1..=settings.max_iterations {
         let backwards = settings.symmetric && it % 2 == 0;
-        let norms = sweep(u, inv_m, rows, springs, backwards);
+        let norms = sweep(backwards);
         let (value, ok) = evaluate(settings.policy, settings.tolerance, settings.max_factor, &norms, previous_wpp);
         previous_wpp = norms.sum_wpp;
         report = NlgsReport { iterations: it, criterion: value, converged: ok };

@@ -13,7 +13,7 @@
 //! naming the step and body, and the state goes back to the start of the step.
 
 use super::contact::ContactRow;
-use super::nlgs::{apply_impulses, solve_nlgs};
+use super::nlgs::{apply_impulses, solve_nlgs_split};
 use super::system::{StepStats, System};
 use crate::error::{Error, Result};
 use crate::geometry::Vec2;
@@ -104,8 +104,16 @@ impl System {
 
         // 4. NLGS.
         apply_impulses(&mut self.bodies.u, &self.bodies.inv_m, &ws.rows, &ws.spring_rows);
-        let report =
-            solve_nlgs(&self.params.nlgs, &mut self.bodies.u, &self.bodies.inv_m, &mut ws.rows, &mut ws.spring_rows);
+        let report = solve_nlgs_split(
+            &self.params.nlgs,
+            &mut ws.split,
+            ws.threads,
+            &ws.q_m,
+            &mut self.bodies.u,
+            &self.bodies.inv_m,
+            &mut ws.rows,
+            &mut ws.spring_rows,
+        );
 
         // 5. Final configuration.
         for ((q, qm), u) in self.bodies.q.iter_mut().zip(&ws.q_m).zip(&self.bodies.u) {

@@ -103,6 +103,9 @@ pub(crate) struct Workspace {
     pub geoms: Vec<ContactGeom>,
     pub spring_rows: Vec<SpringRow>,
     pub detector: Detector,
+    pub split: super::split::SplitWorkspace,
+    /// Threads of the NLGS sweeps (0 or 1: one); not part of the state.
+    pub threads: usize,
 }
 
 /// The complete state of an NSCD simulation.
@@ -195,6 +198,13 @@ impl System {
             }
         }
         [f.x, f.y]
+    }
+
+    /// Sweeps large NLGS problems on `threads` threads (two halves side by side,
+    /// [`super::split`]; more than 2 are used as 2). The numbers do not depend on
+    /// it. Not part of the state: a system read from a checkpoint uses one.
+    pub fn set_threads(&mut self, threads: usize) {
+        self.ws.threads = threads;
     }
 
     /// The NLGS problem of the last step, restarted cold: `u = u_free` and all

@@ -258,6 +258,7 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
         max_iterations,
         max_factor,
         symmetric: ns.symmetric.unwrap_or(false),
+        split_min_rows: crate::nscd::nlgs::DEFAULT_SPLIT_MIN_ROWS,
     };
 
     // [output]

@@ -1,0 +1,314 @@
+//! Domain-split NLGS: the two halves of the sample swept side by side, the
+//! rows that join them after (in the spirit of the parallel NSCD of Renouf,
+//! Dubois & Alart 2004, ref. [25] of Saussine et al. 2006).
+//!
+//! The mobile bodies are split at the median abscissa of their centres (at
+//! `q_m`) into a left and a right set. A row (contact or spring) whose mobile
+//! bodies are all on the left belongs to the left half, all on the right to the
+//! right half, otherwise to the interface. Left and right rows never touch the
+//! same mobile body, so one Gauss–Seidel sweep of the left rows and one of the
+//! right rows can run at the same time on two threads; the interface rows are
+//! swept after both, then the next sweep begins. Bodies with a zero inverse mass
+//! (fixed, or every velocity imposed) are never changed by a row: each part has
+//! its own copy of them.
+//!
+//! Each part owns its velocities (`[its mobile bodies | fixed bodies]`) and its
+//! rows with renumbered body indices, so the plain [`super::nlgs::sweep`] runs
+//! on it. Between two sweeps the interface bodies' velocities are gathered from
+//! the halves and scattered back. The order of the updates (left rows, right
+//! rows, interface rows, each in key order) depends on the positions only,
+//! never on the number of threads: a run gives the same numbers on one core or
+//! two. With two threads the right half is handed to a helper thread for the
+//! step and back each sweep through two one-slot channels; the threads spin
+//! briefly, then yield, while they wait (a sweep lasts tens of microseconds, far
+//! less than a sleep and wake-up).
+//!
+//! Nothing is allocated once the buffers have grown to the problem's size,
+//! except the helper thread, started once per step.
+
+use super::contact::ContactRow;
+use super::criterion::SweepNorms;
+use super::nlgs::sweep;
+use super::sublayer::SpringRow;
+use std::sync::mpsc::{sync_channel, Receiver, TryRecvError};
+
+const LEFT: u8 = 0;
+const RIGHT: u8 = 1;
+const FIXED: u8 = 2;
+const NONE: u32 = u32::MAX;
+
+/// One part of the split problem, with its own velocities and rows.
+#[derive(Debug, Clone, Default)]
+struct Part {
+    u: Vec<[f64; 3]>,
+    inv_m: Vec<[f64; 3]>,
+    rows: Vec<ContactRow>,
+    springs: Vec<SpringRow>,
+    /// Original index of each row and spring.
+    row_of: Vec<u32>,
+    spring_of: Vec<u32>,
+    /// Original index of each mobile body (the fixed copies follow them).
+    body_of: Vec<u32>,
+}
+
+impl Part {
+    fn sweep(&mut self, backwards: bool) -> SweepNorms {
+        sweep(&mut self.u, &self.inv_m, &mut self.rows, &mut self.springs, backwards)
+    }
+
+    fn clear(&mut self) {
+        self.u.clear();
+        self.inv_m.clear();
+        self.rows.clear();
+        self.springs.clear();
+        self.row_of.clear();
+        self.spring_of.clear();
+        self.body_of.clear();
+    }
+}
+
+/// Buffers of the split solve, kept from step to step.
+#[derive(Debug, Clone, Default)]
+pub struct SplitWorkspace {
+    /// Per body: side, and slot in its part (interface slot in `iface_slot`).
+    side: Vec<u8>,
+    slot: Vec<u32>,
+    iface_slot: Vec<u32>,
+    xs: Vec<f64>,
+    fixed: Vec<u32>,
+    left: Part,
+    right: Part,
+    iface: Part,
+}
+
+/// Sums and maxima of two partial sweeps.
+fn merge(a: SweepNorms, b: SweepNorms) -> SweepNorms {
+    SweepNorms {
+        active: a.active + b.active,
+        sum_dvdv: a.sum_dvdv + b.sum_dvdv,
+        max_dvdv: a.max_dvdv.max(b.max_dvdv),
+        sum_dvdvrr: a.sum_dvdvrr + b.sum_dvdvrr,
+        max_dvdvrr: a.max_dvdvrr.max(b.max_dvdvrr),
+        sum_dvor: a.sum_dvor + b.sum_dvor,
+        sum_wrr: a.sum_wrr + b.sum_wrr,
+        sum_wrwr: a.sum_wrwr + b.sum_wrwr,
+        sum_wpp: a.sum_wpp + b.sum_wpp,
+        changed: a.changed || b.changed,
+    }
+}
+
+/// Waits for a message: spins, then yields the core. `None` if the sender is gone.
+fn wait<T>(rx: &Receiver<T>) -> Option<T> {
+    let mut spins = 0u32;
+    loop {
+        match rx.try_recv() {
+            Ok(v) => return Some(v),
+            Err(TryRecvError::Disconnected) => return None,
+            Err(TryRecvError::Empty) => {
+                if spins < 20_000 {
+                    spins += 1;
+                    std::hint::spin_loop();
+                } else {
+                    std::thread::yield_now();
+                }
+            }
+        }
+    }
+}
+
+/// Which part a row between `a` and `b` belongs to: 0 left, 1 right, 2 interface.
+fn part_of(side: &[u8], a: u32, b: u32) -> usize {
+    let side = |i: u32| if i == NONE { FIXED } else { side[i as usize] };
+    match (side(a), side(b)) {
+        (RIGHT, RIGHT) | (RIGHT, FIXED) | (FIXED, RIGHT) => 1,
+        (LEFT, RIGHT) | (RIGHT, LEFT) => 2,
+        _ => 0,
+    }
+}
+
+impl SplitWorkspace {
+    /// Splits the problem: bodies at abscissae `q[i][0]`, velocities `u`.
+    pub(crate) fn load(
+        &mut self,
+        q: &[[f64; 3]],
+        u: &[[f64; 3]],
+        inv_m: &[[f64; 3]],
+        rows: &[ContactRow],
+        springs: &[SpringRow],
+    ) {
+        let n = u.len();
+        let mobile = |i: usize| inv_m[i] != [0.0; 3];
+        self.xs.clear();
+        self.xs.extend((0..n).filter(|&i| mobile(i)).map(|i| q[i][0]));
+        let median = if self.xs.is_empty() {
+            0.0
+        } else {
+            let k = self.xs.len() / 2;
+            *self.xs.select_nth_unstable_by(k, f64::total_cmp).1
+        };
+        self.side.clear();
+        self.slot.clear();
+        self.fixed.clear();
+        self.left.clear();
+        self.right.clear();
+        self.iface.clear();
+        for (i, qi) in q.iter().enumerate().take(n) {
+            let (side, part) = if !mobile(i) {
+                self.slot.push(self.fixed.len() as u32);
+                self.fixed.push(i as u32);
+                self.side.push(FIXED);
+                continue;
+            } else if qi[0] < median {
+                (LEFT, &mut self.left)
+            } else {
+                (RIGHT, &mut self.right)
+            };
+            self.side.push(side);
+            self.slot.push(part.body_of.len() as u32);
+            part.body_of.push(i as u32);
+        }
+        // The interface's mobile bodies: those of its rows, in order of first use.
+        self.iface_slot.clear();
+        self.iface_slot.resize(n, NONE);
+        let iface_body = |i: u32, slot: &mut Vec<u32>, body_of: &mut Vec<u32>| {
+            if i != NONE && inv_m[i as usize] != [0.0; 3] && slot[i as usize] == NONE {
+                slot[i as usize] = body_of.len() as u32;
+                body_of.push(i);
+            }
+        };
+        for r in rows.iter().filter(|r| part_of(&self.side, r.a, r.b) == 2) {
+            iface_body(r.a, &mut self.iface_slot, &mut self.iface.body_of);
+            iface_body(r.b, &mut self.iface_slot, &mut self.iface.body_of);
+        }
+        for s in springs.iter().filter(|s| part_of(&self.side, s.a, s.b) == 2) {
+            iface_body(s.a, &mut self.iface_slot, &mut self.iface.body_of);
+            iface_body(s.b, &mut self.iface_slot, &mut self.iface.body_of);
+        }
+        // Velocities: each part's mobile bodies, then a copy of the fixed ones.
+        let fixed = &self.fixed;
+        for part in [&mut self.left, &mut self.right, &mut self.iface] {
+            for &i in part.body_of.iter().chain(fixed) {
+                part.u.push(u[i as usize]);
+                part.inv_m.push(inv_m[i as usize]);
+            }
+        }
+        // Rows, renumbered into their part, in their original order.
+        for (k, r) in rows.iter().enumerate() {
+            let p = part_of(&self.side, r.a, r.b);
+            let mut r = *r;
+            (r.a, r.b) = (self.index(r.a, p), self.index(r.b, p));
+            let part = self.part_mut(p);
+            part.rows.push(r);
+            part.row_of.push(k as u32);
+        }
+        for (k, s) in springs.iter().enumerate() {
+            let p = part_of(&self.side, s.a, s.b);
+            let mut s = *s;
+            (s.a, s.b) = (self.index(s.a, p), self.index(s.b, p));
+            let part = self.part_mut(p);
+            part.springs.push(s);
+            part.spring_of.push(k as u32);
+        }
+    }
+
+    fn part_mut(&mut self, p: usize) -> &mut Part {
+        match p {
+            0 => &mut self.left,
+            1 => &mut self.right,
+            _ => &mut self.iface,
+        }
+    }
+
+    /// Index of body `i` in part `p`; `u32::MAX` (a world anchor) stays.
+    fn index(&self, i: u32, p: usize) -> u32 {
+        if i == NONE {
+            return i;
+        }
+        let i = i as usize;
+        let movers = [&self.left, &self.right, &self.iface][p].body_of.len() as u32;
+        match (self.side[i], p) {
+            (FIXED, _) => movers + self.slot[i],
+            (_, 2) => self.iface_slot[i],
+            _ => self.slot[i],
+        }
+    }
+
+    /// Copies the interface bodies' velocities from the halves (`to_iface`) or back.
+    fn exchange(left: &mut Part, right: &mut Part, iface: &mut Part, side: &[u8], slot: &[u32], to_iface: bool) {
+        for (k, &i) in iface.body_of.iter().enumerate() {
+            let half = if side[i as usize] == LEFT { &mut *left } else { &mut *right };
+            let j = slot[i as usize] as usize;
+            if to_iface {
+                iface.u[k] = half.u[j];
+            } else {
+                half.u[j] = iface.u[k];
+            }
+        }
+    }
+
+    /// Runs `sweeps` with a function doing one split sweep (on one thread, or on
+    /// two when `threads ≥ 2`), then nothing more: call [`Self::store`] after.
+    pub(crate) fn run<R>(&mut self, threads: usize, sweeps: impl FnOnce(&mut dyn FnMut(bool) -> SweepNorms) -> R) -> R {
+        let Self { left, right, iface, side, slot, .. } = self;
+        let (side, slot) = (&side[..], &slot[..]);
+        let interface = |left: &mut Part, right: &mut Part, iface: &mut Part, backwards: bool| {
+            Self::exchange(left, right, iface, side, slot, true);
+            let n = iface.sweep(backwards);
+            Self::exchange(left, right, iface, side, slot, false);
+            n
+        };
+        if threads < 2 {
+            return sweeps(&mut |backwards| {
+                let l = left.sweep(backwards);
+                let r = right.sweep(backwards);
+                merge(merge(l, r), interface(left, right, iface, backwards))
+            });
+        }
+        std::thread::scope(|s| {
+            let (to_helper, jobs) = sync_channel::<(&mut Part, bool)>(1);
+            let (to_main, done) = sync_channel::<(&mut Part, SweepNorms)>(1);
+            s.spawn(move || {
+                while let Some((part, backwards)) = wait(&jobs) {
+                    let n = part.sweep(backwards);
+                    if to_main.send((part, n)).is_err() {
+                        break;
+                    }
+                }
+            });
+            let mut right = Some(right);
+            let result = sweeps(&mut |backwards| {
+                let r_part = right.take().expect("the right half is home between sweeps");
+                to_helper.send((r_part, backwards)).expect("the helper thread runs until the step ends");
+                let l = left.sweep(backwards);
+                let (r_part, r) = wait(&done).expect("the helper thread answers every sweep");
+                let n = merge(merge(l, r), interface(left, r_part, iface, backwards));
+                right = Some(r_part);
+                n
+            });
+            drop(to_helper);
+            result
+        })
+    }
+
+    /// Writes the velocities and impulses back in the caller's order.
+    pub(crate) fn store(&self, u: &mut [[f64; 3]], rows: &mut [ContactRow], springs: &mut [SpringRow]) {
+        for part in [&self.left, &self.right] {
+            for (&i, ui) in part.body_of.iter().zip(&part.u) {
+                u[i as usize] = *ui;
+            }
+        }
+        for part in [&self.left, &self.right, &self.iface] {
+            for (r, &k) in part.rows.iter().zip(&part.row_of) {
+                rows[k as usize].p = r.p;
+            }
+            for (s, &k) in part.springs.iter().zip(&part.spring_of) {
+                springs[k as usize].p = s.p;
+            }
+        }
+    }
+
+    /// Rows (contacts and springs) in each part: left, right, interface.
+    pub fn parts(&self) -> [usize; 3] {
+        [&self.left, &self.right, &self.iface].map(|p| p.rows.len() + p.springs.len())
+    }
+}
