@@ -113,6 +113,34 @@ fn convergence_and_step_studies() {
     run(&[&args[..], &["--resume"]].concat());
     assert_eq!(std::fs::read(&summary).unwrap(), before);
 
+    // §4: a plain settlement run with a snapshot every cycle.
+    let settle = dir.join("settle");
+    run(&[
+        "saussine",
+        "settle",
+        "--sample",
+        &sample,
+        "--cycles",
+        "2",
+        "--dt",
+        "1e-3",
+        "--bars",
+        "0",
+        "--snapshot-every",
+        "1",
+        "--out",
+        settle.to_str().unwrap(),
+    ]);
+    let cycles = csv(&settle.join("cycles.csv"));
+    assert_eq!(cycles.len(), 2);
+    // The sleeper goes down under a compressive load (A + B cos ≤ −A/2 < 0 at all times).
+    assert!(num(&cycles[1], "settlement_mean_m") > 0.0, "{cycles:?}");
+    for step in [0, 50, 100] {
+        assert!(settle.join(format!("vtk/bodies_{step:09}.vtp")).is_file(), "snapshot of step {step}");
+    }
+    figures_exist(&settle, &["settlement", "interpenetration", "force_chains", "displacements"]);
+    assert!(settle.join("loaded.toml").is_file() && settle.join("summary.json").is_file());
+
     let steps = dir.join("steps");
     run(&[
         "saussine",
