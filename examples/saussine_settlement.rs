@@ -15,7 +15,7 @@
 //! loaded sample at the start and at the end.
 
 use ballast::io::cycles::CycleRecorder;
-use ballast::io::figures::{self, Arrow, Axes, Series};
+use ballast::io::figures::{self, Axes, Series};
 use ballast::io::vtk;
 use ballast::scenarios::saussine::{loaded_scene, measure_sample, sample_scene, LoadingSpec, SampleSpec, SLEEPER};
 use ballast::scene::Scene;
@@ -130,13 +130,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let title = format!("Force chains after {cycles} cycles (line width ∝ normal force)");
             figures::force_chains(&out.join("force_chains"), &title, &polys, &fixed, &figures::force_lines_of(&sys))?;
             if let Some(q0) = after_first {
-                let arrows: Vec<Arrow> = q0
-                    .iter()
-                    .zip(&sys.bodies.q)
-                    .zip(&sys.bodies.info)
-                    .filter(|(_, info)| !info.fixed)
-                    .map(|((a, b), _)| Arrow { from: [a[0], a[1]], displacement: [b[0] - a[0], b[1] - a[1]] })
-                    .collect();
+                let arrows = ballast::io::run_figures::displacement_arrows(&q0, &sys);
                 let title = format!("Grain displacements from cycle 1 to cycle {cycles}");
                 figures::displacement_field(&out.join("displacements"), &title, &polys, &fixed, &arrows, 20.0)?;
             }

@@ -121,13 +121,25 @@ fn label_number(x: f64) -> String {
     format!("{x:e}").replace('.', "p")
 }
 
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// A pool of `threads` threads for runs side by side.
+fn pool(threads: usize) -> Result<rayon::ThreadPool, Failure> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Failure::Run(Error::Io(std::io::Error::other(e))))
+}
+
 /// Writes the scenes of `jobs`, runs them `study.jobs` at a time and reads back their outcomes.
 fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
     let out = &study.out;
     if !(study.checkpoint_every.is_finite() && study.checkpoint_every >= 0.0) {
         return Err(input(format!("--checkpoint-every: must be non-negative, got {}", study.checkpoint_every)));
     }
-    let threads = study.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let threads = study.jobs.unwrap_or_else(cores);
     if threads == 0 {
         return Err(input("--jobs: must be at least 1".into()));
     }
@@ -150,10 +162,7 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
         crate::saussine::write_scene(&job.scene(out), &loaded, &what)?;
     }
     let group = MultiProgress::new();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Failure::Run(Error::Io(std::io::Error::other(e))))?;
+    let pool = pool(threads)?;
     let results: Vec<Result<(), Failure>> = pool.install(|| {
         jobs.par_iter()
             .map(|job| {
@@ -424,11 +433,7 @@ pub fn ensemble(
     let out = &study.out;
     let seeds: Vec<u64> = (0..samples).map(|k| first_seed + k).collect();
     // 1. The samples, deposited side by side.
-    let threads = study.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Failure::Run(Error::Io(std::io::Error::other(e))))?;
+    let pool = pool(study.jobs.unwrap_or_else(cores).max(1))?;
     let group = MultiProgress::new();
     let deposited: Vec<Result<(), Failure>> = pool.install(|| {
         seeds

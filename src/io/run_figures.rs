@@ -34,6 +34,16 @@ pub fn settlement_series(rows: &[super::cycles::CycleRow], label: &str) -> [Seri
     ]
 }
 
+/// One arrow per non-fixed body of `sys`, from its centre in `q0` (m) to its centre now.
+pub fn displacement_arrows(q0: &[[f64; 3]], sys: &System) -> Vec<Arrow> {
+    q0.iter()
+        .zip(&sys.bodies.q)
+        .zip(&sys.bodies.info)
+        .filter(|(_, info)| !info.fixed)
+        .map(|((a, b), _)| Arrow { from: [a[0], a[1]], displacement: [b[0] - a[0], b[1] - a[1]] })
+        .collect()
+}
+
 /// Writes the figures of the run in `dir` (see the module doc); `first_cycle_q` are
 /// the positions at the end of the first cycle, if known. Returns the stems written.
 pub fn write_run_figures(dir: &Path, sys: &System, first_cycle_q: Option<&[[f64; 3]]>) -> Result<Vec<PathBuf>> {
@@ -75,13 +85,7 @@ pub fn write_run_figures(dir: &Path, sys: &System, first_cycle_q: Option<&[[f64;
     figures::force_chains(&stem, &title, &polygons, &fixed, &figures::force_lines_of(sys))?;
     written.push(stem);
     if let Some(q0) = first_cycle_q.filter(|q| q.len() == sys.bodies.len()) {
-        let arrows: Vec<Arrow> = q0
-            .iter()
-            .zip(&sys.bodies.q)
-            .zip(&sys.bodies.info)
-            .filter(|(_, info)| !info.fixed)
-            .map(|((a, b), _)| Arrow { from: [a[0], a[1]], displacement: [b[0] - a[0], b[1] - a[1]] })
-            .collect();
+        let arrows = displacement_arrows(q0, sys);
         // Arrows of the largest displacement drawn a tenth of the sample's width.
         let xs = sys.bodies.q.iter().map(|q| q[0]);
         let width = xs.clone().fold(f64::NEG_INFINITY, f64::max) - xs.fold(f64::INFINITY, f64::min);
