@@ -290,6 +290,7 @@ fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
     assert_eq!(r.status.code(), Some(2));
     let err = String::from_utf8_lossy(&r.stderr);
     assert!(err.starts_with("error:") && err.contains("another scene") && err.trim().lines().count() == 1, "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// A deposit with `simulation.equilibrium` ends once the kinetic energy has stayed
@@ -328,4 +329,5 @@ fn run_stops_at_equilibrium_and_resumes_into_the_same_stop() {
     for f in ["series.csv", "final.json"] {
         assert_eq!(std::fs::read(whole.join(f)).unwrap(), std::fs::read(parts.join(f)).unwrap(), "{f} differs");
     }
+    let _ = std::fs::remove_dir_all(&dir);
 }
