@@ -187,7 +187,10 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
     });
     let mut outcomes = Vec::with_capacity(jobs.len());
     for (job, result) in jobs.iter().zip(results) {
+        let dir = job.dir(out);
         let status = match result {
+            // Skipped on --resume, but diverged in an earlier invocation (no final scene).
+            Ok(()) if !dir.join("final_scene.toml").exists() => "failed in an earlier invocation".to_string(),
             Ok(()) => "ok".to_string(),
             Err(Failure::Input(e)) => return Err(Failure::Input(e)),
             // A diverged run still wrote its series and summary: keep it in the study.
@@ -196,7 +199,6 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
                 format!("failed: {}", e.to_string().split_whitespace().collect::<Vec<_>>().join(" "))
             }
         };
-        let dir = job.dir(out);
         let report = std::fs::read_to_string(dir.join("summary.json"))
             .ok()
             .and_then(|t| serde_json::from_str::<RunReport>(&t).ok());
