@@ -130,10 +130,39 @@ fn main() -> ExitCode {
     }
 }
 
+/// Cores of the machine (1 if unknown).
+pub(crate) fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
 /// Threads of the NLGS sweeps of a single run: 2 when the machine has 2 cores
 /// (the split solver uses at most 2).
 pub(crate) fn default_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get()).min(2)
+    cores().min(2)
+}
+
+/// What an output folder holds for `--resume`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Prior {
+    /// A finished run: `marker` is there and no checkpoint.
+    Finished,
+    /// A run to continue from its checkpoint.
+    Checkpointed,
+    /// Nothing to continue: start afresh.
+    Nothing,
+}
+
+impl Prior {
+    /// The state of `dir` as `--resume` (`resume`) sees it; without `--resume`, always `Nothing`.
+    pub(crate) fn of(dir: &Path, marker: &str, resume: bool) -> Self {
+        let checkpoint = dir.join(CHECKPOINT_FILE).exists();
+        match (resume, checkpoint) {
+            (false, _) => Prior::Nothing,
+            (true, true) => Prior::Checkpointed,
+            (true, false) if dir.join(marker).exists() => Prior::Finished,
+            (true, false) => Prior::Nothing,
+        }
+    }
 }
 
 /// `ballast deposit`: generates, validates and writes a loose deposit scene.
@@ -153,7 +182,7 @@ fn deposit(grains: usize, width: f64, seed: u64, dt: f64, duration: f64, out: &P
 }
 
 /// The error's message on a single line.
-fn one_line(e: &Error) -> String {
+pub(crate) fn one_line(e: &Error) -> String {
     e.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
 }
 

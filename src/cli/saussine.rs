@@ -16,7 +16,7 @@
 //! and the load scaled alike (same pressure), unless `--sleeper-width` is given.
 
 use crate::studies::{self, loading_for, StudyArgs};
-use crate::{run, Failure, RunOptions};
+use crate::{run, Failure, Prior, RunOptions};
 use ballast::scenarios::saussine::{
     loaded_scene, measure_sample, open_bank, sample_scene, Guide, LoadingSpec, SampleSpec,
 };
@@ -293,9 +293,9 @@ type Progress = Option<(indicatif::MultiProgress, String)>;
 /// Runs `scene_path` into `dir` unless a finished run is there already.
 fn run_stage(scene_path: &Path, dir: &Path, resume: bool, quiet: bool, progress: Progress) -> Result<Scene, Failure> {
     let final_scene = dir.join("final_scene.toml");
-    let done = final_scene.exists() && !dir.join(ballast::io::CHECKPOINT_FILE).exists();
-    if !(resume && done) {
-        let resume = resume && dir.join(ballast::io::CHECKPOINT_FILE).exists();
+    let prior = Prior::of(dir, "final_scene.toml", resume);
+    if prior != Prior::Finished {
+        let resume = prior == Prior::Checkpointed;
         // One sweep thread per run when deposits run side by side (an ensemble).
         let threads = if progress.is_some() { 1 } else { crate::default_threads() };
         let opts = RunOptions { quiet, checkpoint_every: 300.0, resume, progress, threads, ..RunOptions::default() };

@@ -22,7 +22,7 @@
 //! finished runs and resumes the checkpointed ones.
 
 use crate::saussine::{sample, LoadingArgs};
-use crate::{run, Failure, RunOptions};
+use crate::{run, Failure, Prior, RunOptions};
 use ballast::io::cycles::CycleRow;
 use ballast::io::figures::{self, Axes, Series};
 use ballast::io::series::SeriesRow;
@@ -121,10 +121,6 @@ fn label_number(x: f64) -> String {
     format!("{x:e}").replace('.', "p")
 }
 
-fn cores() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
-}
-
 /// A pool of `threads` threads for runs side by side.
 fn pool(threads: usize) -> Result<rayon::ThreadPool, Failure> {
     rayon::ThreadPoolBuilder::new()
@@ -139,7 +135,7 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
     if !(study.checkpoint_every.is_finite() && study.checkpoint_every >= 0.0) {
         return Err(input(format!("--checkpoint-every: must be non-negative, got {}", study.checkpoint_every)));
     }
-    let threads = study.jobs.unwrap_or_else(cores);
+    let threads = study.jobs.unwrap_or_else(crate::cores);
     if threads == 0 {
         return Err(input("--jobs: must be at least 1".into()));
     }
@@ -167,14 +163,15 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
         jobs.par_iter()
             .map(|job| {
                 let dir = job.dir(out);
-                let checkpoint = dir.join(io::CHECKPOINT_FILE).exists();
-                if study.resume && dir.join("summary.json").exists() && !checkpoint {
+                // summary.json: a diverged run is finished too (and reported as such).
+                let prior = Prior::of(&dir, "summary.json", study.resume);
+                if prior == Prior::Finished {
                     return Ok(());
                 }
                 let opts = RunOptions {
                     quiet: study.quiet,
                     checkpoint_every: study.checkpoint_every,
-                    resume: study.resume && checkpoint,
+                    resume: prior == Prior::Checkpointed,
                     figures: true,
                     // Several runs at once: one sweep thread each, unless one job.
                     threads: if threads == 1 { crate::default_threads() } else { 1 },
@@ -196,7 +193,7 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
             // A diverged run still wrote its series and summary: keep it in the study.
             Err(Failure::Run(e)) => {
                 eprintln!("run {} failed: {e}", job.label);
-                format!("failed: {}", e.to_string().split_whitespace().collect::<Vec<_>>().join(" "))
+                format!("failed: {}", crate::one_line(&e))
             }
         };
         let report = std::fs::read_to_string(dir.join("summary.json"))
@@ -435,7 +432,7 @@ pub fn ensemble(
     let out = &study.out;
     let seeds: Vec<u64> = (0..samples).map(|k| first_seed + k).collect();
     // 1. The samples, deposited side by side.
-    let pool = pool(study.jobs.unwrap_or_else(cores).max(1))?;
+    let pool = pool(study.jobs.unwrap_or_else(crate::cores).max(1))?;
     let group = MultiProgress::new();
     let deposited: Vec<Result<(), Failure>> = pool.install(|| {
         seeds

@@ -306,9 +306,4 @@ impl SplitWorkspace {
             }
         }
     }
-
-    /// Rows (contacts and springs) in each part: left, right, interface.
-    pub fn parts(&self) -> [usize; 3] {
-        [&self.left, &self.right, &self.iface].map(|p| p.rows.len() + p.springs.len())
-    }
 }
