@@ -22,6 +22,7 @@
 pub mod error;
 pub mod geometry;
 pub mod io;
+pub mod md;
 pub mod nscd;
 pub mod scenarios;
 pub mod scene;

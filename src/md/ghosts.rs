@@ -1,0 +1,123 @@
+//! Symmetry planes by mirror images ("ghosts"), for a quarter sample (Karrech et
+//! al. 2007 §2.3: `u_x = 0` at `x = 0`, `u_y = 0` at `y = 0`).
+//!
+//! A symmetry plane stands for the mirror half of the sample: each sphere near it
+//! has an image across it (position, velocity mirrored; spin, a pseudovector,
+//! mirrored with the opposite sign), and real spheres touch images as they touch
+//! real spheres, friction included. A sphere touching its own image feels the
+//! force of the full-sample contact with `R* = r/2`, `m* = m/2`, and no tangential
+//! slip (the images move symmetrically), so it cannot cross the plane. With two
+//! perpendicular planes, spheres near both also get the image through both (the
+//! opposite quadrant). Forces are applied to real spheres only; a pair across a
+//! plane is computed once from each side, mirror images of each other.
+
+use super::particles::{Particles, V3};
+use serde::{Deserialize, Serialize};
+
+/// A symmetry plane through `point` with unit normal `normal` (into the sample).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SymmetryPlane {
+    pub point: V3,
+    pub normal: V3,
+}
+
+impl SymmetryPlane {
+    /// Signed distance of `x` to the plane (m), positive on the sample's side.
+    #[inline]
+    pub fn distance(&self, x: &V3) -> f64 {
+        (x - self.point).dot(&self.normal)
+    }
+
+    fn mirror_point(&self, x: &V3) -> V3 {
+        x - self.normal * (2.0 * self.distance(x))
+    }
+
+    fn mirror_vector(&self, v: &V3) -> V3 {
+        v - self.normal * (2.0 * v.dot(&self.normal))
+    }
+
+    fn mirror_spin(&self, w: &V3) -> V3 {
+        -self.mirror_vector(w)
+    }
+}
+
+/// The current images: for ghost `g`, `origin[g]` is the real sphere and
+/// `mask[g]` the set of planes (bit `s` for plane `s`) it is mirrored through;
+/// `x`, `v`, `w` its mirrored state.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct Ghosts {
+    pub planes: Vec<SymmetryPlane>,
+    pub origin: Vec<u32>,
+    pub mask: Vec<u32>,
+    /// `mask << 32 | origin`, the stable key of each ghost in the neighbour list.
+    pub key: Vec<u64>,
+    pub x: Vec<V3>,
+    pub v: Vec<V3>,
+    pub w: Vec<V3>,
+}
+
+impl Ghosts {
+    /// No image yet.
+    pub fn new(planes: Vec<SymmetryPlane>) -> Self {
+        Ghosts { planes, ..Default::default() }
+    }
+
+    /// Number of images.
+    pub fn len(&self) -> usize {
+        self.origin.len()
+    }
+
+    /// True if there are no images.
+    pub fn is_empty(&self) -> bool {
+        self.origin.is_empty()
+    }
+
+    /// Chooses the images: spheres closer than `reach` (m) to a plane (to both
+    /// planes for the double image).
+    pub fn select(&mut self, x: &[V3], reach: f64) {
+        self.origin.clear();
+        self.mask.clear();
+        self.key.clear();
+        let np = self.planes.len();
+        if np == 0 {
+            return;
+        }
+        for (i, p) in x.iter().enumerate() {
+            let mut near = 0u32;
+            for (s, plane) in self.planes.iter().enumerate() {
+                if plane.distance(p) < reach {
+                    near |= 1 << s;
+                }
+            }
+            for mask in 1u32..(1 << np) {
+                if mask & near == mask {
+                    self.origin.push(i as u32);
+                    self.mask.push(mask);
+                    self.key.push((mask as u64) << 32 | i as u64);
+                }
+            }
+        }
+    }
+
+    /// Mirrors the current state of the originals into the images.
+    pub fn update(&mut self, p: &Particles) {
+        let n = self.len();
+        self.x.resize(n, V3::zeros());
+        self.v.resize(n, V3::zeros());
+        self.w.resize(n, V3::zeros());
+        for g in 0..n {
+            let i = self.origin[g] as usize;
+            let (mut x, mut v, mut w) = (p.x[i], p.v[i], p.w[i]);
+            for (s, plane) in self.planes.iter().enumerate() {
+                if self.mask[g] & (1 << s) != 0 {
+                    x = plane.mirror_point(&x);
+                    v = plane.mirror_vector(&v);
+                    w = plane.mirror_spin(&w);
+                }
+            }
+            self.x[g] = x;
+            self.v[g] = v;
+            self.w[g] = w;
+        }
+    }
+}
