@@ -14,7 +14,7 @@
 //! For `linear` it holds the tangential spring `ξ` (m) and the stick/slip state.
 //! In both, the memory is projected into the current tangent plane each step.
 
-use super::law::{Model, PairLaw};
+use super::law::{Damping, Model, PairLaw};
 use super::particles::V3;
 use serde::{Deserialize, Serialize};
 
@@ -49,6 +49,8 @@ pub struct Kinematics {
     pub r_star: f64,
     /// Reduced mass `m*` (kg).
     pub m_star: f64,
+    /// Compute the elastic energy (skipped on steps that are not measured).
+    pub measure: bool,
 }
 
 /// Normal and tangential force on the first body (N), and the scalar normal force.
@@ -79,8 +81,16 @@ fn hertz(law: &PairLaw, k: &Kinematics, h: &mut History, dt: f64) -> ContactForc
     let sq = (k.r_star * k.delta).sqrt();
     let kn = 2.0 * law.e_star * sq;
     let fn_el = (2.0 / 3.0) * kn * k.delta;
-    let fn_ = (fn_el - law.damping_n.gamma(k.m_star, kn) * vn).max(0.0);
     let kt = 8.0 * law.g_star * sq;
+    // γ = 2α√(m* k): one square root for both directions when both are ratios.
+    let (gn, gt) = match (law.damping_n, law.damping_t) {
+        (Damping::Ratio(an), Damping::Ratio(at)) => {
+            let s = (k.m_star * kn).sqrt();
+            (2.0 * an * s, 2.0 * at * s * law.kt_kn_sqrt)
+        }
+        (dn, dt_) => (dn.gamma(k.m_star, kn), dt_.gamma(k.m_star, kt)),
+    };
+    let fn_ = (fn_el - gn * vn).max(0.0);
     // Memory into the current tangent plane.
     let mut ft = h.t - n * n.dot(&h.t);
     if h.delta > 0.0 && k.delta < h.delta {
@@ -95,8 +105,8 @@ fn hertz(law: &PairLaw, k: &Kinematics, h: &mut History, dt: f64) -> ContactForc
     }
     h.t = ft;
     h.delta = k.delta;
-    let tangential = ft - vt * law.damping_t.gamma(k.m_star, kt);
-    let energy = 0.4 * fn_el * k.delta + if kt > 0.0 { 0.5 * ft.norm_squared() / kt } else { 0.0 };
+    let tangential = ft - vt * gt;
+    let energy = if k.measure && kt > 0.0 { 0.4 * fn_el * k.delta + 0.5 * ft.norm_squared() / kt } else { 0.0 };
     ContactForce { force: n * fn_ + tangential, tangential, normal: fn_, energy }
 }
 
@@ -132,6 +142,6 @@ fn linear(law: &PairLaw, k: &Kinematics, h: &mut History, dt: f64) -> ContactFor
     };
     h.sliding = sliding as u32;
     h.delta = k.delta;
-    let energy = 0.5 * law.kn * k.delta * k.delta + 0.5 * law.kt * h.t.norm_squared();
+    let energy = if k.measure { 0.5 * law.kn * k.delta * k.delta + 0.5 * law.kt * h.t.norm_squared() } else { 0.0 };
     ContactForce { force: n * fn_ + tangential, tangential, normal: fn_, energy }
 }

@@ -95,6 +95,8 @@ pub struct PairLaw {
     pub mu_s: f64,
     /// Dynamic friction coefficient `μ_d ≤ μ_s` (`linear`; `hertz` uses `μ_s`).
     pub mu_d: f64,
+    /// `hertz`: `√(k_t / k_n) = √(4 G* / E*)`, so one square root gives both dashpots.
+    pub kt_kn_sqrt: f64,
 }
 
 impl PairLaw {
@@ -111,12 +113,24 @@ impl PairLaw {
             damping_t: Damping::Ratio(alpha_t),
             mu_s: mu,
             mu_d: mu,
+            kt_kn_sqrt: (4.0 * g_star(a, b) / e_star(a, b)).sqrt(),
         }
     }
 
     /// A linear spring–dashpot law.
     pub fn linear(kn: f64, kt: f64, damping_n: Damping, damping_t: Damping, mu_s: f64, mu_d: f64) -> Self {
-        PairLaw { model: Model::Linear, e_star: 0.0, g_star: 0.0, kn, kt, damping_n, damping_t, mu_s, mu_d }
+        PairLaw {
+            model: Model::Linear,
+            e_star: 0.0,
+            g_star: 0.0,
+            kn,
+            kt,
+            damping_n,
+            damping_t,
+            mu_s,
+            mu_d,
+            kt_kn_sqrt: (kt / kn).sqrt(),
+        }
     }
 }
 

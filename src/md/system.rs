@@ -84,6 +84,19 @@ struct Backup {
     step: u64,
 }
 
+fn one() -> u64 {
+    1
+}
+
+/// Spheres per chunk below which the per-sphere loops stay serial.
+const PAR_MIN: usize = 512;
+
+/// The work of a step is cut into this many chunks (pairs balanced by count,
+/// spheres by index), run side by side when two threads are allowed and serially
+/// otherwise: the floating-point sums are the same, so a run gives the same
+/// numbers on one thread or two.
+pub const CHUNKS: usize = 2;
+
 /// Steps between two copies of the last good state.
 const BACKUP_EVERY: u64 = 100;
 
@@ -108,6 +121,11 @@ pub struct MdSystem {
     pub virial: Matrix3<f64>,
     /// Statistics of the last step.
     pub last: MdStepStats,
+    /// Energies, virial and overlap statistics are computed on steps that are
+    /// multiples of this (default 1: every step); other steps carry the last
+    /// measured values in their [`MdStepStats`]. Kinetic energy is always exact.
+    #[serde(default = "one")]
+    pub measure_every: u64,
     #[serde(skip)]
     threads: usize,
     #[serde(skip)]
@@ -133,6 +151,7 @@ impl MdSystem {
             gear_w: Vec::new(),
             virial: Matrix3::zeros(),
             last: MdStepStats::default(),
+            measure_every: 1,
             threads: 1,
             work: Vec::new(),
             backup: Backup::default(),
@@ -142,7 +161,7 @@ impl MdSystem {
             w.hist = vec![History::default(); n];
         }
         sys.rebuild();
-        let stats = sys.evaluate(0.0).unwrap_or_default();
+        let stats = sys.evaluate(0.0, true).unwrap_or_default();
         sys.last = MdStepStats { time: 0.0, kinetic_energy: sys.particles.kinetic_energy(), ..stats };
         if let Integrator::Gear(set) = settings.integrator {
             let q = set.order();
@@ -196,77 +215,74 @@ impl MdSystem {
         }
         let dt = self.settings.dt;
         let g = self.settings.gravity;
-        match self.settings.integrator {
-            Integrator::Verlet => {
-                let p = &mut self.particles;
-                for i in 0..p.len() {
-                    p.v[i] += (p.f[i] * p.inv_m[i] + g) * (0.5 * dt);
-                    p.w[i] += p.t[i] * (p.inv_i[i] * 0.5 * dt);
-                    p.x[i] += p.v[i] * dt;
-                }
-            }
-            Integrator::Gear(set) => {
-                let q = set.order();
-                let p = &mut self.particles;
-                for i in 0..p.len() {
-                    predict(&mut self.gear_x[i], 0, q);
-                    predict(&mut self.gear_w[i], 1, q);
-                    p.x[i] = self.gear_x[i][0];
-                    p.v[i] = self.gear_x[i][1] / dt;
-                    p.w[i] = self.gear_w[i][1] / dt;
-                }
-            }
+        let threads = self.threads;
+        let integrator = self.settings.integrator;
+        {
+            let p = &mut self.particles;
+            let mut view = View {
+                x: &mut p.x,
+                v: &mut p.v,
+                w: &mut p.w,
+                f: &p.f,
+                t: &p.t,
+                inv_m: &p.inv_m,
+                inv_i: &p.inv_i,
+                q: &mut p.q,
+                gx: &mut self.gear_x,
+                gw: &mut self.gear_w,
+            };
+            par_for(&mut view, threads, &|c: View| first_half(c, integrator, g, dt));
         }
         if self.needs_rebuild() {
             self.rebuild();
         }
-        let stats = match self.evaluate(dt) {
+        let measure = (self.step + 1) % self.measure_every.max(1) == 0;
+        let stats = match self.evaluate(dt, measure) {
             Ok(s) => s,
             Err(e) => {
                 self.restore_backup();
                 return Err(e);
             }
         };
-        let p = &mut self.particles;
-        match self.settings.integrator {
-            Integrator::Verlet => {
-                for i in 0..p.len() {
-                    p.v[i] += (p.f[i] * p.inv_m[i] + g) * (0.5 * dt);
-                    p.w[i] += p.t[i] * (p.inv_i[i] * 0.5 * dt);
-                    rotate(&mut p.q[i], &p.w[i], dt);
-                }
-            }
-            Integrator::Gear(set) => {
-                let c = set.coefficients();
-                let q = c.len();
-                let h2 = 0.5 * dt * dt;
-                for i in 0..p.len() {
-                    let dx = (p.f[i] * p.inv_m[i] + g) * h2 - self.gear_x[i][2];
-                    let dw = p.t[i] * (p.inv_i[i] * h2) - self.gear_w[i][2];
-                    for k in 0..q {
-                        self.gear_x[i][k] += dx * c[k];
-                    }
-                    for k in 1..q {
-                        self.gear_w[i][k] += dw * c[k];
-                    }
-                    p.x[i] = self.gear_x[i][0];
-                    p.v[i] = self.gear_x[i][1] / dt;
-                    p.w[i] = self.gear_w[i][1] / dt;
-                    rotate(&mut p.q[i], &p.w[i], dt);
-                }
-            }
-        }
+        let kinetic = {
+            let p = &mut self.particles;
+            let mut view = View {
+                x: &mut p.x,
+                v: &mut p.v,
+                w: &mut p.w,
+                f: &p.f,
+                t: &p.t,
+                inv_m: &p.inv_m,
+                inv_i: &p.inv_i,
+                q: &mut p.q,
+                gx: &mut self.gear_x,
+                gw: &mut self.gear_w,
+            };
+            par_for(&mut view, threads, &|c: View| second_half(c, integrator, g, dt))
+        };
         walls::advance(&mut self.walls, self.time + dt, dt);
         self.time += dt;
         self.step += 1;
-        if let Some(i) =
-            (0..p.len()).find(|&i| !(p.x[i].iter().all(|c| c.is_finite()) && p.v[i].iter().all(|c| c.is_finite())))
-        {
+        if !kinetic.is_finite() {
+            let p = &self.particles;
+            let i = (0..p.len())
+                .find(|&i| !(p.x[i].iter().all(|c| c.is_finite()) && p.v[i].iter().all(|c| c.is_finite())))
+                .unwrap_or(0);
             let e = self.diverged(i, "position or velocity is not finite".into());
             self.restore_backup();
             return Err(e);
         }
-        let stats = MdStepStats { time: self.time, kinetic_energy: self.particles.kinetic_energy(), ..stats };
+        let stats = if measure {
+            stats
+        } else {
+            MdStepStats {
+                contacts: stats.contacts,
+                wall_contacts: stats.wall_contacts,
+                coordination: stats.coordination,
+                ..self.last
+            }
+        };
+        let stats = MdStepStats { time: self.time, kinetic_energy: kinetic, ..stats };
         self.last = stats;
         if self.step % BACKUP_EVERY == 0 {
             self.save_backup();
@@ -346,11 +362,11 @@ impl MdSystem {
 
     /// Evaluates all forces at the current state, advancing the contact memory
     /// by `dt` (s).
-    fn evaluate(&mut self, dt: f64) -> Result<MdStepStats> {
+    fn evaluate(&mut self, dt: f64, measure: bool) -> Result<MdStepStats> {
         self.ghosts.update(&self.particles);
         let n = self.particles.len();
         let threads = self.threads.max(1);
-        self.work.resize_with(threads, Workspace::default);
+        self.work.resize_with(CHUNKS, Workspace::default);
         for w in &mut self.work {
             w.f.clear();
             w.f.resize(n, V3::zeros());
@@ -373,9 +389,10 @@ impl MdSystem {
             start: &self.neighbours.start,
             j: &self.neighbours.j,
             dt,
+            measure,
         };
-        let mut bounds = [0usize; 65];
-        let chunks = threads.min(64);
+        let mut bounds = [0usize; CHUNKS + 1];
+        let chunks = CHUNKS;
         let mut row = 0;
         for c in 1..chunks {
             let target = total * c / chunks;
@@ -385,7 +402,7 @@ impl MdSystem {
             bounds[c] = row;
         }
         bounds[chunks] = n;
-        run_chunks(&ctx, &bounds[..=chunks], &mut self.neighbours.hist, 0, &mut self.work[..chunks]);
+        run_chunks(&ctx, &bounds[..=chunks], &mut self.neighbours.hist, 0, &mut self.work[..chunks], threads > 1);
         // Sum the per-thread buffers into the first one.
         let (first, rest) = self.work.split_at_mut(1);
         let w0 = &mut first[0];
@@ -425,7 +442,7 @@ impl MdSystem {
                 let delta = -gap;
                 let a = p.r[i] - delta;
                 let v_rel = p.v[i] + nrm.cross(&p.w[i]) * a - vw;
-                let k = Kinematics { n: nrm, delta, v_rel, r_star, m_star: p.m[i] };
+                let k = Kinematics { n: nrm, delta, v_rel, r_star, m_star: p.m[i], measure: true };
                 let cf = contact::force(law, &k, h, dt);
                 p.f[i] += cf.force;
                 p.t[i] += nrm.cross(&cf.tangential) * (-a);
@@ -485,11 +502,19 @@ struct PairContext<'a> {
     start: &'a [u32],
     j: &'a [u32],
     dt: f64,
+    measure: bool,
 }
 
 /// Runs the chunks `bounds[k]..bounds[k+1]` (rows) side by side, each on its own
 /// workspace and its own slice of the contact memory (which starts at entry `offset`).
-fn run_chunks(ctx: &PairContext, bounds: &[usize], hist: &mut [History], offset: usize, work: &mut [Workspace]) {
+fn run_chunks(
+    ctx: &PairContext,
+    bounds: &[usize],
+    hist: &mut [History],
+    offset: usize,
+    work: &mut [Workspace],
+    parallel: bool,
+) {
     let chunks = bounds.len() - 1;
     if chunks == 1 {
         pair_rows(ctx, bounds[0], bounds[1], hist, offset, &mut work[0]);
@@ -499,10 +524,14 @@ fn run_chunks(ctx: &PairContext, bounds: &[usize], hist: &mut [History], offset:
     let split = ctx.start[bounds[mid]] as usize - offset;
     let (h0, h1) = hist.split_at_mut(split);
     let (w0, w1) = work.split_at_mut(mid);
-    rayon::join(
-        || run_chunks(ctx, &bounds[..=mid], h0, offset, w0),
-        || run_chunks(ctx, &bounds[mid..], h1, offset + split, w1),
-    );
+    let mut a = || run_chunks(ctx, &bounds[..=mid], h0, offset, w0, parallel);
+    let mut b = || run_chunks(ctx, &bounds[mid..], h1, offset + split, w1, parallel);
+    if parallel && ctx.start.len() > PAR_MIN {
+        rayon::join(a, b);
+    } else {
+        a();
+        b();
+    }
 }
 
 /// Forces of the pairs of rows `lo..hi` into `w`.
@@ -544,21 +573,32 @@ fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offs
             let aj = rj - 0.5 * delta;
             let v_rel = vi - vj + nrm.cross(&wi) * ai + nrm.cross(&wj) * aj;
             let mj = p.m[o];
-            let k = Kinematics { n: nrm, delta, v_rel, r_star: ri * rj / rs, m_star: mi * mj / (mi + mj) };
+            let k = Kinematics {
+                n: nrm,
+                delta,
+                v_rel,
+                r_star: ri * rj / rs,
+                m_star: mi * mj / (mi + mj),
+                measure: ctx.measure,
+            };
             let cf = contact::force(law, &k, h, dt);
             fi += cf.force;
             ti -= nrm.cross(&cf.tangential) * ai;
-            // Branch vector from j's centre to i's centre.
             let weight = if ghost { 0.5 } else { 1.0 };
-            w.virial += (cf.force * weight) * d.transpose();
             w.contacts += weight;
-            w.energy += cf.energy * weight;
-            w.sum_overlap += delta;
-            w.overlaps += 1;
-            w.max_overlap = w.max_overlap.max(delta);
-            let rel = delta / ri.min(rj);
-            if rel > w.worst.0 {
-                w.worst = (rel, i);
+            if ctx.measure {
+                // Branch vector from j's centre to i's centre.
+                w.virial += (cf.force * weight) * d.transpose();
+                w.energy += cf.energy * weight;
+                w.sum_overlap += delta;
+                w.overlaps += 1;
+                w.max_overlap = w.max_overlap.max(delta);
+            }
+            if delta > 0.5 * ri.min(rj) {
+                let rel = delta / ri.min(rj);
+                if rel > w.worst.0 {
+                    w.worst = (rel, i);
+                }
             }
             if !ghost {
                 w.f[j] -= cf.force;
@@ -567,5 +607,138 @@ fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offs
         }
         w.f[i] += fi;
         w.t[i] += ti;
+    }
+}
+
+/// The per-sphere arrays the integrator touches, split into chunks for threads.
+struct View<'a> {
+    x: &'a mut [V3],
+    v: &'a mut [V3],
+    w: &'a mut [V3],
+    f: &'a [V3],
+    t: &'a [V3],
+    inv_m: &'a [f64],
+    inv_i: &'a [f64],
+    q: &'a mut [UnitQuaternion<f64>],
+    /// Gear derivatives (empty with Verlet).
+    gx: &'a mut [[V3; 6]],
+    gw: &'a mut [[V3; 6]],
+}
+
+impl<'a> View<'a> {
+    fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    fn split(self, at: usize) -> (View<'a>, View<'a>) {
+        let (x0, x1) = self.x.split_at_mut(at);
+        let (v0, v1) = self.v.split_at_mut(at);
+        let (w0, w1) = self.w.split_at_mut(at);
+        let (f0, f1) = self.f.split_at(at);
+        let (t0, t1) = self.t.split_at(at);
+        let (m0, m1) = self.inv_m.split_at(at);
+        let (i0, i1) = self.inv_i.split_at(at);
+        let (q0, q1) = self.q.split_at_mut(at);
+        let g = at.min(self.gx.len());
+        let (gx0, gx1) = self.gx.split_at_mut(g);
+        let (gw0, gw1) = self.gw.split_at_mut(g);
+        (
+            View { x: x0, v: v0, w: w0, f: f0, t: t0, inv_m: m0, inv_i: i0, q: q0, gx: gx0, gw: gw0 },
+            View { x: x1, v: v1, w: w1, f: f1, t: t1, inv_m: m1, inv_i: i1, q: q1, gx: gx1, gw: gw1 },
+        )
+    }
+
+    fn reborrow(&mut self) -> View<'_> {
+        View {
+            x: self.x,
+            v: self.v,
+            w: self.w,
+            f: self.f,
+            t: self.t,
+            inv_m: self.inv_m,
+            inv_i: self.inv_i,
+            q: self.q,
+            gx: self.gx,
+            gw: self.gw,
+        }
+    }
+}
+
+/// Runs `body` on `threads` chunks of `view` side by side (serially for small
+/// systems) and sums what the chunks return.
+fn par_for(view: &mut View, threads: usize, body: &(dyn Fn(View) -> f64 + Sync)) -> f64 {
+    // Always the same CHUNKS chunks, whatever the threads: the same sums.
+    let at = view.len() / CHUNKS;
+    let (a, b) = view.reborrow().split(at);
+    let (x, y) = if threads > 1 && at >= PAR_MIN { rayon::join(|| body(a), || body(b)) } else { (body(a), body(b)) };
+    x + y
+}
+
+/// Before the force evaluation: half kick and drift (Verlet) or predictor (Gear).
+fn first_half(c: View, integrator: Integrator, g: V3, dt: f64) -> f64 {
+    match integrator {
+        Integrator::Verlet => {
+            for i in 0..c.x.len() {
+                c.v[i] += (c.f[i] * c.inv_m[i] + g) * (0.5 * dt);
+                c.w[i] += c.t[i] * (c.inv_i[i] * 0.5 * dt);
+                c.x[i] += c.v[i] * dt;
+            }
+        }
+        Integrator::Gear(set) => {
+            let q = set.order();
+            for i in 0..c.x.len() {
+                predict(&mut c.gx[i], 0, q);
+                predict(&mut c.gw[i], 1, q);
+                c.x[i] = c.gx[i][0];
+                c.v[i] = c.gx[i][1] / dt;
+                c.w[i] = c.gw[i][1] / dt;
+            }
+        }
+    }
+    0.0
+}
+
+/// After the force evaluation: second half kick (Verlet) or corrector (Gear),
+/// orientations; returns the kinetic energy of the chunk (J), non-finite if a
+/// position or velocity is.
+fn second_half(c: View, integrator: Integrator, g: V3, dt: f64) -> f64 {
+    let mut kinetic = 0.0;
+    let mut finite = true;
+    match integrator {
+        Integrator::Verlet => {
+            for i in 0..c.x.len() {
+                c.v[i] += (c.f[i] * c.inv_m[i] + g) * (0.5 * dt);
+                c.w[i] += c.t[i] * (c.inv_i[i] * 0.5 * dt);
+                rotate(&mut c.q[i], &c.w[i], dt);
+                kinetic += 0.5 * (c.v[i].norm_squared() / c.inv_m[i] + c.w[i].norm_squared() / c.inv_i[i]);
+                finite &= c.x[i].iter().all(|a| a.is_finite());
+            }
+        }
+        Integrator::Gear(set) => {
+            let coef = set.coefficients();
+            let q = coef.len();
+            let h2 = 0.5 * dt * dt;
+            for i in 0..c.x.len() {
+                let dx = (c.f[i] * c.inv_m[i] + g) * h2 - c.gx[i][2];
+                let dw = c.t[i] * (c.inv_i[i] * h2) - c.gw[i][2];
+                for k in 0..q {
+                    c.gx[i][k] += dx * coef[k];
+                }
+                for k in 1..q {
+                    c.gw[i][k] += dw * coef[k];
+                }
+                c.x[i] = c.gx[i][0];
+                c.v[i] = c.gx[i][1] / dt;
+                c.w[i] = c.gw[i][1] / dt;
+                rotate(&mut c.q[i], &c.w[i], dt);
+                kinetic += 0.5 * (c.v[i].norm_squared() / c.inv_m[i] + c.w[i].norm_squared() / c.inv_i[i]);
+                finite &= c.x[i].iter().all(|a| a.is_finite());
+            }
+        }
+    }
+    if finite {
+        kinetic
+    } else {
+        f64::NAN
     }
 }

@@ -4,6 +4,7 @@
 //! free bank, and loaded sleeper ([`saussine`]).
 
 pub mod deposit;
+pub mod md_bed;
 pub mod saussine;
 
 pub use deposit::{pentagon_deposit, DepositSpec};
