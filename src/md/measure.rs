@@ -107,3 +107,47 @@ pub fn deviatoric(sxx: f64, syy: f64, l: V3, l0: V3) -> (f64, f64) {
     let eyy = 1.0 - l[1] / l0[1];
     (2.0 * (sxx - syy) / 3.0, exx - eyy)
 }
+
+impl MdSystem {
+    /// Horizontal cross-section of the container (m²), if the walls make one: a
+    /// cylinder along gravity (`π R²`, halved by each symmetry plane containing its
+    /// axis), or a box of axis-aligned planes (`L_x L_y` for gravity along `z`).
+    pub fn container_section(&self) -> Option<f64> {
+        let g = self.settings.gravity;
+        let up = if g.norm() > 0.0 { -g.normalize() } else { V3::z() };
+        for w in &self.walls {
+            if let super::walls::Shape::Cylinder { axis_point, axis, radius } = w.shape {
+                if axis.cross(&up).norm() < 1e-9 {
+                    let halvings = self
+                        .ghosts
+                        .planes
+                        .iter()
+                        .filter(|p| p.normal.dot(&axis).abs() < 1e-9 && (axis_point - p.point).dot(&p.normal).abs() < 1e-12)
+                        .count();
+                    return Some(std::f64::consts::PI * radius * radius / f64::from(1u32 << halvings));
+                }
+            }
+        }
+        let axis = up.iamax();
+        let area = box_area(&self.walls, axis);
+        (area > 0.0).then_some(area)
+    }
+
+    /// Packing fraction of the sample in its container (the "relative density" of
+    /// Karrech et al. Fig. 3c): sphere volume over `section × height`, the height
+    /// from the lowest sphere bottom to the highest sphere top along gravity (so a
+    /// rough free surface lowers it, as the paper's footnote 2 says). `None`
+    /// without a recognised container.
+    pub fn packing_fraction_bulk(&self) -> Option<f64> {
+        let section = self.container_section()?;
+        let g = self.settings.gravity;
+        let up = if g.norm() > 0.0 { -g.normalize() } else { V3::z() };
+        let p = &self.particles;
+        if p.is_empty() {
+            return None;
+        }
+        let lo = (0..p.len()).map(|i| p.x[i].dot(&up) - p.r[i]).fold(f64::INFINITY, f64::min);
+        let hi = (0..p.len()).map(|i| p.x[i].dot(&up) + p.r[i]).fold(f64::NEG_INFINITY, f64::max);
+        Some(p.volume() / (section * (hi - lo)))
+    }
+}

@@ -4,7 +4,10 @@
 //! free bank, and loaded sleeper ([`saussine`]).
 
 pub mod deposit;
+pub mod karrech;
+pub mod luding;
 pub mod md_bed;
+pub mod md_text;
 pub mod saussine;
 
 pub use deposit::{pentagon_deposit, DepositSpec};
