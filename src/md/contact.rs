@@ -105,7 +105,15 @@ fn hertz(law: &PairLaw, k: &Kinematics, h: &mut History, dt: f64) -> ContactForc
     }
     h.t = ft;
     h.delta = k.delta;
-    let tangential = ft - vt * gt;
+    // Coulomb bounds the whole tangential force, dashpot included (as in David et
+    // al. eqs. 3–4): Karrech's eq. 7 read literally adds `−γ_t v_t` beyond `μ F_n`
+    // while sliding, and a sliding contact would then resist as a viscous one
+    // (no sliding at `g(sin α − μ cos α)` down an incline).
+    let mut tangential = ft - vt * gt;
+    let t2 = tangential.norm_squared();
+    if t2 > limit * limit {
+        tangential *= limit / t2.sqrt();
+    }
     let energy = if k.measure && kt > 0.0 { 0.4 * fn_el * k.delta + 0.5 * ft.norm_squared() / kt } else { 0.0 };
     ContactForce { force: n * fn_ + tangential, tangential, normal: fn_, energy }
 }

@@ -3,7 +3,8 @@
 //! - [`Model::Hertz`]: Karrech et al. (2007) §2.2. Normal force
 //!   `F_n = 4/3 E* √R* δ^{3/2}` (eq. 5), Mindlin tangential stiffness
 //!   `k_t = 8 G* √(R* δ)` (eq. 6), viscous damping `γ = 2 α √(m* k)` with `k` the
-//!   tangent stiffness (`k_n = 2 E* √(R* δ)`, `k_t`) (eq. 7), Coulomb limit. For two
+//!   tangent stiffness (`k_n = 2 E* √(R* δ)`, `k_t`) (eq. 7), Coulomb limit on the
+//!   elastic part and on the whole tangential force (dashpot included). For two
 //!   materials `1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂` and
 //!   `1/G* = (2 − ν₁)/G₁ + (2 − ν₂)/G₂` with `G = E / (2(1 + ν))`; for one material
 //!   these are the paper's `E* = E / (2(1 − ν²))` and `G* = G / (2(2 − ν))`.

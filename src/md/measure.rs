@@ -8,9 +8,9 @@ use super::walls::{box_area, box_extent};
 use nalgebra::Matrix3;
 
 impl MdSystem {
-    /// Gravitational potential energy (J) of the spheres above the lowest point
-    /// of any sphere along gravity (`Σ m |g| h`, `h` the height of the centre
-    /// above that point): zero on a flat layer, independent of where the origin is.
+    /// Gravitational potential energy (J) `Σ m |g| h`, `h` the height of the centre
+    /// above [`MdSystem::gravity_reference`] along gravity (fixed for the run, so
+    /// kinetic + potential energy is conserved without dissipation).
     pub fn gravitational_energy(&self) -> f64 {
         let g = self.settings.gravity;
         let gn = g.norm();
@@ -19,8 +19,7 @@ impl MdSystem {
         }
         let up = -g / gn;
         let p = &self.particles;
-        let base = (0..p.len()).map(|i| p.x[i].dot(&up) - p.r[i]).fold(f64::INFINITY, f64::min);
-        (0..p.len()).map(|i| p.m[i] * gn * (p.x[i].dot(&up) - base)).sum()
+        (0..p.len()).map(|i| p.m[i] * gn * (p.x[i].dot(&up) - self.gravity_reference)).sum()
     }
 
     /// Potential energy `E_p` (J): gravitational plus elastic (of the last evaluation).

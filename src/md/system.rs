@@ -121,6 +121,11 @@ pub struct MdSystem {
     pub virial: Matrix3<f64>,
     /// Statistics of the last step.
     pub last: MdStepStats,
+    /// Zero of the gravitational energy, as a height along `−g` (m): the highest
+    /// upward-facing plane wall below every sphere if there is one (a base), else
+    /// the lowest sphere bottom of the initial state.
+    #[serde(default)]
+    pub gravity_reference: f64,
     /// Energies, virial and overlap statistics are computed on steps that are
     /// multiples of this (default 1: every step); other steps carry the last
     /// measured values in their [`MdStepStats`]. Kinetic energy is always exact.
@@ -152,6 +157,7 @@ impl MdSystem {
             virial: Matrix3::zeros(),
             last: MdStepStats::default(),
             measure_every: 1,
+            gravity_reference: 0.0,
             threads: 1,
             work: Vec::new(),
             backup: Backup::default(),
@@ -160,6 +166,7 @@ impl MdSystem {
         for w in &mut sys.walls {
             w.hist = vec![History::default(); n];
         }
+        sys.gravity_reference = sys.initial_reference();
         sys.rebuild();
         let stats = sys.evaluate(0.0, true).unwrap_or_default();
         sys.last = MdStepStats { time: 0.0, kinetic_energy: sys.particles.kinetic_energy(), ..stats };
@@ -190,6 +197,27 @@ impl MdSystem {
         }
         sys.save_backup();
         sys
+    }
+
+    fn initial_reference(&self) -> f64 {
+        let g = self.settings.gravity;
+        let up = if g.norm() > 0.0 { -g.normalize() } else { V3::z() };
+        let p = &self.particles;
+        let lowest = (0..p.len()).map(|i| p.x[i].dot(&up) - p.r[i]).fold(f64::INFINITY, f64::min);
+        let base = self
+            .walls
+            .iter()
+            .filter_map(|w| Some((w.normal()?, w.point()?)))
+            .filter(|(n, p)| (n - up).norm() < 1e-9 && p.dot(&up) <= lowest)
+            .map(|(_, p)| p.dot(&up))
+            .fold(f64::NEG_INFINITY, f64::max);
+        if base.is_finite() {
+            base
+        } else if lowest.is_finite() {
+            lowest
+        } else {
+            0.0
+        }
     }
 
     /// Number of force-evaluation threads (chunks of the pair list). The numbers
