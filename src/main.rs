@@ -4,7 +4,9 @@
 //! [--stop-after N]` loads and validates the scene, builds the system, makes
 //! `round(duration / dt)` steps and writes `series.csv`, `final.json`,
 //! `summary.json`, `scene.toml`, `final_scene.toml` and `run.json` in `DIR` (see
-//! [`ballast::io`]); `--figures` draws the run's figures at the end.
+//! [`ballast::io`]); `--figures` draws the run's figures at the end (NSCD). The
+//! scene's `[simulation] engine` picks the engine: `nscd` here, `md` in
+//! `cli/md_run.rs`.
 //! Every `S` seconds of wall time (default 300) it writes `checkpoint.json`;
 //! `--resume` continues from it with the same numbers as an uninterrupted run;
 //! `--stop-after N` stops after N steps with a checkpoint; `--vtk-every N` writes
@@ -25,6 +27,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+#[path = "cli/md_run.rs"]
+mod md_run;
 #[path = "cli/saussine.rs"]
 mod saussine;
 #[path = "cli/studies.rs"]
@@ -61,8 +65,10 @@ enum Command {
         /// Write VTK snapshots (`DIR/vtk/*.vtp`, listed in `DIR/run.pvd`) every N steps; 0: none.
         #[arg(long, value_name = "N", default_value_t = 0)]
         vtk_every: u64,
-        /// Threads of the NLGS sweeps: large problems are swept as two halves side by
-        /// side (the numbers do not depend on it). Default: 2 if the machine has 2 cores.
+        /// Threads of the NLGS sweeps (NSCD: large problems are swept as two halves
+        /// side by side) or of the force evaluation (MD: two chunks side by side; the
+        /// scene's `md.threads` wins). The numbers do not depend on it. Default: 2 if
+        /// the machine has 2 cores.
         #[arg(long)]
         threads: Option<usize>,
         /// At the end, draw the run's figures (PNG + SVG): settlement and interpenetration
@@ -135,8 +141,8 @@ pub(crate) fn cores() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
-/// Threads of the NLGS sweeps of a single run: 2 when the machine has 2 cores
-/// (the split solver uses at most 2).
+/// Threads of a single run: 2 when the machine has 2 cores (the split NLGS solver
+/// and the MD force evaluation use at most 2).
 pub(crate) fn default_threads() -> usize {
     cores().min(2)
 }
@@ -199,6 +205,18 @@ fn progress_bar(steps: u64, quiet: bool) -> ProgressBar {
     pb
 }
 
+/// `--checkpoint-every` must be a number of seconds ≥ 0.
+pub(crate) fn check_checkpoint_every(opts: &RunOptions) -> Result<(), Failure> {
+    if opts.checkpoint_every.is_finite() && opts.checkpoint_every >= 0.0 {
+        Ok(())
+    } else {
+        Err(Failure::Input(Error::Scene(format!(
+            "--checkpoint-every: must be a non-negative number of seconds, got {}",
+            opts.checkpoint_every
+        ))))
+    }
+}
+
 /// Options of `ballast run` besides the scene and the output directory.
 #[derive(Default)]
 pub(crate) struct RunOptions {
@@ -209,31 +227,32 @@ pub(crate) struct RunOptions {
     pub vtk_every: u64,
     /// Draw the run's figures at the end (`io::run_figures`).
     pub figures: bool,
-    /// Threads of the NLGS sweeps (the numbers do not depend on it).
+    /// Threads of the NLGS sweeps (NSCD) or of the force evaluation (MD, unless
+    /// the scene gives `md.threads`); the numbers do not depend on it.
     pub threads: usize,
     /// Show the progress bar in this group (runs of a study side by side), with a label.
     pub progress: Option<(indicatif::MultiProgress, String)>,
 }
 
-/// `ballast run`.
+/// `ballast run`: the engine of the scene (`[simulation] engine`) runs it.
 pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> {
     let scene_text = Scene::read_text(scene_path).map_err(Failure::Input)?;
-    let scene = Scene::from_toml_str_named(&scene_text, &scene_path.display().to_string()).map_err(Failure::Input)?;
+    let name = scene_path.display().to_string();
+    let engine = ballast::scene::engine_of_named(&scene_text, &name).map_err(Failure::Input)?;
+    if engine == "md" {
+        return md_run::run(scene_path, &scene_text, out, opts);
+    }
+    let scene = Scene::from_toml_str_named(&scene_text, &name).map_err(Failure::Input)?;
     let steps = scene.steps();
     let every = scene.output_every();
-    if !(opts.checkpoint_every.is_finite() && opts.checkpoint_every >= 0.0) {
-        return Err(Failure::Input(Error::Scene(format!(
-            "--checkpoint-every: must be a non-negative number of seconds, got {}",
-            opts.checkpoint_every
-        ))));
-    }
+    check_checkpoint_every(opts)?;
 
     // A fresh run, or the continuation of a checkpointed one.
     let vtk_dir = out.join("vtk");
     let cycles_path = out.join("cycles.csv");
     let pvd_path = out.join("run.pvd");
     let (mut sys, mut series, mut summary, mut snapshots, mut cycles) = if opts.resume {
-        let cp = Checkpoint::load(out, &scene_text).map_err(Failure::Input)?;
+        let cp = Checkpoint::<ballast::nscd::System>::load(out, &scene_text).map_err(Failure::Input)?;
         let series =
             SeriesWriter::resume(&out.join("series.csv"), cp.series_bytes, cp.series_rows).map_err(Failure::Run)?;
         io::remove_stale(out, "final_scene.toml").map_err(Failure::Run)?;

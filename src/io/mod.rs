@@ -16,12 +16,19 @@
 //! - figures as `<stem>.png` + `<stem>.svg`: curves, force chains, displacement
 //!   fields ([`figures`]).
 //!
+//! An MD run writes the same files but for its own `series.csv` columns
+//! ([`md_series`]), `final.json` with 3D spheres and walls ([`md_state`]),
+//! `summary.json` with particle-steps per second ([`summary::MdRunReport`]) and
+//! `vtk/spheres_*.vtp` snapshots ([`vtk::write_spheres`]); no figures, no cycles.
+//!
 //! Every I/O error names the file it happened on.
 
 pub mod checkpoint;
 pub mod cycles;
 pub mod figures;
 pub mod final_state;
+pub mod md_series;
+pub mod md_state;
 pub mod run_figures;
 pub mod series;
 pub mod summary;
@@ -33,8 +40,10 @@ use std::path::{Path, PathBuf};
 
 pub use checkpoint::{Checkpoint, CHECKPOINT_FILE};
 pub use final_state::{BodyState, FinalState};
+pub use md_series::{md_series_header, md_series_row, MD_SERIES_COLUMNS};
+pub use md_state::{MdFinalState, SphereState, WallState};
 pub use series::{SeriesWriter, SERIES_HEADER};
-pub use summary::{RunReport, RunSummary};
+pub use summary::{MdRunReport, MdRunSummary, RunReport, RunSummary};
 
 /// An I/O error with the path it happened on in its message.
 pub fn io_error(path: &Path, what: &str, e: std::io::Error) -> Error {
@@ -85,7 +94,7 @@ pub fn copy_scene(scene: &Path, dir: &Path) -> Result<PathBuf> {
 pub struct RunInfo {
     /// Random seed of the scene.
     pub seed: u64,
-    /// Engine name (`"nscd"`).
+    /// Engine name (`"nscd"` or `"md"`).
     pub engine: String,
     /// Version of `ballast` that made the run.
     pub version: String,

@@ -6,6 +6,10 @@
 //! over the active contacts), `max_overlap_m`, `total_overlap_m` (sum over the
 //! contacts: the cumulated interpenetration of Saussine et al. 2006, Fig. 2). Floats are written with `{:e}`, the shortest text that
 //! reads back to the same `f64`.
+//!
+//! The writer itself (buffering, cutting back on `--resume`, counting rows) does
+//! not depend on the columns: [`SeriesWriter::with_header`] and
+//! [`SeriesWriter::write_row`] serve the MD series too ([`super::md_series`]).
 
 use super::io_error;
 use crate::error::Result;
@@ -30,10 +34,23 @@ pub struct SeriesWriter {
 impl SeriesWriter {
     /// Creates (truncates) the file at `path` and writes the header.
     pub fn create(path: &Path) -> Result<Self> {
+        Self::with_header(path, SERIES_HEADER)
+    }
+
+    /// Creates (truncates) the file at `path` and writes the header line `header`
+    /// (without its newline), for rows written with [`SeriesWriter::write_row`].
+    pub fn with_header(path: &Path, header: &str) -> Result<Self> {
         let file = File::create(path).map_err(|e| io_error(path, "create", e))?;
         let mut w = Self { path: path.to_path_buf(), out: BufWriter::new(file), rows: 0 };
-        writeln!(w.out, "{SERIES_HEADER}").map_err(|e| io_error(path, "write", e))?;
+        writeln!(w.out, "{header}").map_err(|e| io_error(path, "write", e))?;
         Ok(w)
+    }
+
+    /// Appends one row given as its text (without the newline).
+    pub fn write_row(&mut self, row: &str) -> Result<()> {
+        writeln!(self.out, "{row}").map_err(|e| io_error(&self.path, "write", e))?;
+        self.rows += 1;
+        Ok(())
     }
 
     /// Reopens `series.csv` to continue a run from a checkpoint: the file is cut

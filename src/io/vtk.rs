@@ -1,5 +1,6 @@
-//! VTK snapshots of an NSCD [`System`] for ParaView: the bodies, the contact
-//! force network, and a `.pvd` collection that animates them.
+//! VTK snapshots for ParaView: the bodies and the contact force network of an
+//! NSCD [`System`], the spheres of an MD [`MdSystem`], and a `.pvd` collection
+//! that animates them.
 //!
 //! # Files
 //!
@@ -10,8 +11,8 @@
 //!
 //! Any other extension is an error. [`PvdCollection`] writes a ParaView `.pvd`
 //! collection (`<VTKFile type="Collection">`) of `.vtp` snapshots, one time step
-//! per snapshot, part 0 the bodies and part 1 the contacts: open the `.pvd` in
-//! ParaView and it plays the run.
+//! per snapshot, part 0 the bodies and part 1 the contacts (NSCD) or part 0 the
+//! spheres (MD): open the `.pvd` in ParaView and it plays the run.
 //!
 //! **Why XML for the animation.** ParaView reads a `.pvd` with
 //! `vtkXMLCollectionReader`, which picks the reader of each listed file from its
@@ -77,11 +78,31 @@
 //! `normal_force` and a Tube filter whose radius follows it give the usual
 //! force-chain picture; `point` locates the contacts themselves (the line's
 //! ends are the centres of mass).
+//!
+//! # Spheres file (MD)
+//!
+//! [`write_spheres`]: one point per sphere at its centre (m), in sphere order, each
+//! a vertex cell (`VERTICES` / `<Verts>`), so ParaView shows them as points; a
+//! Glyph filter with a sphere source, scaled by `radius` (scale factor 2: the
+//! glyph is a unit-diameter sphere), draws the spheres at their size. No cell
+//! data. Point data:
+//!
+//! | array      | kind           | unit  | meaning                         |
+//! |------------|----------------|-------|---------------------------------|
+//! | `radius`   | float scalar   | m     | radius                          |
+//! | `id`       | int scalar     | –     | index of the sphere             |
+//! | `material` | int scalar     | –     | index of its material           |
+//! | `velocity` | vector (3)     | m/s   | velocity of the centre          |
+//! | `spin`     | field, 3 comps | rad/s | angular velocity                |
+//!
+//! `radius` is the active scalar and `velocity` the active vector.
 
 use super::io_error;
 use crate::error::Result;
 use crate::geometry::{perp, rotate, Shape, Vec2};
+use crate::md::MdSystem;
 use crate::nscd::System;
+use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -138,20 +159,62 @@ pub fn write_contacts(path: &Path, sys: &System) -> Result<()> {
     write_file(path, &render(&contacts_data(sys), format, &title))
 }
 
-/// One time step of a [`PvdCollection`].
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+/// Writes the spheres of `sys` to `path`: one vertex cell per sphere at its centre
+/// (m) with the point arrays `radius` (m), `id`, `material`, `velocity` (m/s) and
+/// `spin` (rad/s); see the [module documentation](self). The format follows the
+/// extension: `.vtk` legacy, `.vtp` XML.
+pub fn write_spheres(path: &Path, sys: &MdSystem) -> Result<()> {
+    let format = Format::from_path(path)?;
+    let title = format!("ballast MD spheres, step {}, time {:e} s", sys.step, sys.time);
+    write_file(path, &render(&spheres_data(sys), format, &title))
+}
+
+/// One file of a time step of a [`PvdCollection`]: a block of the data set.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PvdPart {
+    /// Name of the block (`bodies`, `contacts`, `spheres`).
+    pub name: String,
+    /// The snapshot (`.vtp`).
+    pub file: PathBuf,
+}
+
+/// One time step of a [`PvdCollection`]: its parts, listed as parts 0, 1, ….
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(from = "EntryForm")]
 pub struct PvdEntry {
     /// Simulated time (s).
     pub time: f64,
-    /// Bodies snapshot (`.vtp`), listed as part 0.
-    pub bodies: PathBuf,
-    /// Contacts snapshot (`.vtp`), listed as part 1.
-    pub contacts: PathBuf,
+    pub parts: Vec<PvdPart>,
 }
 
-/// A ParaView `.pvd` collection of snapshots: each time step lists its bodies
-/// file as part 0 and its contacts file as part 1, so ParaView shows a
-/// two-block data set that it animates over the time steps.
+/// What a [`PvdEntry`] reads from: its own form, or that of checkpoints written
+/// before the entries had a list of parts (a bodies and a contacts file).
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum EntryForm {
+    Parts { time: f64, parts: Vec<PvdPart> },
+    BodiesContacts { time: f64, bodies: PathBuf, contacts: PathBuf },
+}
+
+impl From<EntryForm> for PvdEntry {
+    fn from(e: EntryForm) -> Self {
+        match e {
+            EntryForm::Parts { time, parts } => PvdEntry { time, parts },
+            EntryForm::BodiesContacts { time, bodies, contacts } => {
+                PvdEntry { time, parts: bodies_and_contacts(bodies, contacts) }
+            }
+        }
+    }
+}
+
+fn bodies_and_contacts(bodies: PathBuf, contacts: PathBuf) -> Vec<PvdPart> {
+    vec![PvdPart { name: "bodies".into(), file: bodies }, PvdPart { name: "contacts".into(), file: contacts }]
+}
+
+/// A ParaView `.pvd` collection of snapshots: each time step lists its files as
+/// parts 0, 1, … — for an NSCD run its bodies file and its contacts file, for an
+/// MD run its spheres file — so ParaView shows a multi-block data set that it
+/// animates over the time steps.
 ///
 /// ```no_run
 /// # fn main() -> ballast::Result<()> {
@@ -187,8 +250,15 @@ impl PvdCollection {
     /// from an earlier checkpoint rewrites them), so times are strictly
     /// increasing.
     pub fn push(&mut self, time: f64, bodies: impl Into<PathBuf>, contacts: impl Into<PathBuf>) {
+        self.push_parts(time, bodies_and_contacts(bodies.into(), contacts.into()));
+    }
+
+    /// Adds the snapshot at `time` (s) made of `parts` (parts 0, 1, … in this
+    /// order), dropping the entries at a time not smaller than `time` first, as
+    /// [`PvdCollection::push`] does.
+    pub fn push_parts(&mut self, time: f64, parts: Vec<PvdPart>) {
         self.entries.retain(|e| e.time < time);
-        self.entries.push(PvdEntry { time, bodies: bodies.into(), contacts: contacts.into() });
+        self.entries.push(PvdEntry { time, parts });
     }
 
     /// Writes `dir/bodies_SSSSSSSSS.vtp` and `dir/contacts_SSSSSSSSS.vtp` (`S`: the
@@ -202,6 +272,17 @@ impl PvdCollection {
         write_contacts(&contacts, sys)?;
         self.push(sys.time, bodies.clone(), contacts.clone());
         Ok((bodies, contacts))
+    }
+
+    /// Writes `dir/spheres_SSSSSSSSS.vtp` (`S`: the step number, 9 digits or more)
+    /// for the current state of the MD system `sys`, adds it as part `spheres` at
+    /// time `sys.time` (s) and returns its path. The `.pvd` itself is written by
+    /// [`PvdCollection::write`].
+    pub fn write_spheres_snapshot(&mut self, dir: &Path, sys: &MdSystem) -> Result<PathBuf> {
+        let file = dir.join(format!("spheres_{:09}.vtp", sys.step));
+        write_spheres(&file, sys)?;
+        self.push_parts(sys.time, vec![PvdPart { name: "spheres".into(), file: file.clone() }]);
+        Ok(file)
     }
 
     /// The time steps, in increasing time.
@@ -226,12 +307,13 @@ impl PvdCollection {
         let mut s = String::from("<?xml version=\"1.0\"?>\n");
         s.push_str("<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n");
         for e in &self.entries {
-            for (part, name, file) in [(0, "bodies", &e.bodies), (1, "contacts", &e.contacts)] {
-                let file = relative_to(file, base);
+            for (part, p) in e.parts.iter().enumerate() {
+                let file = relative_to(&p.file, base);
                 let _ = writeln!(
                     s,
-                    "    <DataSet timestep=\"{:e}\" group=\"\" part=\"{part}\" name=\"{name}\" file=\"{}\"/>",
+                    "    <DataSet timestep=\"{:e}\" group=\"\" part=\"{part}\" name=\"{}\" file=\"{}\"/>",
                     e.time,
+                    xml_escape(&p.name),
                     xml_escape(&file.to_string_lossy())
                 );
             }
@@ -295,6 +377,7 @@ fn write_file(path: &Path, text: &str) -> Result<()> {
 enum CellKind {
     Polys,
     Lines,
+    Verts,
 }
 
 /// How a cell array is declared in a legacy file.
@@ -361,6 +444,8 @@ struct PolyData {
     /// End of each cell in `connectivity` (the XML `offsets`).
     offsets: Vec<usize>,
     cell_data: Vec<Array>,
+    /// Arrays of one tuple per point (none for the NSCD files).
+    point_data: Vec<Array>,
 }
 
 impl PolyData {
@@ -382,6 +467,7 @@ fn bodies_data(sys: &System) -> PolyData {
         connectivity: Vec::new(),
         offsets: Vec::with_capacity(b.len()),
         cell_data: Vec::new(),
+        point_data: Vec::new(),
     };
     // Body of each cell: a compound has one cell per part.
     let mut owner: Vec<usize> = Vec::with_capacity(b.len());
@@ -442,6 +528,27 @@ fn contacts_data(sys: &System) -> PolyData {
             Array::int("candidate", contacts.iter().map(|c| c.candidate as i64).collect()),
             Array::int("antagonist", contacts.iter().map(|c| c.antagonist as i64).collect()),
         ],
+        point_data: Vec::new(),
+    }
+}
+
+fn spheres_data(sys: &MdSystem) -> PolyData {
+    let p = &sys.particles;
+    let n = p.len();
+    let v3 = |v: &crate::md::V3| [v[0], v[1], v[2]];
+    PolyData {
+        points: p.x.iter().map(v3).collect(),
+        kind: CellKind::Verts,
+        connectivity: (0..n).collect(),
+        offsets: (1..=n).collect(),
+        cell_data: Vec::new(),
+        point_data: vec![
+            Array::float("radius", p.r.clone()),
+            Array::int("id", (0..n as i64).collect()),
+            Array::int("material", p.material.iter().map(|&m| i64::from(m)).collect()),
+            Array::vectors("velocity", p.v.iter().map(v3).collect()),
+            Array::field3("spin", p.w.iter().map(v3).collect()),
+        ],
     }
 }
 
@@ -468,6 +575,7 @@ fn legacy(d: &PolyData, title: &str) -> String {
     let keyword = match d.kind {
         CellKind::Polys => "POLYGONS",
         CellKind::Lines => "LINES",
+        CellKind::Verts => "VERTICES",
     };
     let _ = writeln!(s, "{keyword} {n} {}", n + d.connectivity.len());
     for i in 0..n {
@@ -478,42 +586,54 @@ fn legacy(d: &PolyData, title: &str) -> String {
         }
         s.push('\n');
     }
-    let _ = writeln!(s, "CELL_DATA {n}");
+    if !d.cell_data.is_empty() {
+        let _ = writeln!(s, "CELL_DATA {n}");
+        legacy_arrays(&mut s, &d.cell_data, n);
+    }
+    if !d.point_data.is_empty() {
+        let _ = writeln!(s, "POINT_DATA {}", d.points.len());
+        legacy_arrays(&mut s, &d.point_data, d.points.len());
+    }
+    s
+}
+
+/// The `SCALARS`, `VECTORS` and `FIELD` blocks of `arrays` of `n` tuples each.
+fn legacy_arrays(s: &mut String, arrays: &[Array], n: usize) {
     let type_name = |a: &Array| match a.values {
         Values::Int(_) => "int",
         Values::Float(_) => "double",
     };
-    for a in d.cell_data.iter().filter(|a| a.role != Role::Field) {
+    for a in arrays.iter().filter(|a| a.role != Role::Field) {
         if a.role == Role::Scalars {
             let _ = write!(s, "SCALARS {} {} 1\nLOOKUP_TABLE default\n", a.name, type_name(a));
         } else {
             let _ = writeln!(s, "VECTORS {} {}", a.name, type_name(a));
         }
-        (0..n).for_each(|i| a.write_tuple(&mut s, i));
+        (0..n).for_each(|i| a.write_tuple(s, i));
     }
-    let fields: Vec<&Array> = d.cell_data.iter().filter(|a| a.role == Role::Field).collect();
+    let fields: Vec<&Array> = arrays.iter().filter(|a| a.role == Role::Field).collect();
     if !fields.is_empty() {
         let _ = writeln!(s, "FIELD FieldData {}", fields.len());
         for a in fields {
             let _ = writeln!(s, "{} {} {n} {}", a.name, a.components, type_name(a));
-            (0..n).for_each(|i| a.write_tuple(&mut s, i));
+            (0..n).for_each(|i| a.write_tuple(s, i));
         }
     }
-    s
 }
 
 fn xml(d: &PolyData, title: &str) -> String {
     let n = d.cells();
-    let (lines, polys) = match d.kind {
-        CellKind::Lines => (n, 0),
-        CellKind::Polys => (0, n),
+    let (verts, lines, polys) = match d.kind {
+        CellKind::Verts => (n, 0, 0),
+        CellKind::Lines => (0, n, 0),
+        CellKind::Polys => (0, 0, n),
     };
     let mut s = String::from("<?xml version=\"1.0\"?>\n");
     let _ = writeln!(s, "<!-- {} -->", title.replace("--", "- -"));
     s.push_str("<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <PolyData>\n");
     let _ = writeln!(
         s,
-        "    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"0\" NumberOfLines=\"{lines}\" \
+        "    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"{verts}\" NumberOfLines=\"{lines}\" \
          NumberOfStrips=\"0\" NumberOfPolys=\"{polys}\">",
         d.points.len()
     );
@@ -522,32 +642,16 @@ fn xml(d: &PolyData, title: &str) -> String {
         let _ = writeln!(s, "{:e} {:e} {:e}", p[0], p[1], p[2]);
     }
     s.push_str("        </DataArray>\n      </Points>\n");
-    let active = |role: Role| d.cell_data.iter().find(|a| a.role == role).map(|a| a.name);
-    s.push_str("      <CellData");
-    if let Some(name) = active(Role::Scalars) {
-        let _ = write!(s, " Scalars=\"{name}\"");
+    if !d.point_data.is_empty() {
+        xml_arrays(&mut s, "PointData", &d.point_data, d.points.len());
     }
-    if let Some(name) = active(Role::Vectors) {
-        let _ = write!(s, " Vectors=\"{name}\"");
+    if !d.cell_data.is_empty() {
+        xml_arrays(&mut s, "CellData", &d.cell_data, n);
     }
-    s.push_str(">\n");
-    for a in &d.cell_data {
-        let ty = match a.values {
-            Values::Int(_) => "Int32",
-            Values::Float(_) => "Float64",
-        };
-        let _ = writeln!(
-            s,
-            "        <DataArray type=\"{ty}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">",
-            a.name, a.components
-        );
-        (0..n).for_each(|i| a.write_tuple(&mut s, i));
-        s.push_str("        </DataArray>\n");
-    }
-    s.push_str("      </CellData>\n");
     let section = match d.kind {
         CellKind::Polys => "Polys",
         CellKind::Lines => "Lines",
+        CellKind::Verts => "Verts",
     };
     let _ = writeln!(s, "      <{section}>");
     s.push_str("        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
@@ -561,4 +665,32 @@ fn xml(d: &PolyData, title: &str) -> String {
     }
     let _ = write!(s, "        </DataArray>\n      </{section}>\n    </Piece>\n  </PolyData>\n</VTKFile>\n");
     s
+}
+
+/// `<PointData>` or `<CellData>` (`element`) of `arrays` of `n` tuples each; the
+/// first scalar and the first vector array are the active ones.
+fn xml_arrays(s: &mut String, element: &str, arrays: &[Array], n: usize) {
+    let active = |role: Role| arrays.iter().find(|a| a.role == role).map(|a| a.name);
+    let _ = write!(s, "      <{element}");
+    if let Some(name) = active(Role::Scalars) {
+        let _ = write!(s, " Scalars=\"{name}\"");
+    }
+    if let Some(name) = active(Role::Vectors) {
+        let _ = write!(s, " Vectors=\"{name}\"");
+    }
+    s.push_str(">\n");
+    for a in arrays {
+        let ty = match a.values {
+            Values::Int(_) => "Int32",
+            Values::Float(_) => "Float64",
+        };
+        let _ = writeln!(
+            s,
+            "        <DataArray type=\"{ty}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">",
+            a.name, a.components
+        );
+        (0..n).for_each(|i| a.write_tuple(s, i));
+        s.push_str("        </DataArray>\n");
+    }
+    let _ = writeln!(s, "      </{element}>");
 }

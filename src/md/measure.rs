@@ -121,7 +121,9 @@ impl MdSystem {
                         .ghosts
                         .planes
                         .iter()
-                        .filter(|p| p.normal.dot(&axis).abs() < 1e-9 && (axis_point - p.point).dot(&p.normal).abs() < 1e-12)
+                        .filter(|p| {
+                            p.normal.dot(&axis).abs() < 1e-9 && (axis_point - p.point).dot(&p.normal).abs() < 1e-12
+                        })
                         .count();
                     return Some(std::f64::consts::PI * radius * radius / f64::from(1u32 << halvings));
                 }

@@ -149,7 +149,8 @@ fn header(out: &mut String, spec: &KarrechSpec, duration: f64, equilibrium: bool
 /// The deposit scene: loose spheres falling in the quarter cylinder, run until
 /// `E_c/E_p ≤ energy_ratio` (or `duration`); a row of `series.csv` every `every` steps.
 pub fn deposit_scene(spec: &KarrechSpec, every: u64) -> String {
-    let mut out = String::from("# Karrech et al. (2007) sample, Table 1: deposit under gravity (ballast karrech deposit).\n\n");
+    let mut out =
+        String::from("# Karrech et al. (2007) sample, Table 1: deposit under gravity (ballast karrech deposit).\n\n");
     header(&mut out, spec, spec.duration, true, every);
     for (k, (r, x)) in loose_spheres(spec).into_iter().enumerate() {
         sphere(&mut out, &format!("g{k}"), "diorite", r, x, None);

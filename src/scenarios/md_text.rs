@@ -12,7 +12,11 @@ pub fn v3(v: V3) -> String {
 
 /// One `[[body]]` sphere.
 pub fn sphere(out: &mut String, name: &str, material: &str, radius: f64, position: V3, velocity: Option<V3>) {
-    let _ = writeln!(out, "[[body]]\nname = \"{name}\"\nmaterial = \"{material}\"\nsphere = {radius:?}\nposition = {}", v3(position));
+    let _ = writeln!(
+        out,
+        "[[body]]\nname = \"{name}\"\nmaterial = \"{material}\"\nsphere = {radius:?}\nposition = {}",
+        v3(position)
+    );
     if let Some(v) = velocity {
         let _ = writeln!(out, "velocity = {}", v3(v));
     }
@@ -21,7 +25,10 @@ pub fn sphere(out: &mut String, name: &str, material: &str, radius: f64, positio
 
 /// One `[[material]]`.
 pub fn material(out: &mut String, name: &str, density: f64, young: f64, poisson: f64) {
-    let _ = writeln!(out, "[[material]]\nname = \"{name}\"\ndensity = {density:?}\nyoung = {young:?}\npoisson = {poisson:?}\n");
+    let _ = writeln!(
+        out,
+        "[[material]]\nname = \"{name}\"\ndensity = {density:?}\nyoung = {young:?}\npoisson = {poisson:?}\n"
+    );
 }
 
 /// A plane `[[wall]]`, with an optional `servo = {...}` inline table body.

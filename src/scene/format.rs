@@ -450,52 +450,67 @@ pub struct SpringSpec {
     pub compression_only: Option<bool>,
 }
 
-/// Visitor of an array of exactly two `T` (serde's own `[T; 2]` lets `toml`
+/// Visitor of an array of exactly `N` `T` (serde's own `[T; N]` lets `toml`
 /// ignore extra elements).
-struct PairVisitor<T>(PhantomData<T>);
+struct ArrayVisitor<T, const N: usize>(PhantomData<T>);
 
-impl<'de, T: Deserialize<'de>> Visitor<'de> for PairVisitor<T> {
-    type Value = [T; 2];
+impl<'de, T: Deserialize<'de>, const N: usize> Visitor<'de> for ArrayVisitor<T, N> {
+    type Value = [T; N];
     fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        f.write_str("an array of exactly 2 elements")
+        write!(f, "an array of exactly {N} elements")
     }
-    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<[T; 2], A::Error> {
-        let x: T = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(0, &self))?;
-        let y: T = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(1, &self))?;
-        let mut n = 2;
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<[T; N], A::Error> {
+        let mut items = Vec::with_capacity(N);
+        while items.len() < N {
+            match seq.next_element()? {
+                Some(x) => items.push(x),
+                None => return Err(de::Error::invalid_length(items.len(), &self)),
+            }
+        }
+        let mut n = N;
         while seq.next_element::<de::IgnoredAny>()?.is_some() {
             n += 1;
         }
-        if n > 2 {
+        if n > N {
             return Err(de::Error::invalid_length(n, &self));
         }
-        Ok([x, y])
+        items.try_into().map_err(|_| de::Error::invalid_length(n, &self))
     }
 }
 
-/// A pair that is exactly two elements long.
+/// An array that is exactly `N` elements long.
 #[derive(Debug, Clone, Copy)]
-struct Pair<T>([T; 2]);
+struct Exact<T, const N: usize>([T; N]);
 
-impl<'de, T: Deserialize<'de>> Deserialize<'de> for Pair<T> {
+impl<'de, T: Deserialize<'de>, const N: usize> Deserialize<'de> for Exact<T, N> {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        d.deserialize_seq(PairVisitor(PhantomData)).map(Pair)
+        d.deserialize_seq(ArrayVisitor(PhantomData)).map(Exact)
     }
+}
+
+/// An array of exactly `N` elements (`deserialize_with`), e.g. a 2D or 3D vector.
+pub(crate) fn array<'de, D: Deserializer<'de>, T: Deserialize<'de>, const N: usize>(d: D) -> Result<[T; N], D::Error> {
+    Exact::deserialize(d).map(|p| p.0)
+}
+
+/// As [`array`], for an optional key (with `#[serde(default)]`).
+pub(crate) fn opt_array<'de, D: Deserializer<'de>, const N: usize>(d: D) -> Result<Option<[f64; N]>, D::Error> {
+    Exact::deserialize(d).map(|p| Some(p.0))
 }
 
 fn pair<'de, D: Deserializer<'de>, T: Deserialize<'de>>(d: D) -> Result<[T; 2], D::Error> {
-    Pair::deserialize(d).map(|p| p.0)
+    array(d)
 }
 
 fn opt_pair<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[f64; 2]>, D::Error> {
-    Pair::deserialize(d).map(|p| Some(p.0))
+    opt_array(d)
 }
 
 fn opt_points<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<[f64; 2]>>, D::Error> {
-    Vec::<Pair<f64>>::deserialize(d).map(|v| Some(v.into_iter().map(|p| p.0).collect()))
+    Vec::<Exact<f64, 2>>::deserialize(d).map(|v| Some(v.into_iter().map(|p| p.0).collect()))
 }
 
 fn opt_parts<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<VertexList>>, D::Error> {
-    Vec::<Vec<Pair<f64>>>::deserialize(d)
+    Vec::<Vec<Exact<f64, 2>>>::deserialize(d)
         .map(|v| Some(v.into_iter().map(|p| p.into_iter().map(|q| q.0).collect()).collect()))
 }

@@ -1,6 +1,8 @@
 //! TOML scene files: parsing, validation, building an [`nscd::System`](crate::nscd::System)
 //! and saving a system's state back as a scene. The format is documented in
-//! `docs/scene-format.md`; all quantities are SI.
+//! `docs/scene-format.md`; all quantities are SI. Scenes of the MD engine
+//! (`engine = "md"`) have their own format, in [`md`] ([`MdScene`]); [`engine_of`]
+//! tells which engine a file is for.
 //!
 //! ```
 //! let scene = ballast::scene::Scene::from_toml_str(r#"
@@ -23,15 +25,57 @@
 
 mod build;
 mod format;
+pub mod md;
 mod parse;
 mod validate;
 mod write;
 
 pub use format::*;
+pub use md::MdScene;
 pub use validate::{MAX_LENGTH, MAX_SIDES, MAX_STEPS, MIN_SIZE};
 
 use crate::error::{Error, Result};
+use serde::Deserialize;
 use std::path::Path;
+
+/// The engines a scene file can be for: `"nscd"` ([`Scene`]) and `"md"` ([`MdScene`]).
+pub const ENGINES: [&str; 2] = ["nscd", "md"];
+
+/// The engine a scene file is for, `"nscd"` or `"md"`: the value of
+/// `[simulation] engine`, read without validating the rest of the file. Load an
+/// `"nscd"` scene with [`Scene`], an `"md"` one with [`MdScene`].
+///
+/// # Errors
+/// [`Error::Scene`] with a one-line message: TOML syntax errors and a missing or
+/// mistyped `engine` as `scene.toml line L: …`, any other engine as
+/// `simulation.engine: unknown engine 'x', expected 'nscd' or 'md'`.
+///
+/// ```
+/// let text = "[simulation]\nengine = \"md\"\ndt = 1e-5\n";
+/// assert_eq!(ballast::scene::engine_of(text).unwrap(), "md");
+/// ```
+pub fn engine_of(text: &str) -> Result<String> {
+    engine_of_named(text, "scene.toml")
+}
+
+/// As [`engine_of`], with `name` in place of `scene.toml` in the messages.
+pub fn engine_of_named(text: &str, name: &str) -> Result<String> {
+    #[derive(Deserialize)]
+    struct Probe {
+        simulation: ProbeSimulation,
+    }
+    #[derive(Deserialize)]
+    struct ProbeSimulation {
+        engine: String,
+    }
+    let probe: Probe = toml::from_str(text).map_err(|e| Error::Scene(parse::one_line(name, text, &e)))?;
+    let engine = probe.simulation.engine;
+    if ENGINES.contains(&engine.as_str()) {
+        Ok(engine)
+    } else {
+        Err(Error::Scene(format!("simulation.engine: unknown engine '{engine}', expected 'nscd' or 'md'")))
+    }
+}
 
 impl Scene {
     /// Parses and fully validates a scene. Errors are [`Error::Scene`] with a
@@ -74,12 +118,7 @@ impl Scene {
 
     /// Number of time steps of the run, `round(duration / dt)` (0 if `dt` is not positive).
     pub fn steps(&self) -> u64 {
-        let n = (self.simulation.duration / self.simulation.dt).round();
-        if n.is_finite() && n >= 0.0 {
-            n.min(MAX_STEPS) as u64
-        } else {
-            0
-        }
+        validate::steps_of(self.simulation.dt, self.simulation.duration)
     }
 
     /// Random seed recorded in the outputs (default 0).

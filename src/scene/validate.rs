@@ -70,12 +70,12 @@ pub(crate) fn num(v: f64) -> String {
     }
 }
 
-fn err<T>(msg: String) -> Result<T> {
+pub(crate) fn err<T>(msg: String) -> Result<T> {
     Err(Error::Scene(msg))
 }
 
 /// `ctx: must be finite, got …` unless `v` is finite.
-fn finite(ctx: &str, v: f64) -> Result<f64> {
+pub(crate) fn finite(ctx: &str, v: f64) -> Result<f64> {
     if v.is_finite() {
         Ok(v)
     } else {
@@ -101,7 +101,7 @@ fn coordinates(ctx: &str, v: [f64; 2]) -> Result<[f64; 2]> {
     }
 }
 
-fn positive(ctx: &str, v: f64) -> Result<f64> {
+pub(crate) fn positive(ctx: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
@@ -109,7 +109,7 @@ fn positive(ctx: &str, v: f64) -> Result<f64> {
     }
 }
 
-fn non_negative(ctx: &str, v: f64) -> Result<f64> {
+pub(crate) fn non_negative(ctx: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v >= 0.0 {
         Ok(v)
     } else {
@@ -127,10 +127,15 @@ fn in_unit(ctx: &str, v: f64) -> Result<f64> {
 
 /// `body[3] 'block'`, or `body[3]` for an unnamed body.
 pub(crate) fn body_label(i: usize, b: &BodySpec) -> String {
-    if b.name.is_empty() {
-        format!("body[{i}]")
+    label("body", i, &b.name)
+}
+
+/// `section[i] 'name'`, or `section[i]` when `name` is empty.
+pub(crate) fn label(section: &str, i: usize, name: &str) -> String {
+    if name.is_empty() {
+        format!("{section}[{i}]")
     } else {
-        format!("body[{i}] '{}'", b.name)
+        format!("{section}[{i}] '{name}'")
     }
 }
 
@@ -166,6 +171,36 @@ pub(crate) fn shape_of(b: &BodySpec) -> std::result::Result<(Shape, Vec2), Strin
     }
 }
 
+/// Checks `simulation.dt` and `simulation.duration` (s): both positive, and
+/// `round(duration / dt)` between 1 and [`MAX_STEPS`].
+pub(crate) fn check_time(dt: f64, duration: f64) -> Result<()> {
+    let dt = positive("simulation.dt", dt)?;
+    let duration = positive("simulation.duration", duration)?;
+    let steps = (duration / dt).round();
+    if steps < 1.0 {
+        return err(format!(
+            "simulation.duration: {} s is shorter than half a time step (dt = {} s)",
+            num(duration),
+            num(dt)
+        ));
+    }
+    if steps > MAX_STEPS {
+        return err(format!("simulation.duration: duration/dt = {steps:e} steps is too many"));
+    }
+    Ok(())
+}
+
+/// Number of time steps `round(duration / dt)` (0 if that is not a number ≥ 0;
+/// at most [`MAX_STEPS`]).
+pub(crate) fn steps_of(dt: f64, duration: f64) -> u64 {
+    let n = (duration / dt).round();
+    if n.is_finite() && n >= 0.0 {
+        n.min(MAX_STEPS) as u64
+    } else {
+        0
+    }
+}
+
 /// The policy named `name`.
 fn policy(name: &str) -> Option<Policy> {
     [Policy::Strict, Policy::Quad, Policy::QuadMax, Policy::Energy].into_iter().find(|p| p.name() == name)
@@ -190,22 +225,15 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
     let sim = &scene.simulation;
     match sim.engine.as_str() {
         "nscd" => {}
-        "md" => return err("simulation.engine: 'md' is not implemented yet (only 'nscd' is)".into()),
+        "md" => {
+            return err(
+                "simulation.engine: 'md' is not implemented yet by the NSCD Scene: read MD scenes with scene::MdScene"
+                    .into(),
+            )
+        }
         other => return err(format!("simulation.engine: unknown engine '{other}', expected 'nscd'")),
     }
-    let dt = positive("simulation.dt", sim.dt)?;
-    let duration = positive("simulation.duration", sim.duration)?;
-    let steps = (duration / dt).round();
-    if steps < 1.0 {
-        return err(format!(
-            "simulation.duration: {} s is shorter than half a time step (dt = {} s)",
-            num(duration),
-            num(dt)
-        ));
-    }
-    if steps > MAX_STEPS {
-        return err(format!("simulation.duration: duration/dt = {steps:e} steps is too many"));
-    }
+    check_time(sim.dt, sim.duration)?;
     finite2("simulation.gravity", sim.gravity())?;
     let thickness = positive("simulation.thickness", sim.thickness())?;
     if let Some(eq) = &sim.equilibrium {

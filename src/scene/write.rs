@@ -7,7 +7,7 @@ use super::format::{BodySpec, Drive, HarmonicSpec, Scene};
 use std::fmt::Write;
 
 /// A float as a TOML float that reads back exactly (`nan`, `inf` included).
-fn float(x: f64) -> String {
+pub(crate) fn float(x: f64) -> String {
     if x.is_nan() {
         "nan".into()
     } else if x.is_infinite() {
@@ -19,7 +19,7 @@ fn float(x: f64) -> String {
 }
 
 /// A TOML basic string.
-fn string(s: &str) -> String {
+pub(crate) fn string(s: &str) -> String {
     let mut out = String::with_capacity(s.len() + 2);
     out.push('"');
     for c in s.chars() {
@@ -61,7 +61,7 @@ fn drive(d: &Drive) -> String {
 }
 
 /// Appends `key = value` if `value` is present.
-fn opt<T>(out: &mut String, key: &str, value: Option<T>, show: impl Fn(T) -> String) {
+pub(crate) fn opt<T>(out: &mut String, key: &str, value: Option<T>, show: impl Fn(T) -> String) {
     if let Some(v) = value {
         let _ = writeln!(out, "{key} = {}", show(v));
     }

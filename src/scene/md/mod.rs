@@ -1,0 +1,99 @@
+//! TOML scene files of the MD engine (`[simulation] engine = "md"`): parsing,
+//! validation, building an [`MdSystem`](crate::md::MdSystem) and saving a
+//! system's state back as a scene. The format is documented in the section "MD
+//! scenes" of `docs/scene-format.md`; all quantities are SI. Errors read like
+//! those of NSCD scenes (one line naming the field; `scene.toml line L: …` for
+//! syntax errors, unknown and missing keys). [`crate::scene::engine_of`] tells
+//! which of the two formats a file is in.
+//!
+//! ```
+//! let scene = ballast::scene::MdScene::from_toml_str(r#"
+//!     [simulation]
+//!     engine = "md"
+//!     dt = 1e-5
+//!     duration = 1e-3
+//!     [[material]]
+//!     name = "glass"
+//!     density = 2500.0
+//!     young = 6e10
+//!     poisson = 0.22
+//!     [[contact]]
+//!     between = ["glass", "glass"]
+//!     model = "hertz"
+//!     friction = 0.3
+//!     [[wall]]
+//!     name = "floor"
+//!     material = "glass"
+//!     plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0] }
+//!     [[body]]
+//!     material = "glass"
+//!     sphere = 0.001
+//!     position = [0.0, 0.0, 0.002]
+//! "#).unwrap();
+//! assert_eq!(scene.steps(), 100);
+//! let sys = scene.build().unwrap();
+//! assert_eq!(sys.particles.len(), 1);
+//! ```
+
+mod build;
+mod format;
+mod validate;
+mod write;
+
+pub use format::*;
+
+use crate::error::{Error, Result};
+use crate::scene::{parse, validate::steps_of, Scene, DEFAULT_OUTPUT_EVERY};
+use std::path::Path;
+
+impl MdScene {
+    /// Parses and fully validates an MD scene. Errors are [`Error::Scene`] with a
+    /// single-line message; TOML syntax errors, unknown keys and missing fields
+    /// read `scene.toml line L: …`.
+    pub fn from_toml_str(text: &str) -> Result<MdScene> {
+        Self::from_toml_str_named(text, "scene.toml")
+    }
+
+    /// As [`MdScene::from_toml_str`], with `name` in place of `scene.toml` in the
+    /// messages of syntax errors.
+    pub fn from_toml_str_named(text: &str, name: &str) -> Result<MdScene> {
+        let scene: MdScene = toml::from_str(text).map_err(|e| Error::Scene(parse::one_line(name, text, &e)))?;
+        validate::check(&scene)?;
+        Ok(scene)
+    }
+
+    /// Reads, parses and validates the MD scene file at `path`; syntax errors name
+    /// the file as given. A file that cannot be read is an [`Error::Scene`] too.
+    pub fn load(path: impl AsRef<Path>) -> Result<MdScene> {
+        let path = path.as_ref();
+        Self::from_toml_str_named(&Scene::read_text(path)?, &path.display().to_string())
+    }
+
+    /// The scene as TOML text that [`MdScene::from_toml_str`] reads back to an
+    /// equal scene (only the keys the scene has; floats in their shortest exact
+    /// form). It does not fail at present; the `Result` leaves room for formats
+    /// that might.
+    pub fn to_toml_string(&self) -> Result<String> {
+        Ok(write::to_toml(self))
+    }
+
+    /// Number of time steps of the run, `round(duration / dt)` (0 if `dt` is not positive).
+    pub fn steps(&self) -> u64 {
+        steps_of(self.simulation.dt, self.simulation.duration)
+    }
+
+    /// Random seed recorded in the outputs (default 0).
+    pub fn seed(&self) -> u64 {
+        self.simulation.seed.unwrap_or(0)
+    }
+
+    /// Number of steps between two rows of `series.csv` (default 1, never 0).
+    pub fn output_every(&self) -> u64 {
+        self.output.as_ref().and_then(|o| o.every).unwrap_or(DEFAULT_OUTPUT_EVERY).max(1)
+    }
+
+    /// Force-evaluation threads the scene asks for (`md.threads`), if any.
+    pub fn threads(&self) -> Option<usize> {
+        self.md.as_ref().and_then(|m| m.threads)
+    }
+}

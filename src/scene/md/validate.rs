@@ -1,0 +1,526 @@
+//! Validation of a parsed MD scene: every value is checked (finite, in range,
+//! names resolved, every pair of materials that can touch has a law, no
+//! contradictory keys) and resolved into what building an
+//! [`MdSystem`](crate::md::MdSystem) needs. Each error is one line naming the
+//! section or the entry and the field, as for NSCD scenes, e.g.
+//! `body[3] 's3': sphere: must be positive and finite, got -0.001` or
+//! `contact[1].normal_stiffness: not a key of model 'hertz' (only of 'linear')`.
+//! Overlapping initial spheres are allowed.
+
+use super::format::{MdContact, MdScene, ServoSpec, WallSpec, DEFAULT_SKIN_FRACTION};
+use crate::error::Result;
+use crate::md::{self, Drive, GearSet, History1, Integrator, MdSettings, Motion, Shape, SymmetryPlane, Wall, V3};
+use crate::scene::validate::{check_time, err, finite, label, non_negative, num, positive, MAX_LENGTH, MIN_SIZE};
+use std::collections::HashMap;
+
+/// Two unit vectors are perpendicular (symmetry planes) or along an axis (box
+/// walls) within this tolerance.
+const ANGLE_TOLERANCE: f64 = 1e-9;
+
+/// The model of a contact law and its parameters, as given (the restitution
+/// mapping, which takes some milliseconds for `hertz`, is left to the build).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum CheckedModel {
+    /// Hertz–Mindlin: `α_n` from `restitution` if given, else `alpha_n`;
+    /// `α_t = alpha_t`, or `α_n` if `None`.
+    Hertz { restitution: Option<f64>, alpha_n: f64, alpha_t: Option<f64> },
+    /// Linear spring–dashpot: stiffnesses (N/m); the normal dashpot from
+    /// `restitution` if given, else the coefficient `gamma_n` (kg/s); tangential
+    /// dashpot `gamma_t` (kg/s).
+    Linear { kn: f64, kt: f64, restitution: Option<f64>, gamma_n: f64, gamma_t: f64 },
+}
+
+/// A contact law resolved by validation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CheckedLaw {
+    /// Material indices.
+    pub a: usize,
+    pub b: usize,
+    pub model: CheckedModel,
+    /// Static and dynamic friction coefficients.
+    pub mu_s: f64,
+    pub mu_d: f64,
+}
+
+/// Everything validation resolved.
+#[derive(Debug, Clone)]
+pub(crate) struct CheckedMd {
+    pub settings: MdSettings,
+    pub materials: Vec<md::Material>,
+    /// Material index of each sphere.
+    pub sphere_materials: Vec<usize>,
+    pub laws: Vec<CheckedLaw>,
+    pub walls: Vec<Wall>,
+    pub planes: Vec<SymmetryPlane>,
+    pub threads: Option<usize>,
+}
+
+/// `ctx: must be finite, got [x, y, z]` unless every component is finite.
+fn finite3(ctx: &str, v: [f64; 3]) -> Result<V3> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(V3::from(v))
+    } else {
+        err(format!("{ctx}: must be finite, got {}", show3(v)))
+    }
+}
+
+fn show3(v: [f64; 3]) -> String {
+    format!("[{}, {}, {}]", num(v[0]), num(v[1]), num(v[2]))
+}
+
+/// A finite point whose coordinates are within [`MAX_LENGTH`].
+fn point(ctx: &str, v: [f64; 3]) -> Result<V3> {
+    let p = finite3(ctx, v)?;
+    if p.iter().all(|x| x.abs() <= MAX_LENGTH) {
+        Ok(p)
+    } else {
+        err(format!("{ctx}: coordinates must be within ±{MAX_LENGTH:e} m, got {}", show3(v)))
+    }
+}
+
+/// A non-zero finite vector, normalised.
+fn direction(ctx: &str, v: [f64; 3]) -> Result<V3> {
+    let d = finite3(ctx, v)?;
+    let n = d.norm();
+    if n > 0.0 && n.is_finite() {
+        Ok(d / n)
+    } else {
+        err(format!("{ctx}: must be a non-zero vector, got {}", show3(v)))
+    }
+}
+
+/// A positive length (m) no larger than [`MAX_LENGTH`].
+fn length(ctx: &str, v: f64) -> Result<f64> {
+    positive(ctx, v)?;
+    if v > MAX_LENGTH {
+        return err(format!("{ctx}: must be at most {MAX_LENGTH:e} m, got {}", num(v)));
+    }
+    Ok(v)
+}
+
+/// The axis (0, 1, 2) a unit vector lies along, if any.
+fn axis_of(n: &V3) -> Option<usize> {
+    let a = n.iamax();
+    ((n[a].abs() - 1.0).abs() < ANGLE_TOLERANCE).then_some(a)
+}
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// Checks the whole scene and resolves names, shapes, laws and defaults.
+pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
+    // [simulation]
+    let sim = &scene.simulation;
+    match sim.engine.as_str() {
+        "md" => {}
+        "nscd" => {
+            return err("simulation.engine: expected 'md', got 'nscd' (an NSCD scene: read it with scene::Scene)".into())
+        }
+        other => return err(format!("simulation.engine: unknown engine '{other}', expected 'md'")),
+    }
+    if let Some(d) = sim.dimension {
+        if d != 3 {
+            return err(format!("simulation.dimension: must be 3 for the md engine, got {d}"));
+        }
+    }
+    check_time(sim.dt, sim.duration)?;
+    let gravity = finite3("simulation.gravity", sim.gravity())?;
+    if let Some(eq) = &sim.equilibrium {
+        if eq.kinetic_energy.is_none() && eq.energy_ratio.is_none() {
+            return err("simulation.equilibrium: give kinetic_energy, energy_ratio or both".into());
+        }
+        if let Some(k) = eq.kinetic_energy {
+            positive("simulation.equilibrium.kinetic_energy", k)?;
+        }
+        if let Some(r) = eq.energy_ratio {
+            positive("simulation.equilibrium.energy_ratio", r)?;
+        }
+        if eq.steps() == 0 {
+            return err("simulation.equilibrium.steps: must be at least 1, got 0".into());
+        }
+    }
+
+    // [md]
+    let ms = scene.md.clone().unwrap_or_default();
+    let integrator = match ms.integrator.as_deref().unwrap_or("verlet") {
+        "verlet" => {
+            if ms.gear.is_some() {
+                return err("md.gear: only with integrator = \"gear\"".into());
+            }
+            Integrator::Verlet
+        }
+        "gear" => {
+            let name = ms.gear.as_deref().unwrap_or("karrech");
+            match GearSet::from_name(name) {
+                Some(set) => Integrator::Gear(set),
+                None => {
+                    return err(format!(
+                        "md.gear: unknown set '{name}', expected one of 'karrech', 'gear3', 'gear4', 'gear5', 'gear6'"
+                    ))
+                }
+            }
+        }
+        other => return err(format!("md.integrator: unknown integrator '{other}', expected 'verlet' or 'gear'")),
+    };
+    if let Some(s) = ms.skin {
+        length("md.skin", s)?;
+    }
+    let background_damping = non_negative("md.background_damping", ms.background_damping.unwrap_or(0.0))?;
+    let background_rotational_damping =
+        non_negative("md.background_rotational_damping", ms.background_rotational_damping.unwrap_or(0.0))?;
+    if ms.threads == Some(0) {
+        return err("md.threads: must be at least 1, got 0".into());
+    }
+
+    // [output]
+    if let Some(every) = scene.output.as_ref().and_then(|o| o.every) {
+        if every < 1 {
+            return err(format!("output.every: must be at least 1, got {every}"));
+        }
+    }
+
+    // [[symmetry]]
+    if scene.symmetry.len() > 2 {
+        return err(format!("symmetry: at most 2 symmetry planes, got {}", scene.symmetry.len()));
+    }
+    let mut planes = Vec::with_capacity(scene.symmetry.len());
+    for (i, s) in scene.symmetry.iter().enumerate() {
+        let point = point(&format!("symmetry[{i}].point"), s.point)?;
+        let normal = direction(&format!("symmetry[{i}].normal"), s.normal)?;
+        planes.push(SymmetryPlane { point, normal });
+    }
+    if let [a, b] = planes.as_slice() {
+        let dot = a.normal.dot(&b.normal);
+        if dot.abs() > ANGLE_TOLERANCE {
+            return err(format!(
+                "symmetry[1].normal: two symmetry planes must be perpendicular, the normals' dot product is {}",
+                num(dot)
+            ));
+        }
+    }
+
+    // [[material]]
+    let mut names: HashMap<&str, usize> = HashMap::new();
+    let mut materials = Vec::with_capacity(scene.materials.len());
+    for (i, m) in scene.materials.iter().enumerate() {
+        if m.name.is_empty() {
+            return err(format!("material[{i}].name: must not be empty"));
+        }
+        if let Some(j) = names.insert(m.name.as_str(), i) {
+            return err(format!("material[{i}].name: duplicate material '{}' (also material[{j}])", m.name));
+        }
+        let ctx = |field: &str| format!("{}: {field}", label("material", i, &m.name));
+        positive(&ctx("density"), m.density)?;
+        positive(&ctx("young"), m.young)?;
+        if !(m.poisson > -1.0 && m.poisson < 0.5) {
+            return err(format!("{}: must be in (-1, 0.5), got {}", ctx("poisson"), num(m.poisson)));
+        }
+        materials.push(md::Material { density: m.density, young: m.young, poisson: m.poisson });
+    }
+    let material = |ctx: &str, name: &str| -> Result<usize> {
+        match names.get(name) {
+            Some(&m) => Ok(m),
+            None => err(format!("{ctx}: unknown material '{name}'")),
+        }
+    };
+
+    // [[contact]]
+    let mut pairs: HashMap<(usize, usize), usize> = HashMap::new();
+    let mut laws = Vec::with_capacity(scene.contacts.len());
+    for (i, c) in scene.contacts.iter().enumerate() {
+        let a = material(&format!("contact[{i}].between"), &c.between[0])?;
+        let b = material(&format!("contact[{i}].between"), &c.between[1])?;
+        if let Some(j) = pairs.insert((a.min(b), a.max(b)), i) {
+            return err(format!(
+                "contact[{i}].between: duplicate law for materials '{}' and '{}' (also contact[{j}])",
+                c.between[0], c.between[1]
+            ));
+        }
+        laws.push(check_contact(i, c, a, b)?);
+    }
+
+    // [[body]]
+    if scene.bodies.is_empty() {
+        return err("body: the scene has no [[body]] (no sphere)".into());
+    }
+    let mut body_names: HashMap<&str, usize> = HashMap::new();
+    let mut sphere_materials = Vec::with_capacity(scene.bodies.len());
+    let mut diameters = 0.0;
+    for (i, b) in scene.bodies.iter().enumerate() {
+        let name = label("body", i, &b.name);
+        let ctx = |field: &str| format!("{name}: {field}");
+        if !b.name.is_empty() {
+            if let Some(j) = body_names.insert(b.name.as_str(), i) {
+                return err(format!("{}: duplicate body name (also body[{j}])", ctx("name")));
+            }
+        }
+        let m = material(&ctx("material"), &b.material)?;
+        let r = length(&ctx("sphere"), b.sphere)?;
+        if r < MIN_SIZE {
+            return err(format!("{}: must be at least {MIN_SIZE:e} m, got {}", ctx("sphere"), num(r)));
+        }
+        point(&ctx("position"), b.position)?;
+        finite3(&ctx("velocity"), b.velocity())?;
+        finite3(&ctx("spin"), b.spin())?;
+        let mass = materials[m].density * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
+        if !(mass.is_finite() && mass > 0.0) {
+            return err(format!("{}: mass {mass:e} kg (density*4/3*pi*r^3) is not positive and finite", ctx("sphere")));
+        }
+        sphere_materials.push(m);
+        diameters += 2.0 * r;
+    }
+
+    // [[wall]]
+    let mut wall_names: HashMap<&str, usize> = HashMap::new();
+    let mut walls = Vec::with_capacity(scene.walls.len());
+    for (i, w) in scene.walls.iter().enumerate() {
+        if w.name.is_empty() {
+            return err(format!("wall[{i}].name: must not be empty"));
+        }
+        if let Some(j) = wall_names.insert(w.name.as_str(), i) {
+            return err(format!("wall[{i}].name: duplicate wall '{}' (also wall[{j}])", w.name));
+        }
+        let name = label("wall", i, &w.name);
+        let m = material(&format!("{name}: material"), &w.material)?;
+        walls.push(check_wall(&name, w, m as u32)?);
+    }
+    // A stress on the box area needs a closed box around the wall's axis.
+    for (i, (w, spec)) in walls.iter().zip(&scene.walls).enumerate() {
+        if let Motion::Servo { drive: Drive::Stress(_, None), .. } = w.motion {
+            let ctx = format!("{}: servo.area", label("wall", i, &spec.name));
+            let Some(axis) = w.normal().as_ref().and_then(axis_of) else {
+                return err(format!("{ctx}: omitted, but the wall's normal is not along x, y or z: give area"));
+            };
+            let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+            let closed = |k: usize| md::walls::box_extent(&walls, k).is_some_and(|e| e > 0.0);
+            if !(closed(a) && closed(b)) {
+                return err(format!(
+                    "{ctx}: omitted, but no plane or disc walls with normals ±{} and ±{} close a box around the {} \
+                     axis: give area",
+                    AXES[a], AXES[b], AXES[axis]
+                ));
+            }
+        }
+    }
+
+    // Every pair of materials that can touch has a law: spheres with spheres
+    // (of one material: two spheres, or one and its symmetry image) and with walls.
+    let n = materials.len();
+    let (mut first, mut second) = (vec![None; n], vec![None; n]);
+    for (i, &m) in sphere_materials.iter().enumerate() {
+        if first[m].is_none() {
+            first[m] = Some(i);
+        } else if second[m].is_none() {
+            second[m] = Some(i);
+        }
+    }
+    let body = |i: usize| label("body", i, &scene.bodies[i].name);
+    let missing = |a: usize, b: usize, what: String| {
+        err(format!(
+            "contact: no [[contact]] between materials '{}' and '{}', which can touch ({what})",
+            scene.materials[a].name, scene.materials[b].name
+        ))
+    };
+    for a in 0..n {
+        let Some(i) = first[a] else { continue };
+        for (b, &first_b) in first.iter().enumerate().skip(a) {
+            let partner = if a == b { second[a].or((!planes.is_empty()).then_some(i)) } else { first_b };
+            match partner {
+                Some(j) if !pairs.contains_key(&(a, b)) => {
+                    let what = if j == i {
+                        format!("{} and its symmetry image", body(i))
+                    } else {
+                        format!("{} and {}", body(i), body(j))
+                    };
+                    return missing(a, b, what);
+                }
+                _ => {}
+            }
+        }
+        for (k, w) in walls.iter().enumerate() {
+            let b = w.material as usize;
+            if !pairs.contains_key(&(a.min(b), a.max(b))) {
+                return missing(a, b, format!("{} and {}", body(i), label("wall", k, &scene.walls[k].name)));
+            }
+        }
+    }
+
+    let skin = ms.skin.unwrap_or(DEFAULT_SKIN_FRACTION * diameters / scene.bodies.len() as f64);
+    let settings =
+        MdSettings { dt: sim.dt, gravity, integrator, skin, background_damping, background_rotational_damping };
+    Ok(CheckedMd { settings, materials, sphere_materials, laws, walls, planes, threads: ms.threads })
+}
+
+/// Checks one `[[contact]]` between materials `a` and `b`.
+fn check_contact(i: usize, c: &MdContact, a: usize, b: usize) -> Result<CheckedLaw> {
+    let ctx = |field: &str| format!("contact[{i}].{field}");
+    let model = match c.model.as_str() {
+        "hertz" => md::Model::Hertz,
+        "linear" => md::Model::Linear,
+        other => return err(format!("{}: unknown model '{other}', expected 'hertz' or 'linear'", ctx("model"))),
+    };
+    // Keys of the other model.
+    let (foreign, other): (&[(&str, bool)], &str) = match model {
+        md::Model::Hertz => (
+            &[
+                ("static_friction", c.static_friction.is_some()),
+                ("dynamic_friction", c.dynamic_friction.is_some()),
+                ("normal_stiffness", c.normal_stiffness.is_some()),
+                ("tangential_stiffness", c.tangential_stiffness.is_some()),
+                ("normal_damping", c.normal_damping.is_some()),
+                ("tangential_damping", c.tangential_damping.is_some()),
+            ],
+            "linear",
+        ),
+        md::Model::Linear => (
+            &[
+                ("normal_damping_ratio", c.normal_damping_ratio.is_some()),
+                ("tangential_damping_ratio", c.tangential_damping_ratio.is_some()),
+            ],
+            "hertz",
+        ),
+    };
+    if let Some((key, _)) = foreign.iter().find(|(_, given)| *given) {
+        let hint = if key.ends_with("_friction") { ": give friction" } else { "" };
+        return err(format!("{}: not a key of model '{}' (only of '{other}'){hint}", ctx(key), c.model));
+    }
+    // Friction: one coefficient, or static and dynamic.
+    let (mu_s, mu_d) = match (c.friction, c.static_friction, c.dynamic_friction) {
+        (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+            let key = if c.static_friction.is_some() { "static_friction" } else { "dynamic_friction" };
+            return err(format!(
+                "{}: give either friction or static_friction and dynamic_friction, not both",
+                ctx(key)
+            ));
+        }
+        (Some(mu), None, None) => {
+            let mu = non_negative(&ctx("friction"), mu)?;
+            (mu, mu)
+        }
+        (None, Some(s), Some(d)) => {
+            let s = non_negative(&ctx("static_friction"), s)?;
+            let d = non_negative(&ctx("dynamic_friction"), d)?;
+            if d > s {
+                return err(format!(
+                    "{}: must not exceed static_friction = {}, got {}",
+                    ctx("dynamic_friction"),
+                    num(s),
+                    num(d)
+                ));
+            }
+            (s, d)
+        }
+        (None, Some(_), None) => {
+            return err(format!("{}: missing, required with static_friction", ctx("dynamic_friction")))
+        }
+        (None, None, Some(_)) => {
+            return err(format!("{}: missing, required with dynamic_friction", ctx("static_friction")))
+        }
+        (None, None, None) => {
+            return err(format!(
+                "{}: missing, give friction (or static_friction and dynamic_friction)",
+                ctx("friction")
+            ))
+        }
+    };
+    let restitution = match c.restitution {
+        Some(e) if e > 0.0 && e <= 1.0 => Some(e),
+        Some(e) => return err(format!("{}: must be in (0, 1], got {}", ctx("restitution"), num(e))),
+        None => None,
+    };
+    let model = match model {
+        md::Model::Hertz => {
+            if restitution.is_some() && c.normal_damping_ratio.is_some() {
+                return err(format!(
+                    "{}: give either restitution or normal_damping_ratio, not both",
+                    ctx("normal_damping_ratio")
+                ));
+            }
+            let alpha_n = non_negative(&ctx("normal_damping_ratio"), c.normal_damping_ratio.unwrap_or(0.0))?;
+            let alpha_t = match c.tangential_damping_ratio {
+                Some(r) => Some(non_negative(&ctx("tangential_damping_ratio"), r)?),
+                None => None,
+            };
+            CheckedModel::Hertz { restitution, alpha_n, alpha_t }
+        }
+        md::Model::Linear => {
+            let Some(kn) = c.normal_stiffness else {
+                return err(format!("{}: missing, required by model 'linear'", ctx("normal_stiffness")));
+            };
+            let Some(kt) = c.tangential_stiffness else {
+                return err(format!("{}: missing, required by model 'linear'", ctx("tangential_stiffness")));
+            };
+            let kn = positive(&ctx("normal_stiffness"), kn)?;
+            let kt = positive(&ctx("tangential_stiffness"), kt)?;
+            if restitution.is_some() && c.normal_damping.is_some() {
+                return err(format!("{}: give either restitution or normal_damping, not both", ctx("normal_damping")));
+            }
+            let gamma_n = non_negative(&ctx("normal_damping"), c.normal_damping.unwrap_or(0.0))?;
+            let gamma_t = non_negative(&ctx("tangential_damping"), c.tangential_damping.unwrap_or(0.0))?;
+            CheckedModel::Linear { kn, kt, restitution, gamma_n, gamma_t }
+        }
+    };
+    Ok(CheckedLaw { a, b, model, mu_s, mu_d })
+}
+
+/// Checks one `[[wall]]` (labelled `name`) of material `material`.
+fn check_wall(name: &str, w: &WallSpec, material: u32) -> Result<Wall> {
+    let ctx = |field: &str| format!("{name}: {field}");
+    let given = [w.plane.is_some(), w.disc.is_some(), w.cylinder.is_some()];
+    match given.iter().filter(|&&g| g).count() {
+        0 => return err(format!("{}: missing, give exactly one of plane, disc, cylinder", ctx("shape"))),
+        1 => {}
+        _ => return err(format!("{}: give exactly one of plane, disc, cylinder, not several", ctx("shape"))),
+    }
+    let shape = if let Some(p) = &w.plane {
+        Shape::Plane { point: point(&ctx("plane.point"), p.point)?, normal: direction(&ctx("plane.normal"), p.normal)? }
+    } else if let Some(d) = &w.disc {
+        Shape::Disc {
+            point: point(&ctx("disc.point"), d.point)?,
+            normal: direction(&ctx("disc.normal"), d.normal)?,
+            radius: length(&ctx("disc.radius"), d.radius)?,
+        }
+    } else {
+        let c = w.cylinder.as_ref().expect("one shape");
+        Shape::Cylinder {
+            axis_point: point(&ctx("cylinder.axis_point"), c.axis_point)?,
+            axis: direction(&ctx("cylinder.axis"), c.axis)?,
+            radius: length(&ctx("cylinder.radius"), c.radius)?,
+        }
+    };
+    let motion = match &w.servo {
+        None => Motion::Fixed,
+        Some(_) if w.cylinder.is_some() => {
+            return err(format!("{}: only plane and disc walls can be servo walls, not a cylinder", ctx("servo")))
+        }
+        Some(s) => check_servo(&ctx("servo"), s)?,
+    };
+    Ok(Wall::new(&w.name, material, shape, motion))
+}
+
+/// Checks a `servo` table (context `ctx`).
+fn check_servo(ctx: &str, s: &ServoSpec) -> Result<Motion> {
+    let f = |field: &str| format!("{ctx}.{field}");
+    let mass = positive(&f("mass"), s.mass)?;
+    let viscosity = non_negative(&f("viscosity"), s.viscosity)?;
+    let amplitude = finite(&f("amplitude"), s.amplitude.unwrap_or(0.0))?;
+    let period = non_negative(&f("period"), s.period.unwrap_or(0.0))?;
+    let drive = match (s.stress, s.force) {
+        (Some(_), Some(_)) => return err(format!("{ctx}: give either stress or force, not both")),
+        (None, None) => return err(format!("{ctx}: missing stress or force, give exactly one")),
+        (Some(base), None) => {
+            let base = finite(&f("stress"), base)?;
+            let area = match s.area {
+                Some(a) => Some(positive(&f("area"), a)?),
+                None => None,
+            };
+            Drive::Stress(History1 { base, amplitude, period }, area)
+        }
+        (None, Some(base)) => {
+            if s.area.is_some() {
+                return err(format!("{}: only with stress, not with force", f("area")));
+            }
+            Drive::Force(History1 { base: finite(&f("force"), base)?, amplitude, period })
+        }
+    };
+    Ok(Motion::Servo { mass, viscosity, drive })
+}
