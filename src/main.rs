@@ -29,6 +29,8 @@ use std::time::Instant;
 
 #[path = "cli/md_run.rs"]
 mod md_run;
+#[path = "cli/md_tests.rs"]
+mod md_tests;
 #[path = "cli/saussine.rs"]
 mod saussine;
 #[path = "cli/studies.rs"]
@@ -101,6 +103,12 @@ enum Command {
     /// The numerical experiments of Saussine et al. (2006): sample, loaded scenes, studies.
     #[command(subcommand)]
     Saussine(saussine::SaussineCommand),
+    /// The MD sample of Karrech et al. (2007), Table 1: deposit, cyclic plate load.
+    #[command(subcommand)]
+    Karrech(md_tests::KarrechCommand),
+    /// The cyclic triaxial box of David, García-Rojo, Herrmann & Luding: compression, cycles.
+    #[command(subcommand)]
+    Luding(md_tests::LudingCommand),
 }
 
 /// Why a command failed, and its exit code.
@@ -122,6 +130,8 @@ fn main() -> ExitCode {
         }
         Command::Deposit { grains, width, seed, dt, duration, out } => deposit(grains, width, seed, dt, duration, &out),
         Command::Saussine(cmd) => saussine::main(cmd),
+        Command::Karrech(cmd) => md_tests::karrech_main(cmd),
+        Command::Luding(cmd) => md_tests::luding_main(cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

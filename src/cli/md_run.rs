@@ -80,6 +80,15 @@ pub(crate) fn run(scene_path: &Path, scene_text: &str, out: &Path, opts: &RunOpt
         }
         (sys, series, MdRunSummary::default(), snapshots)
     };
+    let cycles_path = out.join("cycles.csv");
+    let recorder = scene.output.as_ref().and_then(|o| o.cycles).map(|c| {
+        let x0 = scene.bodies.iter().map(|b| ballast::md::V3::from(b.position)).collect();
+        io::md_cycles::MdCycleRecorder::new(c.frequency, x0)
+    });
+    if let (true, Some(r)) = (opts.resume, &recorder) {
+        io::cycles::truncate_rows(&cycles_path, r.cycles_at(sys.time)).map_err(Failure::Run)?;
+    }
+    let cycles_header = io::md_cycles::MdCycleRecorder::header(&sys);
     let threads = threads(&scene, opts);
     sys.set_threads(threads);
     sys.measure_every = 1;
@@ -116,6 +125,7 @@ pub(crate) fn run(scene_path: &Path, scene_text: &str, out: &Path, opts: &RunOpt
         .write(out)
     };
     for k in first..=last_step {
+        let t_before = sys.time;
         let stats = match sys.step() {
             Ok(stats) => stats,
             Err(e) => {
@@ -124,6 +134,9 @@ pub(crate) fn run(scene_path: &Path, scene_text: &str, out: &Path, opts: &RunOpt
             }
         };
         summary.add(&stats);
+        if let Some(row) = recorder.as_ref().and_then(|r| r.record(&sys, t_before)) {
+            io::md_cycles::append(&cycles_path, &cycles_header, &row).map_err(Failure::Run)?;
+        }
         let calm = equilibrium.is_some_and(|e| {
             let ep = if ratio { sys.gravitational_energy() + stats.elastic_energy } else { 0.0 };
             e.holds(stats.kinetic_energy, ep)

@@ -7,7 +7,9 @@
 //! gravitational above the lowest sphere bottom plus elastic,
 //! [`MdSystem::potential_energy`]), `contacts` (sphere–sphere; a contact with a
 //! symmetry image counts half), `wall_contacts`, `max_overlap` and
-//! `mean_overlap` (m, over all contacts), `coordination` (`(2 N_c + N_w) / N`);
+//! `mean_overlap` (m, over all contacts), `coordination` (`(2 N_c + N_w) / N`),
+//! `packing_fraction` (sphere volume over container section × sample height,
+//! [`MdSystem::packing_fraction_bulk`]; empty when the walls make no container);
 //! then `<wall>_force` for every wall in scene order (N, the normal force the
 //! spheres press it with, positive when pressed: [`MdSystem::wall_load`]; 0 for a
 //! cylinder, which has no single normal), then `<wall>_position` for every servo
@@ -20,7 +22,7 @@ use crate::md::{MdStepStats, MdSystem, Motion};
 use std::fmt::Write as _;
 
 /// The first columns of an MD `series.csv`, before the wall columns.
-pub const MD_SERIES_COLUMNS: [&str; 9] = [
+pub const MD_SERIES_COLUMNS: [&str; 10] = [
     "time",
     "kinetic_energy",
     "elastic_energy",
@@ -30,6 +32,7 @@ pub const MD_SERIES_COLUMNS: [&str; 9] = [
     "max_overlap",
     "mean_overlap",
     "coordination",
+    "packing_fraction",
 ];
 
 /// A CSV field: quoted (quotes doubled) if it holds a comma, a quote or a line break.
@@ -56,7 +59,7 @@ pub fn md_series_header(sys: &MdSystem) -> String {
 /// The row (without the newline) of the step of `sys` that returned `s`.
 pub fn md_series_row(sys: &MdSystem, s: &MdStepStats) -> String {
     let mut r = format!(
-        "{:e},{:e},{:e},{:e},{},{},{:e},{:e},{:e}",
+        "{:e},{:e},{:e},{:e},{},{},{:e},{:e},{:e},{}",
         s.time,
         s.kinetic_energy,
         s.elastic_energy,
@@ -65,7 +68,8 @@ pub fn md_series_row(sys: &MdSystem, s: &MdStepStats) -> String {
         s.wall_contacts,
         s.max_overlap,
         s.mean_overlap,
-        s.coordination
+        s.coordination,
+        sys.packing_fraction_bulk().map_or(String::new(), |p| format!("{p:e}"))
     );
     for w in &sys.walls {
         // 0 − F rather than −F: no `-0e0` for an untouched wall.

@@ -27,6 +27,7 @@ pub mod checkpoint;
 pub mod cycles;
 pub mod figures;
 pub mod final_state;
+pub mod md_cycles;
 pub mod md_series;
 pub mod md_state;
 pub mod run_figures;

@@ -31,7 +31,9 @@ pub struct MdSettings {
     pub skin: f64,
     /// Translational background damping `γ_b` (kg/s): `f = −γ_b v`.
     pub background_damping: f64,
-    /// Rotational background damping `γ_br` (kg·m²/s): `τ = −γ_br ω`.
+    /// Rotational background damping `γ_br` (kg/s): `τ = −γ_br r² ω` on a sphere of
+    /// radius `r` (Luding's form, so that `γ_br` has the unit of `γ_b`; the paper's
+    /// 0.05 kg/s then relaxes spins in `2/5 m/γ_br`, 8 ms for its 1 g spheres).
     pub background_rotational_damping: f64,
 }
 
@@ -490,7 +492,7 @@ impl MdSystem {
         if gb != 0.0 || gr != 0.0 {
             for i in 0..n {
                 p.f[i] -= p.v[i] * gb;
-                p.t[i] -= p.w[i] * gr;
+                p.t[i] -= p.w[i] * (gr * p.r[i] * p.r[i]);
             }
         }
         self.virial = w0.virial;

@@ -2,8 +2,8 @@
 //! and creep in powders and grains*, §§2–3: N spheres (radii Gaussian, mean
 //! 5 mm, standard deviation 0.7 mm, minimum 3 mm; ρ = 2000 kg/m³), linear
 //! contacts (k_n = 5000 N/m, k_t = 1000 N/m, γ₀ = 0.05 kg/s, γ_t = 0.01 kg/s,
-//! μ = 0.1 by default), background damping γ_b = 0.2 kg/s and γ_br = 0.05
-//! (kg·m²/s), Δt = 2·10⁻⁵ s, no gravity, six stress-controlled walls (mass 2 kg,
+//! μ = 0.1 by default), background damping γ_b = 0.2 kg/s and γ_br = 0.05 kg/s
+//! (torque −γ_br r² ω), Δt = 2·10⁻⁵ s, no gravity, six stress-controlled walls (mass 2 kg,
 //! viscosity 200 kg/s).
 //!
 //! 1. [`compression_scene`]: spheres on a cubic lattice (no overlap), all six

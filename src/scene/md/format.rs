@@ -140,6 +140,17 @@ pub struct MdOutput {
     /// Steps between two rows of `series.csv`, ≥ 1; default 1 (the last step always has a row).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub every: Option<u64>,
+    /// `[output.cycles]`: one row of `cycles.csv` per loading cycle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycles: Option<MdCycles>,
+}
+
+/// `[output.cycles]` of an MD scene: the loading frequency (Hz, > 0); a row of
+/// `cycles.csv` at every multiple of `1/frequency` (`io::md_cycles`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MdCycles {
+    pub frequency: f64,
 }
 
 /// `[[symmetry]]`: a symmetry plane (mirror images of the spheres near it).

@@ -177,6 +177,11 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
             return err(format!("output.every: must be at least 1, got {every}"));
         }
     }
+    if let Some(c) = scene.output.as_ref().and_then(|o| o.cycles) {
+        if !(c.frequency.is_finite() && c.frequency > 0.0) {
+            return err(format!("output.cycles.frequency: must be positive and finite, got {}", c.frequency));
+        }
+    }
 
     // [[symmetry]]
     if scene.symmetry.len() > 2 {

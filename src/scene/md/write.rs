@@ -118,6 +118,9 @@ pub(crate) fn to_toml(scene: &MdScene) -> String {
     if let Some(o) = &scene.output {
         out.push_str("\n[output]\n");
         opt(&mut out, "every", o.every, |e| e.to_string());
+        if let Some(c) = o.cycles {
+            let _ = writeln!(out, "cycles = {{ frequency = {} }}", float(c.frequency));
+        }
     }
     for s in &scene.symmetry {
         out.push_str("\n[[symmetry]]\n");

@@ -1,0 +1,440 @@
+//! `ballast karrech …` and `ballast luding …`: the ready-made MD tests.
+//!
+//! - `karrech deposit --out DIR`: the Table 1 sample of Karrech et al. (2007)
+//!   deposited under gravity until `E_c/E_p ≤ 10⁻⁶` (scene `DIR/deposit.toml`,
+//!   run in `DIR`), then the Fig. 3 figures from `series.csv`: apparent weight,
+//!   coordination number, packing fraction, kinetic and potential energy.
+//! - `karrech load --from DEPOSIT --out DIR --mode full|partial --cycles K`: the
+//!   deposited sample under the cyclic plate (§4), then `cycles.csv` (residual
+//!   displacement per cycle) and its figures.
+//! - `luding compress --out DIR --spheres N --friction μ`: isotropic compression of
+//!   the triaxial box of David et al.; `luding cycle --from COMPRESSED --out DIR
+//!   --cycles K`: the cyclic σ_xx, then `loops.csv` (σ_D, ε_D), `strain.csv`
+//!   (ε_N per cycle) and the figures of the paper's Figs. 2–5.
+//!
+//! Every run is an ordinary `ballast run` of a written scene: progress bar,
+//! checkpoints, `--resume`, `--vtk-every` and the outputs of `ballast run`.
+
+use super::{run, Failure, RunOptions};
+use ballast::io::figures::{line_chart, Axes, Series};
+use ballast::md::V3;
+use ballast::scenarios::karrech::{self, KarrechSpec, Loading};
+use ballast::scenarios::luding::{self, LudingSpec};
+use ballast::scene::MdScene;
+use ballast::Error;
+use clap::{Args, Subcommand, ValueEnum};
+use std::path::{Path, PathBuf};
+
+/// Options shared by every MD test run.
+#[derive(Debug, Args, Clone)]
+pub struct RunArgs {
+    /// Output directory.
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Steps between rows of `series.csv`.
+    #[arg(long, default_value_t = 1000)]
+    every: u64,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+    /// Continue a run from its checkpoint.
+    #[arg(long)]
+    resume: bool,
+    /// Wall-clock seconds between checkpoints.
+    #[arg(long, default_value_t = 300.0)]
+    checkpoint_every: f64,
+    /// VTK snapshots every N steps (0: none).
+    #[arg(long, default_value_t = 0)]
+    vtk_every: u64,
+    /// Force-evaluation threads (default: the cores, at most 2).
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+impl RunArgs {
+    fn options(&self) -> RunOptions {
+        RunOptions {
+            quiet: self.quiet,
+            checkpoint_every: self.checkpoint_every,
+            resume: self.resume,
+            vtk_every: self.vtk_every,
+            threads: self.threads.unwrap_or_else(super::default_threads),
+            ..RunOptions::default()
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Mode {
+    /// The whole top under the plate, Δσ = 14.15 kPa, 50 Hz.
+    Full,
+    /// 80 % of the top's area, Δσ = 5.87 kPa, 10 Hz.
+    Partial,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum KarrechCommand {
+    /// Deposits the Table 1 sample in a quarter cylinder under gravity.
+    Deposit {
+        /// Number of spheres (850: the paper's 13.6 N sample, a quarter of it).
+        #[arg(long, default_value_t = karrech::PAPER_SPHERES)]
+        spheres: usize,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Time step (s).
+        #[arg(long, default_value_t = 1e-7)]
+        dt: f64,
+        /// Longest deposit (s).
+        #[arg(long, default_value_t = 1.0)]
+        duration: f64,
+        /// Young's modulus of the spheres (Pa); lower it only for quick looks.
+        #[arg(long, default_value_t = 46.9e9)]
+        young: f64,
+        #[command(flatten)]
+        run: RunArgs,
+    },
+    /// Loads a deposited sample cyclically by a plate.
+    Load {
+        /// The deposit's output directory (its `final_scene.toml`).
+        #[arg(long, value_name = "DIR")]
+        from: PathBuf,
+        #[arg(long, value_enum, default_value_t = Mode::Full)]
+        mode: Mode,
+        #[arg(long, default_value_t = 10)]
+        cycles: u32,
+        #[command(flatten)]
+        run: RunArgs,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+pub enum LudingCommand {
+    /// Isotropic compression of the triaxial box at p₀ from all sides.
+    Compress {
+        /// Number of spheres (343, 1000, 1728, 3375 in the paper).
+        #[arg(long, default_value_t = 1728)]
+        spheres: usize,
+        /// Friction coefficient μ (0.1, 0.15, 0.2, 0.25, 0.5 in the paper).
+        #[arg(long, default_value_t = 0.1)]
+        friction: f64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Longest compression (s).
+        #[arg(long, default_value_t = 10.0)]
+        duration: f64,
+        #[command(flatten)]
+        run: RunArgs,
+    },
+    /// Cyclic σ_xx on a compressed box.
+    Cycle {
+        /// The compression's output directory (its `final_scene.toml` and `spec.json`).
+        #[arg(long, value_name = "DIR")]
+        from: PathBuf,
+        #[arg(long, default_value_t = 10)]
+        cycles: u32,
+        #[command(flatten)]
+        run: RunArgs,
+    },
+}
+
+fn input(msg: String) -> Failure {
+    Failure::Input(Error::Scene(msg))
+}
+
+fn write(path: &Path, text: &str) -> Result<(), Failure> {
+    if let Some(dir) = path.parent() {
+        ballast::io::create_output_dir(dir).map_err(Failure::Run)?;
+    }
+    std::fs::write(path, text).map_err(|e| Failure::Run(ballast::io::io_error(path, "write", e)))
+}
+
+/// Spheres `(radius, position)` and the built system of a finished run's final scene.
+fn final_state(dir: &Path) -> Result<ballast::md::MdSystem, Failure> {
+    let path = dir.join("final_scene.toml");
+    if !path.exists() {
+        return Err(input(format!("--from: no finished run in '{}' (no final_scene.toml)", dir.display())));
+    }
+    MdScene::load(&path).and_then(|s| s.build()).map_err(Failure::Input)
+}
+
+/// The `spec.json` a first stage left in its output directory.
+fn spec_json(dir: &Path) -> Result<serde_json::Value, Failure> {
+    let path = dir.join("spec.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| Failure::Input(ballast::io::io_error(&path, "read", e)))?;
+    serde_json::from_str(&text).map_err(|e| input(format!("{}: {e}", path.display())))
+}
+
+fn spheres_of(sys: &ballast::md::MdSystem) -> Vec<(f64, V3)> {
+    (0..sys.particles.len()).map(|i| (sys.particles.r[i], sys.particles.x[i])).collect()
+}
+
+pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
+    match cmd {
+        KarrechCommand::Deposit { spheres, seed, dt, duration, young, run: args } => {
+            if spheres == 0 || !(dt > 0.0 && duration > 0.0 && young > 0.0) {
+                return Err(input(format!(
+                    "karrech deposit: need spheres > 0, dt > 0, duration > 0, young > 0; got {spheres}, {dt}, {duration}, {young}"
+                )));
+            }
+            let spec = KarrechSpec { dt, duration, young, ..KarrechSpec::table1(spheres, seed) };
+            let scene = args.out.join("deposit.toml");
+            if !(args.resume && scene.exists()) {
+                write(&scene, &karrech::deposit_scene(&spec, args.every))?;
+                let json = format!("{{\"spheres\":{spheres},\"seed\":{seed},\"dt\":{dt:?},\"young\":{young:?}}}");
+                write(&args.out.join("spec.json"), &json)?;
+            }
+            run(&scene, &args.out, &args.options())?;
+            deposit_figures(&args.out)
+        }
+        KarrechCommand::Load { from, mode, cycles, run: args } => {
+            let sys = final_state(&from)?;
+            let v = spec_json(&from)?;
+            let spec = KarrechSpec {
+                dt: v["dt"].as_f64().unwrap_or(1e-7),
+                young: v["young"].as_f64().unwrap_or(46.9e9),
+                ..KarrechSpec::table1(sys.particles.len(), v["seed"].as_u64().unwrap_or(1))
+            };
+            let loading = if mode == Mode::Full { Loading::FULL } else { Loading::PARTIAL };
+            let scene = args.out.join("load.toml");
+            if !(args.resume && scene.exists()) {
+                write(&scene, &karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, args.every))?;
+            }
+            run(&scene, &args.out, &args.options())?;
+            load_figures(&args.out)
+        }
+    }
+}
+
+pub(crate) fn luding_main(cmd: LudingCommand) -> Result<(), Failure> {
+    match cmd {
+        LudingCommand::Compress { spheres, friction, seed, duration, run: args } => {
+            if spheres == 0 || !(friction >= 0.0 && duration > 0.0) {
+                return Err(input(format!(
+                    "luding compress: need spheres > 0, friction ≥ 0, duration > 0; got {spheres}, {friction}, {duration}"
+                )));
+            }
+            let spec = LudingSpec::paper(spheres, friction, seed);
+            let scene = args.out.join("compress.toml");
+            if !(args.resume && scene.exists()) {
+                write(&scene, &luding::compression_scene(&spec, duration, args.every))?;
+                write(
+                    &args.out.join("spec.json"),
+                    &format!("{{\"spheres\":{spheres},\"friction\":{friction:?},\"seed\":{seed}}}"),
+                )?;
+            }
+            run(&scene, &args.out, &args.options())
+        }
+        LudingCommand::Cycle { from, cycles, run: args } => {
+            let sys = final_state(&from)?;
+            let v = spec_json(&from)?;
+            let spec = LudingSpec::paper(
+                sys.particles.len(),
+                v["friction"].as_f64().unwrap_or(0.1),
+                v["seed"].as_u64().unwrap_or(1),
+            );
+            let (lo, hi) =
+                box_corners(&sys).ok_or_else(|| input("luding cycle: the compressed scene has no box".into()))?;
+            let scene = args.out.join("cycle.toml");
+            if !(args.resume && scene.exists()) {
+                write(&scene, &luding::cyclic_scene(&spec, &spheres_of(&sys), lo, hi, cycles, args.every))?;
+            }
+            run(&scene, &args.out, &args.options())?;
+            cycle_figures(&args.out, &spec, hi - lo)
+        }
+    }
+}
+
+/// Lower and upper corners of the box of axis-aligned plane walls.
+fn box_corners(sys: &ballast::md::MdSystem) -> Option<(V3, V3)> {
+    let mut lo = V3::repeat(f64::NAN);
+    let mut hi = V3::repeat(f64::NAN);
+    for w in &sys.walls {
+        let (n, p) = (w.normal()?, w.point()?);
+        let a = n.iamax();
+        if n[a] > 0.0 {
+            lo[a] = p[a];
+        } else {
+            hi[a] = p[a];
+        }
+    }
+    (lo.iter().chain(hi.iter()).all(|c| c.is_finite())).then_some((lo, hi))
+}
+
+/// The named columns of a CSV file of numbers.
+fn columns(path: &Path, names: &[&str]) -> Result<Vec<Vec<f64>>, Failure> {
+    let mut reader =
+        csv::Reader::from_path(path).map_err(|e| Failure::Run(Error::Scene(format!("{}: {e}", path.display()))))?;
+    let header = reader.headers().map_err(|e| Failure::Run(Error::Scene(format!("{}: {e}", path.display()))))?.clone();
+    let idx: Vec<usize> = names
+        .iter()
+        .map(|n| {
+            header
+                .iter()
+                .position(|h| h == *n)
+                .ok_or_else(|| Failure::Run(Error::Scene(format!("{}: no column '{n}'", path.display()))))
+        })
+        .collect::<Result<_, _>>()?;
+    let mut out = vec![Vec::new(); names.len()];
+    for rec in reader.records() {
+        let rec = rec.map_err(|e| Failure::Run(Error::Scene(format!("{}: {e}", path.display()))))?;
+        for (k, &i) in idx.iter().enumerate() {
+            out[k].push(rec.get(i).and_then(|s| s.parse().ok()).unwrap_or(f64::NAN));
+        }
+    }
+    Ok(out)
+}
+
+fn chart(
+    dir: &Path,
+    stem: &str,
+    title: &str,
+    x: &str,
+    y: &str,
+    log_y: bool,
+    series: Vec<Series>,
+) -> Result<(), Failure> {
+    let axes = Axes { title: title.into(), x_label: x.into(), y_label: y.into(), log_x: false, log_y };
+    line_chart(&dir.join(stem), &axes, &series).map_err(Failure::Run)
+}
+
+fn curve(label: &str, x: &[f64], y: &[f64]) -> Series {
+    Series {
+        label: label.into(),
+        points: x.iter().zip(y).filter(|(a, b)| a.is_finite() && b.is_finite()).map(|(a, b)| (*a, *b)).collect(),
+        band: Vec::new(),
+    }
+}
+
+/// Karrech et al. Fig. 3 from a deposit's `series.csv`.
+fn deposit_figures(dir: &Path) -> Result<(), Failure> {
+    let c = columns(
+        &dir.join("series.csv"),
+        &["time", "base_force", "coordination", "packing_fraction", "kinetic_energy", "potential_energy"],
+    )?;
+    let weight = final_state(dir)?.weight();
+    let t = &c[0];
+    let flat: Vec<f64> = t.iter().map(|_| weight).collect();
+    chart(
+        dir,
+        "fig3a_apparent_weight",
+        "Apparent weight on the base",
+        "time (s)",
+        "force (N)",
+        false,
+        vec![curve("apparent weight", t, &c[1]), curve("weight of the spheres", t, &flat)],
+    )?;
+    chart(dir, "fig3b_coordination", "Coordination number", "time (s)", "z", false, vec![curve("z", t, &c[2])])?;
+    chart(dir, "fig3c_packing_fraction", "Packing fraction", "time (s)", "φ", false, vec![curve("φ", t, &c[3])])?;
+    let ek: Vec<f64> = c[4].iter().map(|v| v.max(1e-30)).collect();
+    let ep: Vec<f64> = c[5].iter().map(|v| v.max(1e-30)).collect();
+    chart(
+        dir,
+        "fig3d_energies",
+        "Kinetic and potential energy",
+        "time (s)",
+        "energy (J)",
+        true,
+        vec![curve("kinetic E_c", t, &ek), curve("potential E_p", t, &ep)],
+    )?;
+    println!("figures fig3a–d written in {}", dir.display());
+    Ok(())
+}
+
+/// Residual displacement per cycle and the plate's motion.
+fn load_figures(dir: &Path) -> Result<(), Failure> {
+    let c = columns(&dir.join("cycles.csv"), &["cycle", "mean_displacement_z", "max_displacement"])?;
+    let down: Vec<f64> = c[1].iter().map(|v| -v).collect();
+    chart(
+        dir,
+        "residual_displacement",
+        "Residual displacement at the end of each cycle",
+        "cycle",
+        "displacement (m)",
+        false,
+        vec![curve("mean settlement of the spheres (−u_z)", &c[0], &down), curve("largest displacement", &c[0], &c[2])],
+    )?;
+    let s = columns(&dir.join("series.csv"), &["time", "plate_position", "plate_force"])?;
+    chart(
+        dir,
+        "plate",
+        "Loading plate",
+        "time (s)",
+        "displacement (m)",
+        false,
+        vec![curve("plate displacement (down)", &s[0], &s[1])],
+    )?;
+    println!("figures residual_displacement, plate written in {}", dir.display());
+    Ok(())
+}
+
+/// σ_D–ε_D loops and ε_N per cycle (David et al. Figs. 2–5).
+fn cycle_figures(dir: &Path, spec: &LudingSpec, l0: V3) -> Result<(), Failure> {
+    let c = columns(
+        &dir.join("series.csv"),
+        &[
+            "time",
+            "x0_force",
+            "x1_force",
+            "y0_force",
+            "y1_force",
+            "z0_position",
+            "z1_position",
+            "x0_position",
+            "x1_position",
+            "y0_position",
+            "y1_position",
+        ],
+    )?;
+    let n = c[0].len();
+    let mut loops = String::from("time,sigma_xx,sigma_yy,sigma_D,epsilon_D\n");
+    let (mut sd, mut ed) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for k in 0..n {
+        let l = V3::new(l0[0] - c[7][k] - c[8][k], l0[1] - c[9][k] - c[10][k], l0[2] - c[5][k] - c[6][k]);
+        let sxx = 0.5 * (c[1][k] + c[2][k]) / (l[1] * l[2]);
+        let syy = 0.5 * (c[3][k] + c[4][k]) / (l[0] * l[2]);
+        let (s, e) = ballast::md::measure::deviatoric(sxx, syy, l, l0);
+        loops.push_str(&format!("{:e},{sxx:e},{syy:e},{s:e},{e:e}\n", c[0][k]));
+        sd.push(s);
+        ed.push(e);
+    }
+    write(&dir.join("loops.csv"), &loops)?;
+    // ε_N: ε_D at the ends of the cycles (nearest row).
+    let mut strain = String::from("cycle,time,epsilon_N\n");
+    let (mut cyc, mut en) = (Vec::new(), Vec::new());
+    let total = c[0].last().copied().unwrap_or(0.0);
+    let mut k = 0;
+    for cycle in 1.. {
+        let t = cycle as f64 * spec.period;
+        if t > total + 0.5 * spec.period {
+            break;
+        }
+        while k + 1 < n && (c[0][k + 1] - t).abs() <= (c[0][k] - t).abs() {
+            k += 1;
+        }
+        strain.push_str(&format!("{cycle},{:e},{:e}\n", c[0][k], ed[k]));
+        cyc.push(cycle as f64);
+        en.push(ed[k]);
+    }
+    write(&dir.join("strain.csv"), &strain)?;
+    let sd_kpa: Vec<f64> = sd.iter().map(|s| s / 1e3).collect();
+    chart(
+        dir,
+        "stress_strain_loops",
+        &format!("σ_D vs ε_D, N = {}, μ = {}", spec.spheres, spec.friction),
+        "ε_D",
+        "σ_D (kPa)",
+        false,
+        vec![curve("", &ed, &sd_kpa)],
+    )?;
+    chart(
+        dir,
+        "strain_accumulation",
+        "Accumulated strain ε_N",
+        "cycle",
+        "ε_N",
+        false,
+        vec![curve(&format!("N = {}", spec.spheres), &cyc, &en)],
+    )?;
+    println!("loops.csv, strain.csv and figures written in {}", dir.display());
+    Ok(())
+}
