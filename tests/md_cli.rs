@@ -48,7 +48,7 @@ fn vector(v: &serde_json::Value) -> Vec<f64> {
 }
 
 const HEADER: &str =
-    "time,kinetic_energy,elastic_energy,potential_energy,contacts,wall_contacts,max_overlap,mean_overlap,coordination";
+    "time,kinetic_energy,elastic_energy,potential_energy,contacts,wall_contacts,max_overlap,mean_overlap,coordination,packing_fraction";
 
 #[test]
 fn the_example_writes_every_output() {
@@ -71,16 +71,16 @@ fn the_example_writes_every_output() {
     assert_eq!(lines.next().unwrap(), format!("{HEADER},base_force,mould_force"));
     let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
     assert_eq!(rows.len(), 200);
-    assert!(rows.iter().all(|r| r.len() == 11));
+    assert!(rows.iter().all(|r| r.len() == 12));
     assert!((rows[0][0] - 1e-3).abs() < 1e-12 && (rows[199][0] - 0.2).abs() < 1e-12);
     // At the end the spheres have landed and roll: the base carries the lower one
     // and at most the upper one too, within 1 %; the energy went down.
     let weight = 4.0 / 3.0 * std::f64::consts::PI * 0.0032f64.powi(3) * 2710.0 * 9.81;
     let (first, last) = (&rows[0], &rows[199]);
-    assert!(last[9] > 0.99 * weight && last[9] < 2.01 * weight, "base force {} vs weight {weight}", last[9]);
+    assert!(last[10] > 0.99 * weight && last[10] < 2.01 * weight, "base force {} vs weight {weight}", last[10]);
     assert!(last[1] + last[3] < first[1] + first[3], "energy {last:?} vs {first:?}");
     assert!(last[2] > 0.0 && last[5] >= 1.0, "{last:?}");
-    assert_eq!(last[10], 0.0, "a cylinder has no single normal force");
+    assert_eq!(last[11], 0.0, "a cylinder has no single normal force");
 
     // final.json: 3-component vectors, bodies and walls in scene order.
     let fin = json(&out.join("final.json"));

@@ -139,7 +139,8 @@ pub(crate) fn run(scene_path: &Path, scene_text: &str, out: &Path, opts: &RunOpt
         }
         let calm = equilibrium.is_some_and(|e| {
             let ep = if ratio { sys.gravitational_energy() + stats.elastic_energy } else { 0.0 };
-            e.holds(stats.kinetic_energy, ep)
+            // Moving servo walls are part of the motion that has to die out.
+            e.holds(stats.kinetic_energy + sys.wall_kinetic_energy(), ep)
         });
         summary.calm_steps = if calm { summary.calm_steps + 1 } else { 0 };
         at_equilibrium = equilibrium.is_some_and(|e| summary.calm_steps >= e.steps());

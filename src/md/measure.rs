@@ -152,3 +152,16 @@ impl MdSystem {
         Some(p.volume() / (section * (hi - lo)))
     }
 }
+
+impl MdSystem {
+    /// Kinetic energy of the servo walls `Σ ½ m_w ṡ²` (J).
+    pub fn wall_kinetic_energy(&self) -> f64 {
+        self.walls
+            .iter()
+            .map(|w| match w.motion {
+                super::walls::Motion::Servo { mass, .. } => 0.5 * mass * w.s_dot * w.s_dot,
+                super::walls::Motion::Fixed => 0.0,
+            })
+            .sum()
+    }
+}

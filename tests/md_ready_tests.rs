@@ -1,0 +1,136 @@
+//! The ready-made MD tests at small scale through the `ballast` binary:
+//! `karrech deposit` + `karrech load` and `luding compress` + `luding cycle`.
+//! The expected values are physics: at rest the base carries the spheres' weight,
+//! servo walls hold their prescribed stress, and the cyclic stress reaches
+//! `p₀ + Δσ` at mid-cycle.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn temp_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ballast-md-ready-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn ballast(args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_ballast")).args(args).output().unwrap();
+    assert!(out.status.success(), "ballast {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).to_string()
+}
+
+/// Rows of a CSV file as (header, numbers).
+fn csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines.map(|l| l.split(',').map(|v| v.parse().unwrap_or(f64::NAN)).collect()).collect();
+    (header, rows)
+}
+
+fn col(header: &[String], name: &str) -> usize {
+    header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"))
+}
+
+#[test]
+fn karrech_deposit_then_cyclic_load() {
+    let dir = temp_dir("karrech");
+    let (dep, load) = (dir.join("deposit"), dir.join("load"));
+    // 40 spheres of Table 1 sizes, softened (E = 10 MPa) so that a 2 µs step resolves contacts.
+    ballast(&["karrech", "deposit", "--out", dep.to_str().unwrap(), "--spheres", "40", "--young", "1e7", "--dt", "2e-6"]
+        .iter()
+        .chain(&["--duration", "0.6", "--every", "1000", "--quiet"])
+        .copied()
+        .collect::<Vec<_>>());
+    let scene = std::fs::read_to_string(dep.join("deposit.toml")).unwrap();
+    assert_eq!(scene.matches("[[body]]").count(), 40);
+    assert_eq!(scene.matches("[[symmetry]]").count(), 2);
+    assert!(scene.contains("radius = 0.075"));
+    for fig in ["fig3a_apparent_weight", "fig3b_coordination", "fig3c_packing_fraction", "fig3d_energies"] {
+        assert!(dep.join(format!("{fig}.png")).exists() && dep.join(format!("{fig}.svg")).exists(), "{fig}");
+    }
+    // At rest, 40 spheres lie in one layer on the base of a quarter cylinder of
+    // radius 75 mm: the base carries their weight but for what the cylinder's
+    // friction holds, which needs spheres pressed against it (few here); the
+    // kinetic energy left after 0.6 s is < 1e-5 of the potential. 3 %.
+    let (h, rows) = csv(&dep.join("series.csv"));
+    let last = rows.last().unwrap();
+    let final_json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dep.join("final.json")).unwrap()).unwrap();
+    let weight: f64 = final_json["bodies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| {
+            let r = b["radius"].as_f64().unwrap();
+            2710.0 * 4.0 / 3.0 * std::f64::consts::PI * r * r * r * 9.81
+        })
+        .sum();
+    let base = last[col(&h, "base_force")];
+    assert!((base - weight).abs() < 0.03 * weight, "base {base} N vs weight {weight} N");
+    let phi = last[col(&h, "packing_fraction")];
+    assert!(phi > 0.0 && phi < 0.74, "packing fraction {phi}");
+
+    ballast(&["karrech", "load", "--from", dep.to_str().unwrap(), "--out", load.to_str().unwrap(), "--cycles", "2"]
+        .iter()
+        .chain(&["--every", "500", "--quiet"])
+        .copied()
+        .collect::<Vec<_>>());
+    let (h, rows) = csv(&load.join("cycles.csv"));
+    assert_eq!(rows.len(), 2, "one row per cycle");
+    // Rows at t = k/f, f = 50 Hz, to within a step (2 µs).
+    for (k, r) in rows.iter().enumerate() {
+        assert!((r[col(&h, "time")] - (k + 1) as f64 / 50.0).abs() <= 2e-6 + 1e-12);
+    }
+    assert!(h.contains(&"plate_position".to_string()));
+    assert!(load.join("residual_displacement.png").exists());
+}
+
+#[test]
+fn luding_compression_then_one_cycle() {
+    let dir = temp_dir("luding");
+    let (comp, cyc) = (dir.join("compress"), dir.join("cycle"));
+    ballast(&["luding", "compress", "--out", comp.to_str().unwrap(), "--spheres", "27", "--duration", "3", "--every", "2000"]
+        .iter()
+        .chain(&["--quiet"])
+        .copied()
+        .collect::<Vec<_>>());
+    // At equilibrium each wall holds p₀ = 1 kPa: the spheres' push over the face
+    // area (from the wall positions). Walls at rest within E_k/E_p ≤ 1e-4: 2 %.
+    let (h, rows) = csv(&comp.join("series.csv"));
+    let last = rows.last().unwrap();
+    let scene = std::fs::read_to_string(comp.join("compress.toml")).unwrap();
+    assert!(scene.contains("equilibrium"));
+    let l0 = {
+        // The lattice box: 3 spheres a side at pitch 1.05 × the largest diameter.
+        let final_scene = std::fs::read_to_string(comp.join("final_scene.toml")).unwrap();
+        assert!(final_scene.contains("[[wall]]"));
+        let f: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(comp.join("final.json")).unwrap()).unwrap();
+        let r_max = f["bodies"].as_array().unwrap().iter().map(|b| b["radius"].as_f64().unwrap()).fold(0.0, f64::max);
+        3.0 * 2.0 * r_max * 1.05
+    };
+    let l = |a: &str| l0 - last[col(&h, &format!("{a}0_position"))] - last[col(&h, &format!("{a}1_position"))];
+    let (lx, ly, lz) = (l("x"), l("y"), l("z"));
+    for (wall, area) in [("x0", ly * lz), ("x1", ly * lz), ("y0", lx * lz), ("z1", lx * ly)] {
+        let s = last[col(&h, &format!("{wall}_force"))] / area;
+        assert!((s - 1000.0).abs() < 20.0, "{wall}: {s} Pa");
+    }
+
+    ballast(&["luding", "cycle", "--from", comp.to_str().unwrap(), "--out", cyc.to_str().unwrap(), "--cycles", "1"]
+        .iter()
+        .chain(&["--every", "1000", "--quiet"])
+        .copied()
+        .collect::<Vec<_>>());
+    let (h, rows) = csv(&cyc.join("loops.csv"));
+    // σ_xx follows p₀ + Δσ(1 − cos 2πt/t₀)/2: 1200 Pa at t = 5 s; the walls lag the
+    // stress by their relaxation time m/γ = 0.01 s ≪ 10 s, and the box keeps
+    // σ_yy at p₀. 3 % (the spheres' own dynamics on 27 spheres).
+    let mid = rows.iter().min_by(|a, b| (a[0] - 5.0).abs().total_cmp(&(b[0] - 5.0).abs())).unwrap();
+    assert!((mid[col(&h, "sigma_xx")] - 1200.0).abs() < 36.0, "σ_xx {}", mid[col(&h, "sigma_xx")]);
+    assert!((mid[col(&h, "sigma_yy")] - 1000.0).abs() < 30.0, "σ_yy {}", mid[col(&h, "sigma_yy")]);
+    let (_, strain) = csv(&cyc.join("strain.csv"));
+    assert_eq!(strain.len(), 1);
+    assert!(cyc.join("stress_strain_loops.png").exists() && cyc.join("strain_accumulation.svg").exists());
+}
