@@ -38,11 +38,13 @@ fn karrech_deposit_then_cyclic_load() {
     let dir = temp_dir("karrech");
     let (dep, load) = (dir.join("deposit"), dir.join("load"));
     // 40 spheres of Table 1 sizes, softened (E = 10 MPa) so that a 2 µs step resolves contacts.
-    ballast(&["karrech", "deposit", "--out", dep.to_str().unwrap(), "--spheres", "40", "--young", "1e7", "--dt", "2e-6"]
-        .iter()
-        .chain(&["--duration", "0.6", "--every", "1000", "--quiet"])
-        .copied()
-        .collect::<Vec<_>>());
+    ballast(
+        &["karrech", "deposit", "--out", dep.to_str().unwrap(), "--spheres", "40", "--young", "1e7", "--dt", "2e-6"]
+            .iter()
+            .chain(&["--duration", "0.6", "--every", "1000", "--quiet"])
+            .copied()
+            .collect::<Vec<_>>(),
+    );
     let scene = std::fs::read_to_string(dep.join("deposit.toml")).unwrap();
     assert_eq!(scene.matches("[[body]]").count(), 40);
     assert_eq!(scene.matches("[[symmetry]]").count(), 2);
@@ -72,11 +74,13 @@ fn karrech_deposit_then_cyclic_load() {
     let phi = last[col(&h, "packing_fraction")];
     assert!(phi > 0.0 && phi < 0.74, "packing fraction {phi}");
 
-    ballast(&["karrech", "load", "--from", dep.to_str().unwrap(), "--out", load.to_str().unwrap(), "--cycles", "2"]
-        .iter()
-        .chain(&["--every", "500", "--quiet"])
-        .copied()
-        .collect::<Vec<_>>());
+    ballast(
+        &["karrech", "load", "--from", dep.to_str().unwrap(), "--out", load.to_str().unwrap(), "--cycles", "2"]
+            .iter()
+            .chain(&["--every", "500", "--quiet"])
+            .copied()
+            .collect::<Vec<_>>(),
+    );
     let (h, rows) = csv(&load.join("cycles.csv"));
     assert_eq!(rows.len(), 2, "one row per cycle");
     // Rows at t = k/f, f = 50 Hz, to within a step (2 µs).
@@ -91,11 +95,24 @@ fn karrech_deposit_then_cyclic_load() {
 fn luding_compression_then_one_cycle() {
     let dir = temp_dir("luding");
     let (comp, cyc) = (dir.join("compress"), dir.join("cycle"));
-    ballast(&["luding", "compress", "--out", comp.to_str().unwrap(), "--spheres", "27", "--duration", "3", "--every", "2000"]
+    ballast(
+        &[
+            "luding",
+            "compress",
+            "--out",
+            comp.to_str().unwrap(),
+            "--spheres",
+            "27",
+            "--duration",
+            "3",
+            "--every",
+            "2000",
+        ]
         .iter()
         .chain(&["--quiet"])
         .copied()
-        .collect::<Vec<_>>());
+        .collect::<Vec<_>>(),
+    );
     // At equilibrium each wall holds p₀ = 1 kPa: the spheres' push over the face
     // area (from the wall positions). Walls at rest within E_k/E_p ≤ 1e-4: 2 %.
     let (h, rows) = csv(&comp.join("series.csv"));
@@ -118,11 +135,13 @@ fn luding_compression_then_one_cycle() {
         assert!((s - 1000.0).abs() < 20.0, "{wall}: {s} Pa");
     }
 
-    ballast(&["luding", "cycle", "--from", comp.to_str().unwrap(), "--out", cyc.to_str().unwrap(), "--cycles", "1"]
-        .iter()
-        .chain(&["--every", "1000", "--quiet"])
-        .copied()
-        .collect::<Vec<_>>());
+    ballast(
+        &["luding", "cycle", "--from", comp.to_str().unwrap(), "--out", cyc.to_str().unwrap(), "--cycles", "1"]
+            .iter()
+            .chain(&["--every", "1000", "--quiet"])
+            .copied()
+            .collect::<Vec<_>>(),
+    );
     let (h, rows) = csv(&cyc.join("loops.csv"));
     // σ_xx follows p₀ + Δσ(1 − cos 2πt/t₀)/2: 1200 Pa at t = 5 s; the walls lag the
     // stress by their relaxation time m/γ = 0.01 s ≪ 10 s, and the box keeps

@@ -388,6 +388,7 @@ fn cycle_figures(dir: &Path, spec: &LudingSpec, l0: V3) -> Result<(), Failure> {
     let n = c[0].len();
     let mut loops = String::from("time,sigma_xx,sigma_yy,sigma_D,epsilon_D\n");
     let (mut sd, mut ed) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    #[allow(clippy::needless_range_loop)]
     for k in 0..n {
         let l = V3::new(l0[0] - c[7][k] - c[8][k], l0[1] - c[9][k] - c[10][k], l0[2] - c[5][k] - c[6][k]);
         let sxx = 0.5 * (c[1][k] + c[2][k]) / (l[1] * l[2]);

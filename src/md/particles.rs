@@ -54,6 +54,7 @@ impl Particles {
 
     /// Adds a solid sphere of radius `r` (m) and density `density` (kg/m³) made of
     /// `material`, at `x` with velocity `v` and spin `w`; returns its index.
+    #[allow(clippy::too_many_arguments)]
     pub fn push(&mut self, name: &str, material: u32, density: f64, r: f64, x: V3, v: V3, w: V3) -> usize {
         let m = density * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
         self.x.push(x);

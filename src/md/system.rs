@@ -266,7 +266,7 @@ impl MdSystem {
         if self.needs_rebuild() {
             self.rebuild();
         }
-        let measure = (self.step + 1) % self.measure_every.max(1) == 0;
+        let measure = (self.step + 1).is_multiple_of(self.measure_every.max(1));
         let stats = match self.evaluate(dt, measure) {
             Ok(s) => s,
             Err(e) => {
@@ -314,7 +314,7 @@ impl MdSystem {
         };
         let stats = MdStepStats { time: self.time, kinetic_energy: kinetic, ..stats };
         self.last = stats;
-        if self.step % BACKUP_EVERY == 0 {
+        if self.step.is_multiple_of(BACKUP_EVERY) {
             self.save_backup();
         }
         Ok(stats)
@@ -424,6 +424,7 @@ impl MdSystem {
         let mut bounds = [0usize; CHUNKS + 1];
         let chunks = CHUNKS;
         let mut row = 0;
+        #[allow(clippy::needless_range_loop)]
         for c in 1..chunks {
             let target = total * c / chunks;
             while row < n && (self.neighbours.start[row] as usize) < target {
@@ -746,16 +747,15 @@ fn second_half(c: View, integrator: Integrator, g: V3, dt: f64) -> f64 {
         }
         Integrator::Gear(set) => {
             let coef = set.coefficients();
-            let q = coef.len();
             let h2 = 0.5 * dt * dt;
             for i in 0..c.x.len() {
                 let dx = (c.f[i] * c.inv_m[i] + g) * h2 - c.gx[i][2];
                 let dw = c.t[i] * (c.inv_i[i] * h2) - c.gw[i][2];
-                for k in 0..q {
-                    c.gx[i][k] += dx * coef[k];
-                }
-                for k in 1..q {
-                    c.gw[i][k] += dw * coef[k];
+                for (k, ck) in coef.iter().enumerate() {
+                    c.gx[i][k] += dx * *ck;
+                    if k > 0 {
+                        c.gw[i][k] += dw * *ck;
+                    }
                 }
                 c.x[i] = c.gx[i][0];
                 c.v[i] = c.gx[i][1] / dt;
