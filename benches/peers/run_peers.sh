@@ -14,7 +14,8 @@
 #      REPEAT (default 1: repeat each in.dense this many times),
 #      LMP, LIGGGHTS (executables), MODELS (LAMMPS models, default "0";
 #      "0 1" also times `granular hertz/material` if settled_N_1.restart exists),
-#      LAMMPS_NP (default 1; >1 runs LAMMPS under mpirun -np, code name lammps-npK).
+#      LAMMPS_NP (default 1; >1 runs LAMMPS under mpirun -np with `processors * 1 1`,
+#      code name lammps-npK).
 set -u
 PEERS_DIR=${PEERS_DIR:-/work/peers-run}
 NSTEPS=${NSTEPS:-10000}
@@ -60,15 +61,20 @@ for N in 2000 8000; do
     [ -f "$rs" ] || { [ "$N" = 2000 ] && [ "$model" = 0 ] && echo "missing $rs" >&2 && status=1; continue; }
     [ -n "$LMP" ] || { echo "no lmp executable (set LMP or PEERS_DIR)" >&2; status=1; break; }
     code=lammps; [ "$model" = 1 ] && code=lammps-granular
-    launch=("$LMP")
+    launch=("$LMP"); infile=in.dense
     if [ "$LAMMPS_NP" -gt 1 ]; then
       [ -n "$MPIRUN" ] || { echo "no mpirun for LAMMPS_NP=$LAMMPS_NP" >&2; status=1; continue; }
       launch=("$MPIRUN" -np "$LAMMPS_NP" "$LMP"); code="${code}-np${LAMMPS_NP}"
+      # default grid splits along z (the tall box) and puts ~all atoms of the bed on one
+      # rank; in.dense_np = in.dense with `processors * 1 1` before read_restart.
+      sed 's/^read_restart/processors      * 1 1\nread_restart/' "$PEERS_DIR/lammps/in.dense" \
+        > "$PEERS_DIR/lammps/in.dense_np"
+      infile=in.dense_np
     fi
     for r in $(seq 1 "$REPEAT"); do
       log="$LOGDIR/${code}_${N}_${stamp}_$r.log"
-      ( cd "$PEERS_DIR/lammps" && "${launch[@]}" -in in.dense -var N "$N" -var L "$L" \
-          -var model "$model" -var nsteps "$NSTEPS" -log "$log" -screen none ) || status=1
+      ( cd "$PEERS_DIR/lammps" && "${launch[@]}" -in "$infile" -var N "$N" -var L "$L" \
+          -var model "$model" -var nsteps "$NSTEPS" -log "$log" -screen none >/dev/null ) || status=1
       echo "# $code N=$N segments: $(segments_from_log "$log")  log=$log" >&2
       echo "$code $N $(rate_from_log "$log")"
     done
@@ -80,7 +86,7 @@ for N in 2000 8000; do
     for r in $(seq 1 "$REPEAT"); do
       log="$LOGDIR/liggghts_${N}_${stamp}_$r.log"
       ( cd "$PEERS_DIR/liggghts" && "$LIGGGHTS" -in in.dense -var N "$N" -var L "$L" \
-          -var nsteps "$NSTEPS" -log "$log" -screen none ) || status=1
+          -var nsteps "$NSTEPS" -log "$log" -screen none >/dev/null ) || status=1
       echo "# liggghts N=$N segments: $(segments_from_log "$log")  log=$log" >&2
       echo "liggghts $N $(rate_from_log "$log")"
     done
