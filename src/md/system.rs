@@ -248,19 +248,7 @@ impl MdSystem {
         let threads = self.threads;
         let integrator = self.settings.integrator;
         {
-            let p = &mut self.particles;
-            let mut view = View {
-                x: &mut p.x,
-                v: &mut p.v,
-                w: &mut p.w,
-                f: &p.f,
-                t: &p.t,
-                inv_m: &p.inv_m,
-                inv_i: &p.inv_i,
-                q: &mut p.q,
-                gx: &mut self.gear_x,
-                gw: &mut self.gear_w,
-            };
+            let mut view = self.view();
             par_for(&mut view, threads, &|c: View| first_half(c, integrator, g, dt));
         }
         if self.needs_rebuild() {
@@ -275,19 +263,7 @@ impl MdSystem {
             }
         };
         let kinetic = {
-            let p = &mut self.particles;
-            let mut view = View {
-                x: &mut p.x,
-                v: &mut p.v,
-                w: &mut p.w,
-                f: &p.f,
-                t: &p.t,
-                inv_m: &p.inv_m,
-                inv_i: &p.inv_i,
-                q: &mut p.q,
-                gx: &mut self.gear_x,
-                gw: &mut self.gear_w,
-            };
+            let mut view = self.view();
             par_for(&mut view, threads, &|c: View| second_half(c, integrator, g, dt))
         };
         walls::advance(&mut self.walls, self.time + dt, dt);
@@ -318,6 +294,23 @@ impl MdSystem {
             self.save_backup();
         }
         Ok(stats)
+    }
+
+    /// The integrator's view of the sphere arrays.
+    fn view(&mut self) -> View<'_> {
+        let p = &mut self.particles;
+        View {
+            x: &mut p.x,
+            v: &mut p.v,
+            w: &mut p.w,
+            f: &p.f,
+            t: &p.t,
+            inv_m: &p.inv_m,
+            inv_i: &p.inv_i,
+            q: &mut p.q,
+            gx: &mut self.gear_x,
+            gw: &mut self.gear_w,
+        }
     }
 
     fn diverged(&self, body: usize, what: String) -> Error {
