@@ -396,7 +396,10 @@ fn syntax_errors_unknown_keys_missing_keys_and_vector_lengths() {
     expect(&edit("[simulation]", "[simulation"), &["scene.toml line 2:"]);
     expect(&edit("dt = 1e-6\n", ""), &["missing field `dt`"]);
     expect(&edit("duration = 1e-4\n", "duration = 1e-4\n\n[output]\ncycle = 3\n"), &["unknown field `cycle`"]);
-    expect(&edit("duration = 1e-4\n", "duration = 1e-4\n\n[output]\ncycles = 3\n"), &["line", "expected struct MdCycles"]);
+    expect(
+        &edit("duration = 1e-4\n", "duration = 1e-4\n\n[output]\ncycles = 3\n"),
+        &["line", "expected struct MdCycles"],
+    );
     expect(
         &edit("duration = 1e-4\n", "duration = 1e-4\n\n[output]\ncycles = { frequency = -1.0 }\n"),
         &["output.cycles.frequency: must be positive and finite, got -1"],
