@@ -17,7 +17,7 @@
 //! then hold the last good state) or an output file cannot be written.
 
 use ballast::io::vtk::PvdCollection;
-use ballast::io::{self, Checkpoint, FinalState, RunInfo, RunReport, RunSummary, SeriesWriter, CHECKPOINT_FILE};
+use ballast::io::{self, Checkpoint, FinalState, RunReport, RunSummary, SeriesWriter, CHECKPOINT_FILE};
 use ballast::nscd::StepStats;
 use ballast::scene::Scene;
 use ballast::Error;
@@ -244,6 +244,36 @@ pub(crate) struct RunOptions {
     pub progress: Option<(indicatif::MultiProgress, String)>,
 }
 
+/// Writes `run.json` (seed, engine, crate version, steps, time step) in `out`.
+pub(crate) fn write_run_info(out: &Path, seed: u64, engine: &str, steps: u64, dt: f64) -> Result<(), Failure> {
+    let info =
+        io::RunInfo { seed, engine: engine.to_string(), version: env!("CARGO_PKG_VERSION").to_string(), steps, dt };
+    info.write(out).map(|_| ()).map_err(Failure::Run)
+}
+
+/// Writes `final_scene.toml`: `state` (the scene holding the final state, as TOML)
+/// under a header naming the crate version, the input scene, the time and the step.
+pub(crate) fn write_final_scene(
+    out: &Path,
+    scene_path: &Path,
+    time: f64,
+    step: u64,
+    state: &str,
+) -> Result<(), Failure> {
+    let text = format!(
+        "# Written by ballast {}: the state of {} at t = {time} s (step {step}).\n\
+         # Rerun it with `ballast run`; time restarts at 0.\n\n{state}",
+        env!("CARGO_PKG_VERSION"),
+        scene_path.display().to_string().replace(char::is_control, "?"),
+    );
+    io::write_text(out, "final_scene.toml", &text).map(|_| ()).map_err(Failure::Run)
+}
+
+/// The line printed when a run stops on request (`--stop-after`), leaving a checkpoint.
+pub(crate) fn print_stopped(step: u64, steps: u64, time: f64, elapsed_s: f64) {
+    println!("stopped at step {step} of {steps} (t = {time:.6} s) after {elapsed_s:.2} s; continue with --resume");
+}
+
 /// `ballast run`: the engine of the scene (`[simulation] engine`) runs it.
 pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<(), Failure> {
     let scene_text = Scene::read_text(scene_path).map_err(Failure::Input)?;
@@ -278,14 +308,7 @@ pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<()
         io::remove_stale(out, "final_scene.toml").map_err(Failure::Run)?;
         io::remove_stale(out, CHECKPOINT_FILE).map_err(Failure::Run)?;
         io::copy_scene(scene_path, out).map_err(Failure::Run)?;
-        let info = RunInfo {
-            seed: scene.seed(),
-            engine: scene.simulation.engine.clone(),
-            version: env!("CARGO_PKG_VERSION").to_string(),
-            steps,
-            dt: scene.simulation.dt,
-        };
-        info.write(out).map_err(Failure::Run)?;
+        write_run_info(out, scene.seed(), &scene.simulation.engine, steps, scene.simulation.dt)?;
         let series = SeriesWriter::create(&out.join("series.csv")).map_err(Failure::Run)?;
         let mut snapshots = PvdCollection::new();
         if opts.vtk_every > 0 {
@@ -388,12 +411,7 @@ pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<()
         // Stopped on request: leave a checkpoint and nothing that looks final.
         checkpoint(&sys, &mut series, summary, &snapshots, &cycles).map_err(Failure::Run)?;
         series.finish().map_err(Failure::Run)?;
-        println!(
-            "stopped at step {} of {steps} (t = {:.6} s) after {:.2} s; continue with --resume",
-            sys.step,
-            sys.time,
-            started.elapsed().as_secs_f64()
-        );
+        print_stopped(sys.step, steps, sys.time, started.elapsed().as_secs_f64());
         return Ok(());
     }
     if let Some((stats, false)) = last {
@@ -414,16 +432,7 @@ pub(crate) fn run(scene_path: &Path, out: &Path, opts: &RunOptions) -> Result<()
     }
     io::remove_stale(out, CHECKPOINT_FILE).map_err(Failure::Run)?;
     let state = scene.with_state(&sys).to_toml_string().map_err(Failure::Run)?;
-    let final_scene = format!(
-        "# Written by ballast {}: the state of {} at t = {} s (step {}).\n\
-         # Rerun it with `ballast run`; time restarts at 0.\n\n{}",
-        env!("CARGO_PKG_VERSION"),
-        scene_path.display().to_string().replace(char::is_control, "?"),
-        sys.time,
-        sys.step,
-        state
-    );
-    io::write_text(out, "final_scene.toml", &final_scene).map_err(Failure::Run)?;
+    write_final_scene(out, scene_path, sys.time, sys.step, &state)?;
 
     let energy = last.map_or(0.0, |(s, _)| s.kinetic_energy);
     println!(

@@ -16,10 +16,12 @@
 //! 2000-sphere bed this costs a few per cent of the step (within the noise of the
 //! measurement).
 
-use crate::{check_checkpoint_every, progress_bar, Failure, RunOptions};
+use crate::{
+    check_checkpoint_every, print_stopped, progress_bar, write_final_scene, write_run_info, Failure, RunOptions,
+};
 use ballast::io::vtk::PvdCollection;
 use ballast::io::{
-    self, md_series_header, md_series_row, Checkpoint, MdFinalState, MdRunReport, MdRunSummary, RunInfo, SeriesWriter,
+    self, md_series_header, md_series_row, Checkpoint, MdFinalState, MdRunReport, MdRunSummary, SeriesWriter,
     CHECKPOINT_FILE,
 };
 use ballast::md::{MdStepStats, MdSystem};
@@ -62,14 +64,7 @@ pub(crate) fn run(scene_path: &Path, scene_text: &str, out: &Path, opts: &RunOpt
             io::remove_stale(out, stale).map_err(Failure::Run)?;
         }
         io::copy_scene(scene_path, out).map_err(Failure::Run)?;
-        let info = RunInfo {
-            seed: scene.seed(),
-            engine: scene.simulation.engine.clone(),
-            version: env!("CARGO_PKG_VERSION").to_string(),
-            steps,
-            dt: scene.simulation.dt,
-        };
-        info.write(out).map_err(Failure::Run)?;
+        write_run_info(out, scene.seed(), &scene.simulation.engine, steps, scene.simulation.dt)?;
         let series = SeriesWriter::with_header(&series_path, &md_series_header(&sys)).map_err(Failure::Run)?;
         let mut snapshots = PvdCollection::new();
         if opts.vtk_every > 0 {
@@ -135,7 +130,7 @@ pub(crate) fn run(scene_path: &Path, scene_text: &str, out: &Path, opts: &RunOpt
         };
         summary.add(&stats);
         if let Some(row) = recorder.as_ref().and_then(|r| r.record(&sys, t_before)) {
-            io::md_cycles::append(&cycles_path, &cycles_header, &row).map_err(Failure::Run)?;
+            io::cycles::append_with_header(&cycles_path, &cycles_header, &row).map_err(Failure::Run)?;
         }
         let calm = equilibrium.is_some_and(|e| {
             let ep = if ratio { sys.gravitational_energy() + stats.elastic_energy } else { 0.0 };
@@ -175,12 +170,7 @@ pub(crate) fn run(scene_path: &Path, scene_text: &str, out: &Path, opts: &RunOpt
         // Stopped on request: leave a checkpoint and nothing that looks final.
         checkpoint(&sys, &mut series, summary, &snapshots).map_err(Failure::Run)?;
         series.finish().map_err(Failure::Run)?;
-        println!(
-            "stopped at step {} of {steps} (t = {:.6} s) after {:.2} s; continue with --resume",
-            sys.step,
-            sys.time,
-            started.elapsed().as_secs_f64()
-        );
+        print_stopped(sys.step, steps, sys.time, started.elapsed().as_secs_f64());
         return Ok(());
     }
     // After a divergence the engine holds its last saved good state (at most a
@@ -196,16 +186,7 @@ pub(crate) fn run(scene_path: &Path, scene_text: &str, out: &Path, opts: &RunOpt
     }
     io::remove_stale(out, CHECKPOINT_FILE).map_err(Failure::Run)?;
     let state = scene.with_state(&sys).to_toml_string().map_err(Failure::Run)?;
-    let final_scene = format!(
-        "# Written by ballast {}: the state of {} at t = {} s (step {}).\n\
-         # Rerun it with `ballast run`; time restarts at 0.\n\n{}",
-        env!("CARGO_PKG_VERSION"),
-        scene_path.display().to_string().replace(char::is_control, "?"),
-        sys.time,
-        sys.step,
-        state
-    );
-    io::write_text(out, "final_scene.toml", &final_scene).map_err(Failure::Run)?;
+    write_final_scene(out, scene_path, sys.time, sys.step, &state)?;
 
     println!(
         "{} steps to t = {:.6} s{} in {:.2} s ({:.3e} particle-steps/s on {threads} threads): {} spheres, final \

@@ -134,11 +134,17 @@ pub fn truncate_rows(path: &Path, rows: u64) -> Result<()> {
 
 /// Appends `row` (and the header first if the file is new) to `path`.
 pub fn append_row(path: &Path, row: &str) -> Result<()> {
+    append_with_header(path, CYCLES_HEADER, row)
+}
+
+/// Appends `row` to `path`, writing `header` first if the file is new (the
+/// per-cycle files of both engines).
+pub fn append_with_header(path: &Path, header: &str, row: &str) -> Result<()> {
     let new = !path.exists();
     let mut f =
         std::fs::OpenOptions::new().create(true).append(true).open(path).map_err(|e| io_error(path, "open", e))?;
     if new {
-        writeln!(f, "{CYCLES_HEADER}").map_err(|e| io_error(path, "write", e))?;
+        writeln!(f, "{header}").map_err(|e| io_error(path, "write", e))?;
     }
     writeln!(f, "{row}").map_err(|e| io_error(path, "write", e))
 }

@@ -64,18 +64,3 @@ impl MdCycleRecorder {
         Some(row)
     }
 }
-
-/// Appends `row` to `path`, writing `header` first if the file is new.
-pub fn append(path: &std::path::Path, header: &str, row: &str) -> crate::Result<()> {
-    use std::io::Write;
-    let new = !path.exists();
-    let mut f = std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(path)
-        .map_err(|e| super::io_error(path, "open", e))?;
-    if new {
-        writeln!(f, "{header}").map_err(|e| super::io_error(path, "write", e))?;
-    }
-    writeln!(f, "{row}").map_err(|e| super::io_error(path, "write", e))
-}

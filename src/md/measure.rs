@@ -8,6 +8,16 @@ use super::walls::{box_area, box_extent};
 use nalgebra::Matrix3;
 
 impl MdSystem {
+    /// The unit vector against gravity (`+z` without gravity).
+    pub fn up(&self) -> V3 {
+        let g = self.settings.gravity;
+        if g.norm() > 0.0 {
+            -g.normalize()
+        } else {
+            V3::z()
+        }
+    }
+
     /// Gravitational potential energy (J) `Σ m |g| h`, `h` the height of the centre
     /// above [`MdSystem::gravity_reference`] along gravity (fixed for the run, so
     /// kinetic + potential energy is conserved without dissipation).
@@ -112,8 +122,7 @@ impl MdSystem {
     /// cylinder along gravity (`π R²`, halved by each symmetry plane containing its
     /// axis), or a box of axis-aligned planes (`L_x L_y` for gravity along `z`).
     pub fn container_section(&self) -> Option<f64> {
-        let g = self.settings.gravity;
-        let up = if g.norm() > 0.0 { -g.normalize() } else { V3::z() };
+        let up = self.up();
         for w in &self.walls {
             if let super::walls::Shape::Cylinder { axis_point, axis, radius } = w.shape {
                 if axis.cross(&up).norm() < 1e-9 {
@@ -141,8 +150,7 @@ impl MdSystem {
     /// without a recognised container.
     pub fn packing_fraction_bulk(&self) -> Option<f64> {
         let section = self.container_section()?;
-        let g = self.settings.gravity;
-        let up = if g.norm() > 0.0 { -g.normalize() } else { V3::z() };
+        let up = self.up();
         let p = &self.particles;
         if p.is_empty() {
             return None;

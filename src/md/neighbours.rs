@@ -38,6 +38,7 @@ pub struct Neighbours {
 struct Scratch {
     cell_of: Vec<u32>,
     cell_start: Vec<u32>,
+    fill: Vec<u32>,
     items: Vec<u32>,
     start: Vec<u32>,
     j: Vec<u32>,
@@ -111,12 +112,11 @@ impl Neighbours {
         }
         s.items.clear();
         s.items.resize(n_all, 0);
-        {
-            let mut fill = s.cell_start.clone();
-            for (i, &c) in s.cell_of.iter().enumerate() {
-                s.items[fill[c as usize] as usize] = i as u32;
-                fill[c as usize] += 1;
-            }
+        s.fill.clear();
+        s.fill.extend_from_slice(&s.cell_start);
+        for (i, &c) in s.cell_of.iter().enumerate() {
+            s.items[s.fill[c as usize] as usize] = i as u32;
+            s.fill[c as usize] += 1;
         }
         // Rows, each sorted by key, with the memory of the old list merged in.
         s.start.clear();

@@ -139,6 +139,11 @@ pub struct MdSystem {
     work: Vec<Workspace>,
     #[serde(skip)]
     backup: Backup,
+    /// Centres and radii of the spheres and their images, for the neighbour build.
+    #[serde(skip)]
+    all_x: Vec<V3>,
+    #[serde(skip)]
+    all_r: Vec<f64>,
 }
 
 impl MdSystem {
@@ -163,6 +168,8 @@ impl MdSystem {
             threads: 1,
             work: Vec::new(),
             backup: Backup::default(),
+            all_x: Vec::new(),
+            all_r: Vec::new(),
         };
         let n = sys.particles.len();
         for w in &mut sys.walls {
@@ -202,8 +209,7 @@ impl MdSystem {
     }
 
     fn initial_reference(&self) -> f64 {
-        let g = self.settings.gravity;
-        let up = if g.norm() > 0.0 { -g.normalize() } else { V3::z() };
+        let up = self.up();
         let p = &self.particles;
         let lowest = (0..p.len()).map(|i| p.x[i].dot(&up) - p.r[i]).fold(f64::INFINITY, f64::min);
         let base = self
@@ -366,11 +372,15 @@ impl MdSystem {
         let r_max = p.max_radius();
         self.ghosts.select(&p.x, 2.0 * r_max + skin);
         self.ghosts.update(p);
-        let mut x = p.x.clone();
+        // Spheres then images, in buffers kept between builds.
+        let (x, r) = (&mut self.all_x, &mut self.all_r);
+        x.clear();
+        x.extend_from_slice(&p.x);
         x.extend_from_slice(&self.ghosts.x);
-        let mut r = p.r.clone();
+        r.clear();
+        r.extend_from_slice(&p.r);
         r.extend(self.ghosts.origin.iter().map(|&i| p.r[i as usize]));
-        self.neighbours.build(&x, &r, n, &self.ghosts.key);
+        self.neighbours.build(x, r, n, &self.ghosts.key);
         for w in &mut self.walls {
             w.candidates.clear();
             for i in 0..n {
