@@ -26,5 +26,6 @@ pub mod md;
 pub mod nscd;
 pub mod scenarios;
 pub mod scene;
+pub mod team;
 
 pub use error::{Error, Result};

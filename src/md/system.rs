@@ -1,12 +1,21 @@
 //! The MD system and its time step.
 //!
-//! Data flow of a step (velocity Verlet): half kick and drift of every sphere →
-//! neighbour list rebuilt if needed ([`super::neighbours`], images of the symmetry
-//! planes re-selected with it) → images mirrored ([`super::ghosts`]) → pair forces
-//! ([`super::contact`], half list, one force buffer per thread, summed) → wall
-//! forces ([`super::walls`]) → background damping → second half kick → servo walls
-//! advanced. With a Gear integrator the kicks are replaced by the predictor before
-//! and the corrector after the force evaluation ([`super::integrator`]).
+//! Data flow of a step (velocity Verlet), in three phases that each run as two
+//! chunks side by side on a [`Team`] (or one after the other on one thread):
+//! 1. half kick and drift of every sphere, largest displacement since the last
+//!    neighbour build; then, on the caller, the neighbour list rebuilt if needed
+//!    ([`super::neighbours`], images of the symmetry planes re-selected with it)
+//!    and the images mirrored ([`super::ghosts`]);
+//! 2. pair forces ([`super::contact`], half list cut into two chunks of rows
+//!    with as many pairs each, one force buffer per chunk);
+//! 3. per chunk of spheres: the two buffers summed, wall forces ([`super::walls`]),
+//!    background damping, second half kick; then, on the caller, the wall loads
+//!    and statistics of the chunks summed and the servo walls advanced.
+//!
+//! With a Gear integrator the kicks are replaced by the predictor before and the
+//! corrector after the force evaluation ([`super::integrator`]). The chunks are
+//! the same whatever the number of threads, so are the sums: a run gives the same
+//! numbers on one thread or two.
 
 use super::contact::{self, History, Kinematics};
 use super::ghosts::Ghosts;
@@ -16,6 +25,7 @@ use super::neighbours::Neighbours;
 use super::particles::{rotate, Particles, V3};
 use super::walls::{self, Wall};
 use crate::error::{Error, Result};
+use crate::team::Team;
 use nalgebra::{Matrix3, UnitQuaternion};
 use serde::{Deserialize, Serialize};
 
@@ -58,11 +68,9 @@ pub struct MdStepStats {
     pub coordination: f64,
 }
 
-/// Per-thread accumulators of a force evaluation.
-#[derive(Debug, Clone, Default)]
-struct Workspace {
-    f: Vec<V3>,
-    t: Vec<V3>,
+/// Contact statistics of one chunk of a force evaluation.
+#[derive(Debug, Clone, Copy)]
+struct Tally {
     contacts: f64,
     sum_overlap: f64,
     overlaps: usize,
@@ -72,6 +80,57 @@ struct Workspace {
     virial: Matrix3<f64>,
     /// Worst overlap relative to the smaller radius, and its sphere.
     worst: (f64, usize),
+}
+
+impl Default for Tally {
+    fn default() -> Self {
+        Tally {
+            contacts: 0.0,
+            sum_overlap: 0.0,
+            overlaps: 0,
+            max_overlap: 0.0,
+            energy: 0.0,
+            virial: Matrix3::zeros(),
+            worst: (0.0, 0),
+        }
+    }
+}
+
+impl Tally {
+    fn add(&mut self, o: &Tally) {
+        self.contacts += o.contacts;
+        self.sum_overlap += o.sum_overlap;
+        self.overlaps += o.overlaps;
+        self.max_overlap = self.max_overlap.max(o.max_overlap);
+        self.energy += o.energy;
+        self.virial += o.virial;
+        if o.worst.0 > self.worst.0 {
+            self.worst = o.worst;
+        }
+    }
+}
+
+/// Force buffers and statistics of one chunk of the pair loop.
+#[derive(Debug, Clone, Default)]
+struct Workspace {
+    f: Vec<V3>,
+    t: Vec<V3>,
+    tally: Tally,
+}
+
+/// What one chunk of spheres reports from the last phase of a step.
+#[derive(Debug, Clone, Default)]
+struct Tail {
+    /// Force of the chunk's spheres on each wall (N), and their number.
+    wall_force: Vec<V3>,
+    wall_contacts: Vec<usize>,
+    /// Sphere–wall contact statistics.
+    tally: Tally,
+    /// Kinetic energy of the chunk after the step (J), non-finite if a position
+    /// or velocity is.
+    kinetic: f64,
+    /// First sphere with a non-finite force or torque.
+    bad_force: Option<usize>,
 }
 
 /// A copy of the state, for keeping the last good one when a step fails.
@@ -90,8 +149,9 @@ fn one() -> u64 {
     1
 }
 
-/// Spheres per chunk below which the per-sphere loops stay serial.
-const PAR_MIN: usize = 512;
+/// Spheres per chunk below which a step stays on one thread (a phase must
+/// outlast the hand-over to the helper by far).
+const PAR_MIN: usize = 256;
 
 /// The work of a step is cut into this many chunks (pairs balanced by count,
 /// spheres by index), run side by side when two threads are allowed and serially
@@ -133,10 +193,18 @@ pub struct MdSystem {
     /// measured values in their [`MdStepStats`]. Kinetic energy is always exact.
     #[serde(default = "one")]
     pub measure_every: u64,
+    /// Contact memory of the sphere–wall contacts, sphere by sphere: entry
+    /// `i · walls + k` for sphere `i` and wall `k`.
+    #[serde(default)]
+    wall_hist: Vec<History>,
     #[serde(skip)]
     threads: usize,
     #[serde(skip)]
+    team: Team,
+    #[serde(skip)]
     work: Vec<Workspace>,
+    #[serde(skip)]
+    tails: Vec<Tail>,
     #[serde(skip)]
     backup: Backup,
     /// Centres and radii of the spheres and their images, for the neighbour build.
@@ -165,19 +233,21 @@ impl MdSystem {
             last: MdStepStats::default(),
             measure_every: 1,
             gravity_reference: 0.0,
+            wall_hist: Vec::new(),
             threads: 1,
+            team: Team::default(),
             work: Vec::new(),
+            tails: Vec::new(),
             backup: Backup::default(),
             all_x: Vec::new(),
             all_r: Vec::new(),
         };
         let n = sys.particles.len();
-        for w in &mut sys.walls {
-            w.hist = vec![History::default(); n];
-        }
+        sys.wall_hist = vec![History::default(); n * sys.walls.len()];
         sys.gravity_reference = sys.initial_reference();
         sys.rebuild();
-        let stats = sys.evaluate(0.0, true).unwrap_or_default();
+        sys.ghosts.update(&sys.particles);
+        let stats = sys.forces(0.0, true, false).map(|(s, _)| s).unwrap_or_default();
         sys.last = MdStepStats { time: 0.0, kinetic_energy: sys.particles.kinetic_energy(), ..stats };
         if let Integrator::Gear(set) = settings.integrator {
             let q = set.order();
@@ -228,10 +298,15 @@ impl MdSystem {
         }
     }
 
-    /// Number of force-evaluation threads (chunks of the pair list). The numbers
-    /// depend on it only through the order of floating-point sums of forces.
+    /// Number of threads of a step: 1, or 2 (the caller and a helper that spins
+    /// between the phases of a step; more are not used). The numbers do not
+    /// depend on it: the work is always cut into the same [`CHUNKS`] chunks.
     pub fn set_threads(&mut self, threads: usize) {
-        self.threads = threads.max(1);
+        let threads = threads.clamp(1, CHUNKS);
+        if threads != self.threads {
+            self.team = Team::default();
+        }
+        self.threads = threads;
     }
 
     /// Threads in use.
@@ -246,35 +321,46 @@ impl MdSystem {
     /// overlap by more than half the smaller radius; the system then holds the
     /// last good state (at most [`BACKUP_EVERY`] steps back).
     pub fn step(&mut self) -> Result<MdStepStats> {
-        if self.threads == 0 {
-            self.threads = 1;
+        let n = self.particles.len();
+        let parallel = self.threads > 1 && n >= CHUNKS * PAR_MIN;
+        if parallel && self.team.threads() < 2 {
+            self.team = Team::new(2);
+        } else if !parallel && self.team.threads() > 1 {
+            self.team = Team::default();
+        }
+        // A system read from a file without the wall contact memory starts afresh.
+        let nw = self.walls.len();
+        if self.wall_hist.len() != n * nw {
+            self.wall_hist = vec![History::default(); n * nw];
         }
         let dt = self.settings.dt;
         let g = self.settings.gravity;
-        let threads = self.threads;
         let integrator = self.settings.integrator;
-        {
-            let mut view = self.view();
-            par_for(&mut view, threads, &|c: View| first_half(c, integrator, g, dt));
-        }
-        if self.needs_rebuild() {
+        // Phase 1: predictor, and how far the spheres went since the last build.
+        let built = self.neighbours.x_build.len() == n;
+        let moved2 = {
+            let MdSystem { particles, gear_x, gear_w, neighbours, team, .. } = self;
+            let x0 = if built { &neighbours.x_build[..] } else { &[] };
+            let view = View::new(particles, gear_x, gear_w, x0);
+            let (a, b) = view.halves();
+            let (ma, mb) = team.join(|| first_half(a, integrator, g, dt), || first_half(b, integrator, g, dt));
+            ma.max(mb)
+        };
+        let d = moved2.sqrt();
+        let dw = self.walls.iter().map(|w| (w.s - w.s_build).abs()).fold(0.0, f64::max);
+        if !built || !(d + d.max(dw) <= self.settings.skin) {
             self.rebuild();
         }
+        self.ghosts.update(&self.particles);
+        // Phases 2 and 3.
         let measure = (self.step + 1).is_multiple_of(self.measure_every.max(1));
-        let stats = match self.evaluate(dt, measure) {
-            Ok(s) => s,
+        let (stats, kinetic) = match self.forces(dt, measure, true) {
+            Ok(r) => r,
             Err(e) => {
                 self.restore_backup();
                 return Err(e);
             }
         };
-        let kinetic = {
-            let mut view = self.view();
-            par_for(&mut view, threads, &|c: View| second_half(c, integrator, g, dt))
-        };
-        walls::advance(&mut self.walls, self.time + dt, dt);
-        self.time += dt;
-        self.step += 1;
         if !kinetic.is_finite() {
             let p = &self.particles;
             let i = (0..p.len())
@@ -284,6 +370,9 @@ impl MdSystem {
             self.restore_backup();
             return Err(e);
         }
+        walls::advance(&mut self.walls, self.time + dt, dt);
+        self.time += dt;
+        self.step += 1;
         let stats = if measure {
             stats
         } else {
@@ -302,26 +391,10 @@ impl MdSystem {
         Ok(stats)
     }
 
-    /// The integrator's view of the sphere arrays.
-    fn view(&mut self) -> View<'_> {
-        let p = &mut self.particles;
-        View {
-            x: &mut p.x,
-            v: &mut p.v,
-            w: &mut p.w,
-            f: &p.f,
-            t: &p.t,
-            inv_m: &p.inv_m,
-            inv_i: &p.inv_i,
-            q: &mut p.q,
-            gx: &mut self.gear_x,
-            gw: &mut self.gear_w,
-        }
-    }
-
+    /// Names the sphere `body` in a divergence of the step being made.
     fn diverged(&self, body: usize, what: String) -> Error {
         Error::Diverged {
-            step: self.step,
+            step: self.step + 1,
             body,
             name: self.particles.name.get(body).cloned().unwrap_or_default(),
             what,
@@ -357,13 +430,6 @@ impl MdSystem {
         self.step = b.step;
     }
 
-    /// True if some pair may have come within reach since the last build.
-    fn needs_rebuild(&self) -> bool {
-        let d = self.neighbours.max_displacement(&self.particles.x);
-        let dw = self.walls.iter().map(|w| (w.s - w.s_build).abs()).fold(0.0, f64::max);
-        d + d.max(dw) > self.settings.skin
-    }
-
     /// Rebuilds the images, the neighbour list and the wall candidate lists.
     pub fn rebuild(&mut self) {
         let p = &self.particles;
@@ -381,40 +447,42 @@ impl MdSystem {
         r.extend_from_slice(&p.r);
         r.extend(self.ghosts.origin.iter().map(|&i| p.r[i as usize]));
         self.neighbours.build(x, r, n, &self.ghosts.key);
-        for w in &mut self.walls {
+        let nw = self.walls.len();
+        self.wall_hist.resize(n * nw, History::default());
+        for (k, w) in self.walls.iter_mut().enumerate() {
             w.candidates.clear();
             for i in 0..n {
                 match w.gap(&p.x[i], p.r[i]) {
                     Some((gap, _, _)) if gap < skin => w.candidates.push(i as u32),
-                    _ => w.hist[i] = History::default(),
+                    _ => self.wall_hist[i * nw + k] = History::default(),
                 }
             }
             w.s_build = w.s;
         }
     }
 
-    /// Evaluates all forces at the current state, advancing the contact memory
-    /// by `dt` (s).
-    fn evaluate(&mut self, dt: f64, measure: bool) -> Result<MdStepStats> {
-        self.ghosts.update(&self.particles);
+    /// Evaluates all forces at the current state (images already mirrored),
+    /// advancing the contact memory by `dt` (s), and with `integrate` finishes
+    /// the step (second half kick or corrector). Returns the statistics and the
+    /// kinetic energy after the step (J; 0 without `integrate`).
+    fn forces(&mut self, dt: f64, measure: bool, integrate: bool) -> Result<(MdStepStats, f64)> {
         let n = self.particles.len();
-        let threads = self.threads.max(1);
+        let nw = self.walls.len();
         self.work.resize_with(CHUNKS, Workspace::default);
-        for w in &mut self.work {
-            w.f.clear();
-            w.f.resize(n, V3::zeros());
-            w.t.clear();
-            w.t.resize(n, V3::zeros());
-            w.contacts = 0.0;
-            w.sum_overlap = 0.0;
-            w.overlaps = 0;
-            w.max_overlap = 0.0;
-            w.energy = 0.0;
-            w.virial = Matrix3::zeros();
-            w.worst = (0.0, 0);
-        }
-        // Rows split so that each chunk has about the same number of pairs.
+        self.tails.resize_with(CHUNKS, Tail::default);
+        // Phase 2: pair forces, rows cut so that each chunk has about as many pairs.
         let total = self.neighbours.pairs();
+        let mut bounds = [0usize; CHUNKS + 1];
+        let mut row = 0;
+        #[allow(clippy::needless_range_loop)]
+        for c in 1..CHUNKS {
+            let target = total * c / CHUNKS;
+            while row < n && (self.neighbours.start[row] as usize) < target {
+                row += 1;
+            }
+            bounds[c] = row;
+        }
+        bounds[CHUNKS] = n;
         let ctx = PairContext {
             p: &self.particles,
             g: &self.ghosts,
@@ -424,107 +492,73 @@ impl MdSystem {
             dt,
             measure,
         };
-        let mut bounds = [0usize; CHUNKS + 1];
-        let chunks = CHUNKS;
-        let mut row = 0;
-        #[allow(clippy::needless_range_loop)]
-        for c in 1..chunks {
-            let target = total * c / chunks;
-            while row < n && (self.neighbours.start[row] as usize) < target {
-                row += 1;
-            }
-            bounds[c] = row;
+        run_chunks(&self.team, &ctx, &bounds, &mut self.neighbours.hist, 0, &mut self.work);
+        // Phase 3: per chunk of spheres, sum, walls, damping, second half.
+        let s = &self.settings;
+        let ctx = TailContext {
+            work: &self.work,
+            walls: &self.walls,
+            laws: &self.laws,
+            damping: (s.background_damping, s.background_rotational_damping),
+            integrator: s.integrator,
+            gravity: s.gravity,
+            dt,
+            integrate,
+        };
+        {
+            let MdSystem { particles, gear_x, gear_w, team, wall_hist, tails, .. } = self;
+            let view = View::new(particles, gear_x, gear_w, &[]);
+            let at = view.len() / CHUNKS;
+            let (a, b) = view.halves();
+            let (ha, hb) = wall_hist.split_at_mut(at * nw);
+            let (ta, tb) = tails.split_at_mut(1);
+            team.join(|| tail(a, ha, &ctx, &mut ta[0]), || tail(b, hb, &ctx, &mut tb[0]));
         }
-        bounds[chunks] = n;
-        run_chunks(&ctx, &bounds[..=chunks], &mut self.neighbours.hist, 0, &mut self.work[..chunks], threads > 1);
-        // Sum the per-thread buffers into the first one.
-        let (first, rest) = self.work.split_at_mut(1);
-        let w0 = &mut first[0];
-        for w in rest.iter() {
-            for i in 0..n {
-                w0.f[i] += w.f[i];
-                w0.t[i] += w.t[i];
-            }
-            w0.contacts += w.contacts;
-            w0.sum_overlap += w.sum_overlap;
-            w0.overlaps += w.overlaps;
-            w0.max_overlap = w0.max_overlap.max(w.max_overlap);
-            w0.energy += w.energy;
-            w0.virial += w.virial;
-            if w.worst.0 > w0.worst.0 {
-                w0.worst = w.worst;
-            }
+        // Sums over the chunks, in chunk order.
+        let mut tally = Tally::default();
+        for w in &self.work {
+            tally.add(&w.tally);
         }
-        std::mem::swap(&mut self.particles.f, &mut w0.f);
-        std::mem::swap(&mut self.particles.t, &mut w0.t);
-        // Walls.
-        let p = &mut self.particles;
-        let mut wall_contacts = 0;
-        for wall in &mut self.walls {
+        let mut kinetic = 0.0;
+        let mut bad_force = None;
+        for (k, wall) in self.walls.iter_mut().enumerate() {
             wall.force = V3::zeros();
             wall.contacts = 0;
-            let vw = wall.velocity();
-            for &i in &wall.candidates {
-                let i = i as usize;
-                let touching = wall.gap(&p.x[i], p.r[i]).filter(|g| g.0 < 0.0);
-                let h = &mut wall.hist[i];
-                let Some((gap, nrm, r_star)) = touching else {
-                    *h = History::default();
-                    continue;
-                };
-                let Some(law) = self.laws.get(p.material[i] as usize, wall.material as usize) else { continue };
-                let delta = -gap;
-                let a = p.r[i] - delta;
-                let v_rel = p.v[i] + nrm.cross(&p.w[i]) * a - vw;
-                let k = Kinematics { n: nrm, delta, v_rel, r_star, m_star: p.m[i], measure: true };
-                let cf = contact::force(law, &k, h, dt);
-                p.f[i] += cf.force;
-                p.t[i] += nrm.cross(&cf.tangential) * (-a);
-                wall.force -= cf.force;
-                wall.contacts += 1;
-                w0.sum_overlap += delta;
-                w0.overlaps += 1;
-                w0.max_overlap = w0.max_overlap.max(delta);
-                w0.energy += cf.energy;
-                if delta / p.r[i] > w0.worst.0 {
-                    w0.worst = (delta / p.r[i], i);
-                }
-            }
-            wall_contacts += wall.contacts;
-        }
-        let (gb, gr) = (self.settings.background_damping, self.settings.background_rotational_damping);
-        if gb != 0.0 || gr != 0.0 {
-            for i in 0..n {
-                p.f[i] -= p.v[i] * gb;
-                p.t[i] -= p.w[i] * (gr * p.r[i] * p.r[i]);
+            for t in &self.tails {
+                wall.force += t.wall_force[k];
+                wall.contacts += t.wall_contacts[k];
             }
         }
-        self.virial = w0.virial;
-        let (worst, worst_i) = w0.worst;
-        let summary = (w0.contacts, w0.energy, w0.max_overlap, w0.sum_overlap, w0.overlaps);
-        if worst > 0.5 || !summary.1.is_finite() {
-            let r = p.r[worst_i];
+        for t in &self.tails {
+            tally.add(&t.tally);
+            kinetic += t.kinetic;
+            bad_force = bad_force.or(t.bad_force);
+        }
+        let wall_contacts = self.walls.iter().map(|w| w.contacts).sum::<usize>();
+        self.virial = tally.virial;
+        let (worst, worst_i) = tally.worst;
+        if worst > 0.5 || !tally.energy.is_finite() {
+            let r = self.particles.r[worst_i];
             return Err(self.diverged(
                 worst_i,
                 format!("runaway overlap: {:.3e} m, {:.0} % of the radius", worst * r, 100.0 * worst),
             ));
         }
-        if let Some(i) =
-            (0..n).find(|&i| !(p.f[i].iter().all(|c| c.is_finite()) && p.t[i].iter().all(|c| c.is_finite())))
-        {
+        if let Some(i) = bad_force {
             return Err(self.diverged(i, "contact force is not finite".into()));
         }
-        let (contacts, energy, max_overlap, sum_overlap, overlaps) = summary;
-        Ok(MdStepStats {
+        let contacts = tally.contacts;
+        let stats = MdStepStats {
             time: self.time,
             kinetic_energy: 0.0,
-            elastic_energy: energy,
+            elastic_energy: tally.energy,
             contacts,
             wall_contacts,
-            max_overlap,
-            mean_overlap: if overlaps > 0 { sum_overlap / overlaps as f64 } else { 0.0 },
+            max_overlap: tally.max_overlap,
+            mean_overlap: if tally.overlaps > 0 { tally.sum_overlap / tally.overlaps as f64 } else { 0.0 },
             coordination: if n > 0 { (2.0 * contacts + wall_contacts as f64) / n as f64 } else { 0.0 },
-        })
+        };
+        Ok((stats, kinetic))
     }
 }
 
@@ -539,15 +573,16 @@ struct PairContext<'a> {
     measure: bool,
 }
 
-/// Runs the chunks `bounds[k]..bounds[k+1]` (rows) side by side, each on its own
-/// workspace and its own slice of the contact memory (which starts at entry `offset`).
+/// Runs the chunks `bounds[k]..bounds[k+1]` (rows) side by side on `team`, each
+/// on its own workspace and its own slice of the contact memory (which starts at
+/// entry `offset`).
 fn run_chunks(
+    team: &Team,
     ctx: &PairContext,
     bounds: &[usize],
     hist: &mut [History],
     offset: usize,
     work: &mut [Workspace],
-    parallel: bool,
 ) {
     let chunks = bounds.len() - 1;
     if chunks == 1 {
@@ -558,22 +593,23 @@ fn run_chunks(
     let split = ctx.start[bounds[mid]] as usize - offset;
     let (h0, h1) = hist.split_at_mut(split);
     let (w0, w1) = work.split_at_mut(mid);
-    let mut a = || run_chunks(ctx, &bounds[..=mid], h0, offset, w0, parallel);
-    let mut b = || run_chunks(ctx, &bounds[mid..], h1, offset + split, w1, parallel);
-    if parallel && ctx.start.len() > PAR_MIN {
-        rayon::join(a, b);
-    } else {
-        a();
-        b();
-    }
+    team.join(
+        || run_chunks(team, ctx, &bounds[..=mid], h0, offset, w0),
+        || run_chunks(team, ctx, &bounds[mid..], h1, offset + split, w1),
+    );
 }
 
-/// Forces of the pairs of rows `lo..hi` into `w`.
+/// Forces of the pairs of rows `lo..hi` into `w` (cleared first).
 #[inline(never)]
 fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offset: usize, w: &mut Workspace) {
     let p = ctx.p;
     let n = p.len();
     let dt = ctx.dt;
+    w.f.clear();
+    w.f.resize(n, V3::zeros());
+    w.t.clear();
+    w.t.resize(n, V3::zeros());
+    let mut tally = Tally::default();
     for i in lo..hi {
         let (xi, vi, wi, ri, mi, mati) = (p.x[i], p.v[i], p.w[i], p.r[i], p.m[i], p.material[i] as usize);
         let mut fi = V3::zeros();
@@ -619,19 +655,19 @@ fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offs
             fi += cf.force;
             ti -= nrm.cross(&cf.tangential) * ai;
             let weight = if ghost { 0.5 } else { 1.0 };
-            w.contacts += weight;
+            tally.contacts += weight;
             if ctx.measure {
                 // Branch vector from j's centre to i's centre.
-                w.virial += (cf.force * weight) * d.transpose();
-                w.energy += cf.energy * weight;
-                w.sum_overlap += delta;
-                w.overlaps += 1;
-                w.max_overlap = w.max_overlap.max(delta);
+                tally.virial += (cf.force * weight) * d.transpose();
+                tally.energy += cf.energy * weight;
+                tally.sum_overlap += delta;
+                tally.overlaps += 1;
+                tally.max_overlap = tally.max_overlap.max(delta);
             }
             if delta > 0.5 * ri.min(rj) {
                 let rel = delta / ri.min(rj);
-                if rel > w.worst.0 {
-                    w.worst = (rel, i);
+                if rel > tally.worst.0 {
+                    tally.worst = (rel, i);
                 }
             }
             if !ghost {
@@ -642,73 +678,203 @@ fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offs
         w.f[i] += fi;
         w.t[i] += ti;
     }
+    w.tally = tally;
+}
+
+/// Read-only data of the last phase of a step.
+struct TailContext<'a> {
+    /// The pair loop's force buffers, one per chunk.
+    work: &'a [Workspace],
+    walls: &'a [Wall],
+    laws: &'a LawTable,
+    /// Background damping `(γ_b, γ_br)` (kg/s).
+    damping: (f64, f64),
+    integrator: Integrator,
+    gravity: V3,
+    dt: f64,
+    /// Finish the step (second half kick or corrector) after the forces.
+    integrate: bool,
+}
+
+/// The last phase of a step on one chunk of spheres: total force and torque of
+/// each sphere (pair buffers summed, walls, background damping), then the second
+/// half of the integrator. `hist` is the chunk's wall contact memory.
+fn tail(c: View, hist: &mut [History], ctx: &TailContext, out: &mut Tail) {
+    let (lo, len) = (c.lo, c.len());
+    let nw = ctx.walls.len();
+    let dt = ctx.dt;
+    out.wall_force.clear();
+    out.wall_force.resize(nw, V3::zeros());
+    out.wall_contacts.clear();
+    out.wall_contacts.resize(nw, 0);
+    out.bad_force = None;
+    out.kinetic = 0.0;
+    let mut tally = Tally::default();
+    for i in 0..len {
+        let mut f = V3::zeros();
+        let mut t = V3::zeros();
+        for w in ctx.work {
+            f += w.f[lo + i];
+            t += w.t[lo + i];
+        }
+        c.f[i] = f;
+        c.t[i] = t;
+    }
+    for (k, wall) in ctx.walls.iter().enumerate() {
+        let cand = &wall.candidates;
+        let a = cand.partition_point(|&i| (i as usize) < lo);
+        let b = cand.partition_point(|&i| (i as usize) < lo + len);
+        let vw = wall.velocity();
+        for &gi in &cand[a..b] {
+            let i = gi as usize - lo;
+            let touching = wall.gap(&c.x[i], c.r[i]).filter(|g| g.0 < 0.0);
+            let h = &mut hist[i * nw + k];
+            let Some((gap, nrm, r_star)) = touching else {
+                *h = History::default();
+                continue;
+            };
+            let Some(law) = ctx.laws.get(c.material[i] as usize, wall.material as usize) else { continue };
+            let delta = -gap;
+            let a = c.r[i] - delta;
+            let v_rel = c.v[i] + nrm.cross(&c.w[i]) * a - vw;
+            let k_ = Kinematics { n: nrm, delta, v_rel, r_star, m_star: 1.0 / c.inv_m[i], measure: true };
+            let cf = contact::force(law, &k_, h, dt);
+            c.f[i] += cf.force;
+            c.t[i] += nrm.cross(&cf.tangential) * (-a);
+            out.wall_force[k] -= cf.force;
+            out.wall_contacts[k] += 1;
+            tally.sum_overlap += delta;
+            tally.overlaps += 1;
+            tally.max_overlap = tally.max_overlap.max(delta);
+            tally.energy += cf.energy;
+            if delta / c.r[i] > tally.worst.0 {
+                tally.worst = (delta / c.r[i], lo + i);
+            }
+        }
+    }
+    let (gb, gr) = ctx.damping;
+    if gb != 0.0 || gr != 0.0 {
+        for i in 0..len {
+            c.f[i] -= c.v[i] * gb;
+            c.t[i] -= c.w[i] * (gr * c.r[i] * c.r[i]);
+        }
+    }
+    out.bad_force = (0..len).find(|&i| !(c.f[i].iter().all(|a| a.is_finite()) && c.t[i].iter().all(|a| a.is_finite())));
+    out.bad_force = out.bad_force.map(|i| lo + i);
+    out.tally = tally;
+    if ctx.integrate {
+        out.kinetic = second_half(c, ctx.integrator, ctx.gravity, dt);
+    }
 }
 
 /// The per-sphere arrays the integrator touches, split into chunks for threads.
 struct View<'a> {
+    /// Index of the first sphere of the chunk.
+    lo: usize,
     x: &'a mut [V3],
     v: &'a mut [V3],
     w: &'a mut [V3],
-    f: &'a [V3],
-    t: &'a [V3],
+    f: &'a mut [V3],
+    t: &'a mut [V3],
+    r: &'a [f64],
+    material: &'a [u32],
     inv_m: &'a [f64],
     inv_i: &'a [f64],
     q: &'a mut [UnitQuaternion<f64>],
     /// Gear derivatives (empty with Verlet).
     gx: &'a mut [[V3; 6]],
     gw: &'a mut [[V3; 6]],
+    /// Positions at the last neighbour build (empty if unused).
+    x0: &'a [V3],
 }
 
 impl<'a> View<'a> {
+    fn new(p: &'a mut Particles, gx: &'a mut [[V3; 6]], gw: &'a mut [[V3; 6]], x0: &'a [V3]) -> Self {
+        View {
+            lo: 0,
+            x: &mut p.x,
+            v: &mut p.v,
+            w: &mut p.w,
+            f: &mut p.f,
+            t: &mut p.t,
+            r: &p.r,
+            material: &p.material,
+            inv_m: &p.inv_m,
+            inv_i: &p.inv_i,
+            q: &mut p.q,
+            gx,
+            gw,
+            x0,
+        }
+    }
+
     fn len(&self) -> usize {
         self.x.len()
+    }
+
+    /// The two chunks (always [`CHUNKS`] = 2, whatever the threads).
+    fn halves(self) -> (View<'a>, View<'a>) {
+        let at = self.len() / CHUNKS;
+        self.split(at)
     }
 
     fn split(self, at: usize) -> (View<'a>, View<'a>) {
         let (x0, x1) = self.x.split_at_mut(at);
         let (v0, v1) = self.v.split_at_mut(at);
         let (w0, w1) = self.w.split_at_mut(at);
-        let (f0, f1) = self.f.split_at(at);
-        let (t0, t1) = self.t.split_at(at);
+        let (f0, f1) = self.f.split_at_mut(at);
+        let (t0, t1) = self.t.split_at_mut(at);
+        let (r0, r1) = self.r.split_at(at);
+        let (c0, c1) = self.material.split_at(at);
         let (m0, m1) = self.inv_m.split_at(at);
         let (i0, i1) = self.inv_i.split_at(at);
         let (q0, q1) = self.q.split_at_mut(at);
         let g = at.min(self.gx.len());
         let (gx0, gx1) = self.gx.split_at_mut(g);
         let (gw0, gw1) = self.gw.split_at_mut(g);
+        let b = at.min(self.x0.len());
+        let (b0, b1) = self.x0.split_at(b);
+        let lo = self.lo;
         (
-            View { x: x0, v: v0, w: w0, f: f0, t: t0, inv_m: m0, inv_i: i0, q: q0, gx: gx0, gw: gw0 },
-            View { x: x1, v: v1, w: w1, f: f1, t: t1, inv_m: m1, inv_i: i1, q: q1, gx: gx1, gw: gw1 },
+            View {
+                lo,
+                x: x0,
+                v: v0,
+                w: w0,
+                f: f0,
+                t: t0,
+                r: r0,
+                material: c0,
+                inv_m: m0,
+                inv_i: i0,
+                q: q0,
+                gx: gx0,
+                gw: gw0,
+                x0: b0,
+            },
+            View {
+                lo: lo + at,
+                x: x1,
+                v: v1,
+                w: w1,
+                f: f1,
+                t: t1,
+                r: r1,
+                material: c1,
+                inv_m: m1,
+                inv_i: i1,
+                q: q1,
+                gx: gx1,
+                gw: gw1,
+                x0: b1,
+            },
         )
     }
-
-    fn reborrow(&mut self) -> View<'_> {
-        View {
-            x: self.x,
-            v: self.v,
-            w: self.w,
-            f: self.f,
-            t: self.t,
-            inv_m: self.inv_m,
-            inv_i: self.inv_i,
-            q: self.q,
-            gx: self.gx,
-            gw: self.gw,
-        }
-    }
-}
-
-/// Runs `body` on `threads` chunks of `view` side by side (serially for small
-/// systems) and sums what the chunks return.
-fn par_for(view: &mut View, threads: usize, body: &(dyn Fn(View) -> f64 + Sync)) -> f64 {
-    // Always the same CHUNKS chunks, whatever the threads: the same sums.
-    let at = view.len() / CHUNKS;
-    let (a, b) = view.reborrow().split(at);
-    let (x, y) = if threads > 1 && at >= PAR_MIN { rayon::join(|| body(a), || body(b)) } else { (body(a), body(b)) };
-    x + y
 }
 
 /// Before the force evaluation: half kick and drift (Verlet) or predictor (Gear).
+/// Returns the largest squared displacement since the last neighbour build (m²;
+/// 0 if the view has no build positions).
 fn first_half(c: View, integrator: Integrator, g: V3, dt: f64) -> f64 {
     match integrator {
         Integrator::Verlet => {
@@ -729,7 +895,12 @@ fn first_half(c: View, integrator: Integrator, g: V3, dt: f64) -> f64 {
             }
         }
     }
-    0.0
+    if c.x0.len() != c.x.len() {
+        return 0.0;
+    }
+    // A non-finite position is skipped here (no rebuild over it); the force
+    // evaluation reports it.
+    c.x.iter().zip(c.x0).map(|(a, b)| (a - b).norm_squared()).fold(0.0, f64::max)
 }
 
 /// After the force evaluation: second half kick (Verlet) or corrector (Gear),

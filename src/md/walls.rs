@@ -15,7 +15,6 @@
 //! `m_w/γ_w` is many steps); gravity does not act on walls (the load is the
 //! prescribed one).
 
-use super::contact::History;
 use super::particles::V3;
 use serde::{Deserialize, Serialize};
 
@@ -89,10 +88,9 @@ pub struct Wall {
     pub contacts: usize,
     /// Displacement at the last neighbour build (m).
     pub s_build: f64,
-    /// Spheres within the skin at the last build.
+    /// Spheres within the skin at the last build, in increasing order (their
+    /// contact memory is kept by the system, per sphere and wall).
     pub candidates: Vec<u32>,
-    /// Contact memory per sphere (indexed by sphere).
-    pub hist: Vec<History>,
 }
 
 impl Wall {
@@ -109,7 +107,6 @@ impl Wall {
             contacts: 0,
             s_build: 0.0,
             candidates: Vec::new(),
-            hist: Vec::new(),
         }
     }
 
