@@ -50,24 +50,18 @@ fn main() {
     } else if let Some(f) = &cache {
         std::fs::write(f, serde_json::to_string(&sys).expect("serialise")).expect("write cache");
     }
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("thread pool");
-    for threads in [1, 2] {
+    // BED_THREADS=1 or =2: time only that count (default both).
+    let only: Option<usize> = std::env::var("BED_THREADS").ok().and_then(|t| t.parse().ok());
+    for threads in [1, 2].into_iter().filter(|t| only.is_none_or(|o| o == *t)) {
         let mut run = sys.clone();
         run.set_threads(threads);
         // Energies and overlap statistics every 10 000 steps, as the peers' thermo output.
         run.measure_every = 10_000;
         for rep in 0..3 {
             let t = Instant::now();
-            // The whole loop runs on a worker of rayon's pool, so that each
-            // `rayon::join` of a step runs one half on this thread and hands the
-            // other to the second worker (called from outside the pool, a join
-            // parks the caller and wakes two workers).
-            rayon::in_place_scope(|_| ());
-            pool.install(|| {
-                for _ in 0..timed {
-                    run.step().expect("dense run");
-                }
-            });
+            for _ in 0..timed {
+                run.step().expect("dense run");
+            }
             let s = t.elapsed().as_secs_f64();
             println!("threads {threads} run {rep}: {:.2} M particle-steps/s", n as f64 * timed as f64 / s / 1e6);
         }

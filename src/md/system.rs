@@ -637,18 +637,20 @@ fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offs
             let Some(law) = ctx.laws.get(mati, p.material[o] as usize) else { continue };
             let (vj, wj) = if ghost { (ctx.g.v[j - n], ctx.g.w[j - n]) } else { (p.v[j], p.w[j]) };
             let dist = dist2.sqrt();
-            let nrm = if dist > 0.0 { d / dist } else { V3::z() };
+            let nrm = if dist > 0.0 { d * (1.0 / dist) } else { V3::z() };
             let delta = rs - dist;
             let ai = ri - 0.5 * delta;
             let aj = rj - 0.5 * delta;
             let v_rel = vi - vj + nrm.cross(&wi) * ai + nrm.cross(&wj) * aj;
             let mj = p.m[o];
+            let inv = 1.0 / (rs * (mi + mj));
             let k = Kinematics {
                 n: nrm,
                 delta,
                 v_rel,
-                r_star: ri * rj / rs,
-                m_star: mi * mj / (mi + mj),
+                // R* = ri rj / (ri + rj), m* = mi mj / (mi + mj): one division.
+                r_star: ri * rj * (mi + mj) * inv,
+                m_star: mi * mj * rs * inv,
                 measure: ctx.measure,
             };
             let cf = contact::force(law, &k, h, dt);
@@ -737,7 +739,7 @@ fn tail(c: View, hist: &mut [History], ctx: &TailContext, out: &mut Tail) {
             let delta = -gap;
             let a = c.r[i] - delta;
             let v_rel = c.v[i] + nrm.cross(&c.w[i]) * a - vw;
-            let k_ = Kinematics { n: nrm, delta, v_rel, r_star, m_star: 1.0 / c.inv_m[i], measure: true };
+            let k_ = Kinematics { n: nrm, delta, v_rel, r_star, m_star: c.m[i], measure: true };
             let cf = contact::force(law, &k_, h, dt);
             c.f[i] += cf.force;
             c.t[i] += nrm.cross(&cf.tangential) * (-a);
@@ -777,6 +779,7 @@ struct View<'a> {
     f: &'a mut [V3],
     t: &'a mut [V3],
     r: &'a [f64],
+    m: &'a [f64],
     material: &'a [u32],
     inv_m: &'a [f64],
     inv_i: &'a [f64],
@@ -798,6 +801,7 @@ impl<'a> View<'a> {
             f: &mut p.f,
             t: &mut p.t,
             r: &p.r,
+            m: &p.m,
             material: &p.material,
             inv_m: &p.inv_m,
             inv_i: &p.inv_i,
@@ -825,6 +829,7 @@ impl<'a> View<'a> {
         let (f0, f1) = self.f.split_at_mut(at);
         let (t0, t1) = self.t.split_at_mut(at);
         let (r0, r1) = self.r.split_at(at);
+        let (mm0, mm1) = self.m.split_at(at);
         let (c0, c1) = self.material.split_at(at);
         let (m0, m1) = self.inv_m.split_at(at);
         let (i0, i1) = self.inv_i.split_at(at);
@@ -844,6 +849,7 @@ impl<'a> View<'a> {
                 f: f0,
                 t: t0,
                 r: r0,
+                m: mm0,
                 material: c0,
                 inv_m: m0,
                 inv_i: i0,
@@ -860,6 +866,7 @@ impl<'a> View<'a> {
                 f: f1,
                 t: t1,
                 r: r1,
+                m: mm1,
                 material: c1,
                 inv_m: m1,
                 inv_i: i1,
@@ -915,7 +922,8 @@ fn second_half(c: View, integrator: Integrator, g: V3, dt: f64) -> f64 {
                 c.v[i] += (c.f[i] * c.inv_m[i] + g) * (0.5 * dt);
                 c.w[i] += c.t[i] * (c.inv_i[i] * 0.5 * dt);
                 rotate(&mut c.q[i], &c.w[i], dt);
-                kinetic += 0.5 * (c.v[i].norm_squared() / c.inv_m[i] + c.w[i].norm_squared() / c.inv_i[i]);
+                // Solid sphere: I = 2/5 m r².
+                kinetic += 0.5 * c.m[i] * (c.v[i].norm_squared() + 0.4 * c.r[i] * c.r[i] * c.w[i].norm_squared());
                 finite &= c.x[i].iter().all(|a| a.is_finite());
             }
         }
@@ -935,7 +943,8 @@ fn second_half(c: View, integrator: Integrator, g: V3, dt: f64) -> f64 {
                 c.v[i] = c.gx[i][1] / dt;
                 c.w[i] = c.gw[i][1] / dt;
                 rotate(&mut c.q[i], &c.w[i], dt);
-                kinetic += 0.5 * (c.v[i].norm_squared() / c.inv_m[i] + c.w[i].norm_squared() / c.inv_i[i]);
+                // Solid sphere: I = 2/5 m r².
+                kinetic += 0.5 * c.m[i] * (c.v[i].norm_squared() + 0.4 * c.r[i] * c.r[i] * c.w[i].norm_squared());
                 finite &= c.x[i].iter().all(|a| a.is_finite());
             }
         }
