@@ -348,7 +348,7 @@ impl MdSystem {
         };
         let d = moved2.sqrt();
         let dw = self.walls.iter().map(|w| (w.s - w.s_build).abs()).fold(0.0, f64::max);
-        if !built || !(d + d.max(dw) <= self.settings.skin) {
+        if !built || d + d.max(dw) > self.settings.skin {
             self.rebuild();
         }
         self.ghosts.update(&self.particles);
