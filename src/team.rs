@@ -35,6 +35,9 @@ struct Shared {
     done: AtomicU64,
     /// Set while the helper sleeps (it must then be unparked).
     sleeping: AtomicBool,
+    /// Set while a join uses the helper: a join nested in one, or called from
+    /// another thread meanwhile, runs its halves on its caller instead.
+    busy: AtomicBool,
     stop: AtomicBool,
     /// The posted job; written by the caller before `posted` is raised, read by
     /// the helper after it sees the raise, and not touched by the caller again
@@ -82,6 +85,7 @@ impl Team {
             posted: AtomicU64::new(0),
             done: AtomicU64::new(0),
             sleeping: AtomicBool::new(false),
+            busy: AtomicBool::new(false),
             stop: AtomicBool::new(false),
             job: UnsafeCell::new(None),
         });
@@ -100,7 +104,8 @@ impl Team {
     }
 
     /// Runs `a` on the caller and `b` on the helper at the same time, and returns
-    /// both results; without a helper, `a` then `b` on the caller.
+    /// both results; without a helper (or while it is busy with another join,
+    /// e.g. when called from inside `a` or `b`), `a` then `b` on the caller.
     ///
     /// # Panics
     /// If `a` or `b` panics (after both have finished).
@@ -108,7 +113,10 @@ impl Team {
     where
         RB: Send,
     {
-        let Some(h) = &self.helper else {
+        let helper = self.helper.as_ref().filter(|h| {
+            h.shared.busy.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).is_ok()
+        });
+        let Some(h) = helper else {
             let ra = a();
             return (ra, b());
         };
@@ -170,6 +178,7 @@ impl Drop for Wait<'_> {
                 std::thread::yield_now();
             }
         }
+        self.shared.busy.store(false, Ordering::Release);
     }
 }
 
@@ -274,6 +283,25 @@ mod tests {
             },
         );
         assert_ne!(other, caller);
+    }
+
+    #[test]
+    fn nested_and_concurrent_joins_run_on_their_caller() {
+        let team = Team::new(2);
+        let (a, (b, c)) = team.join(|| team.join(|| 1, || 2), || team.join(|| 3, || 4));
+        assert_eq!((a, b, c), ((1, 2), 3, 4));
+        // Two threads sharing the team: each join either gets the helper or runs
+        // both halves itself; every result comes back.
+        std::thread::scope(|s| {
+            let t: Vec<_> = (0..2u64)
+                .map(|k| {
+                    let team = &team;
+                    s.spawn(move || (0..500u64).map(|i| team.join(|| i, || k * i)).map(|(x, y)| x + y).sum::<u64>())
+                })
+                .collect();
+            let sums: Vec<u64> = t.into_iter().map(|h| h.join().unwrap()).collect();
+            assert_eq!(sums, vec![124_750, 249_500]);
+        });
     }
 
     #[test]

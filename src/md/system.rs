@@ -614,8 +614,9 @@ fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offs
         let (xi, vi, wi, ri, mi, mati) = (p.x[i], p.v[i], p.w[i], p.r[i], p.m[i], p.material[i] as usize);
         let mut fi = V3::zeros();
         let mut ti = V3::zeros();
-        for e in ctx.start[i] as usize..ctx.start[i + 1] as usize {
-            let j = ctx.j[e] as usize;
+        let (e0, e1) = (ctx.start[i] as usize, ctx.start[i + 1] as usize);
+        for (&j, h) in ctx.j[e0..e1].iter().zip(&mut hist[e0 - offset..e1 - offset]) {
+            let j = j as usize;
             let ghost = j >= n;
             let (xj, o) = if ghost {
                 let g = j - n;
@@ -627,7 +628,6 @@ fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offs
             let d = xi - xj;
             let dist2 = d.norm_squared();
             let rs = ri + rj;
-            let h = &mut hist[e - offset];
             if dist2 >= rs * rs {
                 if h.delta != 0.0 {
                     *h = History::default();
