@@ -39,11 +39,14 @@ fn main() {
     let settle_s = t0.elapsed().as_secs_f64();
     println!(
         "settled {n} spheres in {settle} steps, {settle_s:.1} s ({:.2} M particle-steps/s on 2 threads); top centre {:.4} m; \
-         Ek {:.3e} J; {} neighbour builds",
+         Ek {:.3e} J; {} neighbour builds; {} listed pairs, {} contacts, {} wall contacts",
         n as f64 * settle as f64 / settle_s / 1e6,
         top_centre(&sys),
         sys.last.kinetic_energy,
-        sys.neighbours.builds
+        sys.neighbours.builds,
+        sys.neighbours.pairs(),
+        sys.last.contacts,
+        sys.last.wall_contacts
     );
     if let (Some(f), 0) = (&cache, settle) {
         println!("loaded the settled bed from {f}");

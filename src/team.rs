@@ -113,9 +113,10 @@ impl Team {
     where
         RB: Send,
     {
-        let helper = self.helper.as_ref().filter(|h| {
-            h.shared.busy.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).is_ok()
-        });
+        let helper = self
+            .helper
+            .as_ref()
+            .filter(|h| h.shared.busy.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).is_ok());
         let Some(h) = helper else {
             let ra = a();
             return (ra, b());

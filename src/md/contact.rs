@@ -76,6 +76,9 @@ pub fn force(law: &PairLaw, k: &Kinematics, h: &mut History, dt: f64) -> Contact
 #[inline(always)]
 fn hertz(law: &PairLaw, k: &Kinematics, h: &mut History, dt: f64) -> ContactForce {
     let n = k.n;
+    // 1/√(R* δ_old), from the memory alone, so that it is computed while the
+    // current overlap is (off the step's chain of dependent square roots).
+    let inv_sq_old = if h.delta > 0.0 { 1.0 / (k.r_star * h.delta).sqrt() } else { 0.0 };
     let vn = k.v_rel.dot(&n);
     let vt = k.v_rel - n * vn;
     let sq = (k.r_star * k.delta).sqrt();
@@ -95,7 +98,8 @@ fn hertz(law: &PairLaw, k: &Kinematics, h: &mut History, dt: f64) -> ContactForc
     let mut ft = h.t - n * n.dot(&h.t);
     if h.delta > 0.0 && k.delta < h.delta {
         // Unloading: back to the tangential force of this normal force (Karrech §2.2).
-        ft *= (k.delta / h.delta).sqrt();
+        // k_t(δ)/k_t(δ_old) = √(δ/δ_old) = √(R* δ) / √(R* δ_old).
+        ft *= sq * inv_sq_old;
     }
     ft -= vt * (kt * dt);
     let limit = law.mu_s * fn_;

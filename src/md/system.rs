@@ -641,7 +641,7 @@ fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offs
             let delta = rs - dist;
             let ai = ri - 0.5 * delta;
             let aj = rj - 0.5 * delta;
-            let v_rel = vi - vj + nrm.cross(&wi) * ai + nrm.cross(&wj) * aj;
+            let v_rel = vi - vj + nrm.cross(&(wi * ai + wj * aj));
             let mj = p.m[o];
             let inv = 1.0 / (rs * (mi + mj));
             let k = Kinematics {
@@ -655,7 +655,8 @@ fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offs
             };
             let cf = contact::force(law, &k, h, dt);
             fi += cf.force;
-            ti -= nrm.cross(&cf.tangential) * ai;
+            let arm = nrm.cross(&cf.tangential);
+            ti -= arm * ai;
             let weight = if ghost { 0.5 } else { 1.0 };
             tally.contacts += weight;
             if ctx.measure {
@@ -674,7 +675,7 @@ fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offs
             }
             if !ghost {
                 w.f[j] -= cf.force;
-                w.t[j] -= nrm.cross(&cf.tangential) * aj;
+                w.t[j] -= arm * aj;
             }
         }
         w.f[i] += fi;
