@@ -268,6 +268,31 @@ fn run_stops_at_equilibrium() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Spheres released from rest meet `E_k < r E_p` at once (E_k = 0): the
+/// equilibrium window must not start before the condition has failed once. The
+/// lower sphere's bottom is 0.8 mm above the base: it lands after
+/// √(2 · 0.8 mm / g) = 12.8 ms = 6386 steps of 2 µs; with `energy_ratio = 1e-2`
+/// and a 100-step window, a run that counted from the start stopped at step 100.
+#[test]
+fn equilibrium_is_not_declared_before_the_sample_has_moved() {
+    let dir = temp_dir("equilibrium_rest");
+    let scene = dir.join("in.toml");
+    let text = example()
+        .replace("seed = 1\n", "seed = 1\nequilibrium = { energy_ratio = 1e-2, steps = 100 }\n")
+        .replace("every = 500", "every = 1");
+    std::fs::write(&scene, &text).unwrap();
+    let out = dir.join("out");
+    run_ok(&scene, &out, &[]);
+    let series = std::fs::read_to_string(out.join("series.csv")).unwrap();
+    let rows: Vec<Vec<f64>> =
+        series.lines().skip(1).map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    // The condition held over the first 100 steps (columns: time, E_k, E_el, E_p).
+    assert!(rows[..100].iter().all(|r| r[1] < 1e-2 * r[3]), "the test needs a calm start");
+    let stop = json(&out.join("final.json"))["step"].as_u64().unwrap();
+    assert!(stop > 6386, "stopped at step {stop}, before the lower sphere landed");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn servo_walls_get_a_position_column() {
     let dir = temp_dir("servo");

@@ -137,7 +137,10 @@ pub(crate) fn run(scene_path: &Path, scene_text: &str, out: &Path, opts: &RunOpt
             // Moving servo walls are part of the motion that has to die out.
             e.holds(stats.kinetic_energy + sys.wall_kinetic_energy(), ep)
         });
-        summary.calm_steps = if calm { summary.calm_steps + 1 } else { 0 };
+        // Calm steps count only once the condition has failed at least once: a
+        // deposit released from rest meets E_k < r E_p before anything has fallen.
+        summary.moved |= equilibrium.is_some() && !calm;
+        summary.calm_steps = if calm && summary.moved { summary.calm_steps + 1 } else { 0 };
         at_equilibrium = equilibrium.is_some_and(|e| summary.calm_steps >= e.steps());
         if k % every == 0 || k == steps || at_equilibrium {
             series.write_row(&md_series_row(&sys, &stats)).map_err(Failure::Run)?;

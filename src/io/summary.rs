@@ -121,6 +121,10 @@ pub struct MdRunSummary {
     pub wall_contacts: u64,
     /// Consecutive steps so far that met the equilibrium condition.
     pub calm_steps: u64,
+    /// Whether some step so far failed the equilibrium condition: only then do
+    /// calm steps count (a sample released from rest has not settled yet).
+    #[serde(default)]
+    pub moved: bool,
     /// Wall time spent stepping so far, over every invocation (s).
     pub wall_time_s: f64,
 }

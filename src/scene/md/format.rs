@@ -81,6 +81,8 @@ impl MdSimulation {
 /// for `steps` consecutive steps: the kinetic energy `E_k` below
 /// `kinetic_energy` (J), and `E_k` below `energy_ratio` times the potential
 /// energy `E_p` (gravitational + elastic, [`crate::md::MdSystem::potential_energy`]).
+/// The steps count only after a first step that failed the conditions: a
+/// sample released from rest is not at equilibrium before it has moved.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MdEquilibrium {
