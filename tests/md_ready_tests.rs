@@ -152,4 +152,41 @@ fn luding_compression_then_one_cycle() {
     let (_, strain) = csv(&cyc.join("strain.csv"));
     assert_eq!(strain.len(), 1);
     assert!(cyc.join("stress_strain_loops.png").exists() && cyc.join("strain_accumulation.svg").exists());
+
+    // Figs. 3–5 overlay runs: the same box cycled again, compared with the first.
+    let again = dir.join("again");
+    ballast(
+        &["luding", "cycle", "--from", comp.to_str().unwrap(), "--out", again.to_str().unwrap(), "--cycles", "1"]
+            .iter()
+            .chain(&["--every", "1000", "--quiet"])
+            .copied()
+            .collect::<Vec<_>>(),
+    );
+    let cmp = dir.join("compare");
+    ballast(&[
+        "luding",
+        "compare",
+        "--runs",
+        cyc.to_str().unwrap(),
+        again.to_str().unwrap(),
+        "--out",
+        cmp.to_str().unwrap(),
+    ]);
+    let text = std::fs::read_to_string(cmp.join("compare.csv")).unwrap();
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    assert_eq!(rows.len(), 2, "{text}");
+    // Same scene, same seed: the same ε_N to the last digit, labelled with N = 27.
+    let eps = |r: &str| r.rsplit(',').next().unwrap().to_string();
+    assert_eq!(eps(rows[0]), eps(rows[1]));
+    assert!(rows.iter().all(|r| r.contains(",27,0.1,1,")), "{text}");
+    for f in ["strain_accumulation.png", "strain_accumulation.svg", "first_cycle_loops.png", "first_cycle_loops.svg"] {
+        assert!(cmp.join(f).exists(), "{f}");
+    }
+    // A folder that is not a cycled run is refused with its name.
+    let out = Command::new(env!("CARGO_BIN_EXE_ballast"))
+        .args(["luding", "compare", "--runs", comp.to_str().unwrap(), "--out", cmp.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("not a `luding cycle` output"), "{err}");
 }

@@ -10,7 +10,9 @@
 //! - `luding compress --out DIR --spheres N --friction μ`: isotropic compression of
 //!   the triaxial box of David et al.; `luding cycle --from COMPRESSED --out DIR
 //!   --cycles K`: the cyclic σ_xx, then `loops.csv` (σ_D, ε_D), `strain.csv`
-//!   (ε_N per cycle) and the figures of the paper's Figs. 2–5.
+//!   (ε_N per cycle) and the figures of the paper's Figs. 2–5 for that run;
+//!   `luding compare --runs DIR… --out DIR`: several cycled runs (sizes N or
+//!   frictions μ) on common axes, as the paper's Figs. 3–5.
 //!
 //! Every run is an ordinary `ballast run` of a written scene: progress bar,
 //! checkpoints, `--resume`, `--vtk-every` and the outputs of `ballast run`.
@@ -135,6 +137,16 @@ pub enum LudingCommand {
         #[command(flatten)]
         run: RunArgs,
     },
+    /// Several cycled runs on common axes (the paper's Figs. 3–5): ε_N per cycle
+    /// and the first cycle's σ_D–ε_D loop of each, labelled by N and μ.
+    Compare {
+        /// Output directories of `luding cycle` runs.
+        #[arg(long, value_name = "DIR", num_args = 1.., required = true)]
+        runs: Vec<PathBuf>,
+        /// Where the figures and `compare.csv` go.
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+    },
 }
 
 fn input(msg: String) -> Failure {
@@ -238,10 +250,53 @@ pub(crate) fn luding_main(cmd: LudingCommand) -> Result<(), Failure> {
             if !(args.resume && scene.exists()) {
                 write(&scene, &luding::cyclic_scene(&spec, &spheres_of(&sys), lo, hi, cycles, args.every))?;
             }
+            if !(args.resume && args.out.join("spec.json").exists()) {
+                write(
+                    &args.out.join("spec.json"),
+                    &format!(
+                        "{{\"spheres\":{},\"friction\":{:?},\"seed\":{},\"period\":{:?},\"cycles\":{cycles}}}",
+                        spec.spheres, spec.friction, spec.seed, spec.period
+                    ),
+                )?;
+            }
             run(&scene, &args.out, &args.options())?;
             cycle_figures(&args.out, &spec, hi - lo)
         }
+        LudingCommand::Compare { runs, out } => compare_figures(&runs, &out),
     }
+}
+
+/// Figs. 3–5 of David et al. from several `luding cycle` runs.
+fn compare_figures(runs: &[PathBuf], out: &Path) -> Result<(), Failure> {
+    ballast::io::create_output_dir(out).map_err(Failure::Run)?;
+    let mut table = String::from("run,spheres,friction,cycle,epsilon_N\n");
+    let (mut strain, mut loops) = (Vec::new(), Vec::new());
+    for dir in runs {
+        let v = spec_json(dir)?;
+        let (Some(n), Some(mu), Some(period)) = (v["spheres"].as_u64(), v["friction"].as_f64(), v["period"].as_f64())
+        else {
+            return Err(input(format!(
+                "{}: spec.json has no spheres, friction or period (not a `luding cycle` output)",
+                dir.display()
+            )));
+        };
+        let label = format!("N = {n}, μ = {mu}");
+        let s = columns(&dir.join("strain.csv"), &["cycle", "epsilon_N"])?;
+        for (c, e) in s[0].iter().zip(&s[1]) {
+            table.push_str(&format!("{},{n},{mu:?},{c},{e:e}\n", dir.display()));
+        }
+        strain.push(curve(&label, &s[0], &s[1]));
+        let l = columns(&dir.join("loops.csv"), &["time", "sigma_D", "epsilon_D"])?;
+        let first: Vec<usize> = (0..l[0].len()).filter(|&k| l[0][k] <= period).collect();
+        let e: Vec<f64> = first.iter().map(|&k| l[2][k]).collect();
+        let sd: Vec<f64> = first.iter().map(|&k| l[1][k] / 1e3).collect();
+        loops.push(curve(&label, &e, &sd));
+    }
+    write(&out.join("compare.csv"), &table)?;
+    chart(out, "strain_accumulation", "Accumulated strain ε_N (Figs. 3, 5)", "cycle", "ε_N", false, strain)?;
+    chart(out, "first_cycle_loops", "First cycle, σ_D vs ε_D (Fig. 4)", "ε_D", "σ_D (kPa)", false, loops)?;
+    println!("compare.csv, strain_accumulation and first_cycle_loops written in {}", out.display());
+    Ok(())
 }
 
 /// Lower and upper corners of the box of axis-aligned plane walls.
