@@ -66,7 +66,7 @@ impl KarrechSpec {
             loose_fraction: 0.05,
             seed,
             dt: 1e-7,
-            duration: 1.0,
+            duration: 2.0,
             energy_ratio: 1e-6,
         }
     }
