@@ -11,6 +11,8 @@
 //! each other; the caller runs its own half meanwhile and then waits for the
 //! helper's, so both halves always run at the same time.
 //!
+//! The split NLGS (`nscd::split`) uses the same team for its two half-sweeps.
+//!
 //! A team without a helper (one thread) runs both halves in order on the caller.
 
 use std::cell::UnsafeCell;

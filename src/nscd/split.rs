@@ -18,19 +18,17 @@
 //! the halves and scattered back. The order of the updates (left rows, right
 //! rows, interface rows, each in key order) depends on the positions only,
 //! never on the number of threads: a run gives the same numbers on one core or
-//! two. With two threads the right half is handed to a helper thread for the
-//! step and back each sweep through two one-slot channels; the threads spin
-//! briefly, then yield, while they wait (a sweep lasts tens of microseconds, far
-//! less than a sleep and wake-up).
+//! two. With two threads each sweep of the right half runs on the helper of a
+//! [`Team`], started once and spinning between sweeps (a sweep lasts tens of
+//! microseconds, far less than a sleep and wake-up).
 //!
-//! Nothing is allocated once the buffers have grown to the problem's size,
-//! except the helper thread, started once per step.
+//! Nothing is allocated once the buffers have grown to the problem's size.
 
 use super::contact::ContactRow;
 use super::criterion::SweepNorms;
 use super::nlgs::sweep;
 use super::sublayer::SpringRow;
-use std::sync::mpsc::{sync_channel, Receiver, TryRecvError};
+use crate::team::Team;
 
 const LEFT: u8 = 0;
 const RIGHT: u8 = 1;
@@ -79,6 +77,8 @@ pub struct SplitWorkspace {
     left: Part,
     right: Part,
     iface: Part,
+    /// The caller and, with two threads, the helper that sweeps the right half.
+    team: Team,
 }
 
 /// Sums and maxima of two partial sweeps.
@@ -94,25 +94,6 @@ fn merge(a: SweepNorms, b: SweepNorms) -> SweepNorms {
         sum_wrwr: a.sum_wrwr + b.sum_wrwr,
         sum_wpp: a.sum_wpp + b.sum_wpp,
         changed: a.changed || b.changed,
-    }
-}
-
-/// Waits for a message: spins, then yields the core. `None` if the sender is gone.
-fn wait<T>(rx: &Receiver<T>) -> Option<T> {
-    let mut spins = 0u32;
-    loop {
-        match rx.try_recv() {
-            Ok(v) => return Some(v),
-            Err(TryRecvError::Disconnected) => return None,
-            Err(TryRecvError::Empty) => {
-                if spins < 20_000 {
-                    spins += 1;
-                    std::hint::spin_loop();
-                } else {
-                    std::thread::yield_now();
-                }
-            }
-        }
     }
 }
 
@@ -249,44 +230,18 @@ impl SplitWorkspace {
     /// Runs `sweeps` with a function doing one split sweep (on one thread, or on
     /// two when `threads ≥ 2`), then nothing more: call [`Self::store`] after.
     pub(crate) fn run<R>(&mut self, threads: usize, sweeps: impl FnOnce(&mut dyn FnMut(bool) -> SweepNorms) -> R) -> R {
-        let Self { left, right, iface, side, slot, .. } = self;
-        let (side, slot) = (&side[..], &slot[..]);
-        let interface = |left: &mut Part, right: &mut Part, iface: &mut Part, backwards: bool| {
-            Self::exchange(left, right, iface, side, slot, true);
-            let n = iface.sweep(backwards);
-            Self::exchange(left, right, iface, side, slot, false);
-            n
-        };
-        if threads < 2 {
-            return sweeps(&mut |backwards| {
-                let l = left.sweep(backwards);
-                let r = right.sweep(backwards);
-                merge(merge(l, r), interface(left, right, iface, backwards))
-            });
+        if (threads >= 2) != (self.team.threads() >= 2) {
+            self.team = Team::new(threads);
         }
-        std::thread::scope(|s| {
-            let (to_helper, jobs) = sync_channel::<(&mut Part, bool)>(1);
-            let (to_main, done) = sync_channel::<(&mut Part, SweepNorms)>(1);
-            s.spawn(move || {
-                while let Some((part, backwards)) = wait(&jobs) {
-                    let n = part.sweep(backwards);
-                    if to_main.send((part, n)).is_err() {
-                        break;
-                    }
-                }
-            });
-            let mut right = Some(right);
-            let result = sweeps(&mut |backwards| {
-                let r_part = right.take().expect("the right half is home between sweeps");
-                to_helper.send((r_part, backwards)).expect("the helper thread runs until the step ends");
-                let l = left.sweep(backwards);
-                let (r_part, r) = wait(&done).expect("the helper thread answers every sweep");
-                let n = merge(merge(l, r), interface(left, r_part, iface, backwards));
-                right = Some(r_part);
-                n
-            });
-            drop(to_helper);
-            result
+        let Self { left, right, iface, side, slot, team, .. } = self;
+        let (side, slot) = (&side[..], &slot[..]);
+        sweeps(&mut |backwards| {
+            // Left and right side by side (in turn on one thread), then the interface.
+            let (l, r) = team.join(|| left.sweep(backwards), || right.sweep(backwards));
+            Self::exchange(left, right, iface, side, slot, true);
+            let i = iface.sweep(backwards);
+            Self::exchange(left, right, iface, side, slot, false);
+            merge(merge(l, r), i)
         })
     }
 
