@@ -323,11 +323,8 @@ impl MdSystem {
     /// between the phases of a step; more are not used). The numbers do not
     /// depend on it: the work is always cut into the same [`CHUNKS`] chunks.
     pub fn set_threads(&mut self, threads: usize) {
-        let threads = threads.clamp(1, CHUNKS);
-        if threads != self.threads {
-            self.team = Team::default();
-        }
-        self.threads = threads;
+        // The next step starts or stops the team's helper to match.
+        self.threads = threads.clamp(1, CHUNKS);
     }
 
     /// Threads in use.
