@@ -19,11 +19,13 @@
 //! # Ok::<(), ballast::Error>(())
 //! ```
 
+pub mod clock;
 pub mod error;
 pub mod geometry;
 pub mod io;
 pub mod md;
 pub mod nscd;
+pub mod run;
 pub mod scenarios;
 pub mod scene;
 pub mod team;

@@ -1,8 +1,8 @@
 //! Per-cycle settlement statistics (`cycles.csv`) against a quasi-static spring.
 
 mod common;
-use ballast::io::cycles::CycleRecorder;
 use ballast::nscd::{Harmonic, Load, Spring};
+use ballast::run::{CyclePlan, RunOptions, RunPlan, Runner};
 use common::*;
 
 /// A pad on a stiff sublayer spring (k = k_N/L0 = 2.05e8 N/m, natural frequency
@@ -40,14 +40,26 @@ fn cycle_settlement_of_a_sprung_pad_is_the_quasi_static_deflection() {
         impulse: 0.0,
     });
     let k = k_n / l0;
-    let mut rec = CycleRecorder::new(&s, f, p);
-    let mut rows = Vec::new();
-    for _ in 0..1500 {
-        let st = s.step().unwrap();
-        if let Some(r) = rec.record(&s, &st) {
-            rows.push(r.split(',').map(|x| x.parse::<f64>().unwrap()).collect::<Vec<f64>>());
-        }
-    }
+    // The library's run loop writes cycles.csv (with the positions of the pad).
+    let dir = std::env::temp_dir().join(format!("ballast-cycles-{}", std::process::id()));
+    let plan = RunPlan {
+        cycles: Some(CyclePlan { frequency: f, body: Some(p), positions: true }),
+        ..RunPlan::new(1500, 1500)
+    };
+    let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
+    Runner::from_system(s, plan).unwrap().run(&dir, &opts, &mut |_| {}).unwrap();
+    let rows: Vec<Vec<f64>> = ballast::io::cycles::read_nscd(&dir.join("cycles.csv"))
+        .unwrap()
+        .iter()
+        .map(|r| {
+            vec![r.cycle as f64, r.time_s, r.settlement_mean_m, r.settlement_at_min_load_m, r.mean_grain_speed_m_s]
+        })
+        .collect();
+    // The positions at the cycle ends: the pad's height is y0 minus the settlement
+    // at the cycle's last step, to the float32 resolution of the stored displacement.
+    let positions = ballast::io::positions::read(&dir).unwrap();
+    assert_eq!((positions.reference.bodies.clone(), positions.cycles.len()), (vec![p], 3));
+    let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(rows.len(), 3, "one row per 20 Hz cycle over 0.15 s");
     for r in &rows[1..] {
         // Dynamic correction (f/f0)² = 6e-5; the θ-weighted spring tracks the load to

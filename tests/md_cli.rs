@@ -48,7 +48,8 @@ fn vector(v: &serde_json::Value) -> Vec<f64> {
 }
 
 const HEADER: &str =
-    "time,kinetic_energy,elastic_energy,potential_energy,contacts,wall_contacts,max_overlap,mean_overlap,coordination,packing_fraction";
+    "time_s,kinetic_energy_J,elastic_energy_J,potential_energy_J,contacts,wall_contacts,max_overlap_m,\
+mean_overlap_m,coordination,packing_fraction";
 
 #[test]
 fn the_example_writes_every_output() {
@@ -58,7 +59,7 @@ fn the_example_writes_every_output() {
     std::fs::write(&scene, &text).unwrap();
     let out = dir.join("out");
     let stdout = run_ok(&scene, &out, &[]);
-    assert!(stdout.contains("100000 steps") && stdout.contains("particle-steps/s"), "{stdout}");
+    assert!(stdout.contains("100000 steps") && stdout.contains("body-steps/s"), "{stdout}");
     for name in ["series.csv", "final.json", "summary.json", "run.json", "scene.toml", "final_scene.toml"] {
         assert!(out.join(name).is_file(), "{name} missing");
     }
@@ -68,7 +69,7 @@ fn the_example_writes_every_output() {
     // series.csv: the exact header, one row every 500 steps of 100 000.
     let series = std::fs::read_to_string(out.join("series.csv")).unwrap();
     let mut lines = series.lines();
-    assert_eq!(lines.next().unwrap(), format!("{HEADER},base_force,mould_force"));
+    assert_eq!(lines.next().unwrap(), format!("{HEADER},base_force_N,mould_force_N"));
     let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
     assert_eq!(rows.len(), 200);
     assert!(rows.iter().all(|r| r.len() == 12));
@@ -112,8 +113,8 @@ fn the_example_writes_every_output() {
     );
     assert_eq!(info["dt"].as_f64(), Some(2e-6));
     let summary = json(&out.join("summary.json"));
-    assert_eq!((summary["steps"].as_u64(), summary["spheres"].as_u64()), (Some(100000), Some(2)));
-    assert!(summary["particle_steps_per_s"].as_f64().unwrap() > 0.0);
+    assert_eq!((summary["steps"].as_u64(), summary["bodies"].as_u64()), (Some(100000), Some(2)));
+    assert!(summary["body_steps_per_s"].as_f64().unwrap() > 0.0);
     assert!(summary["max_overlap_m"].as_f64().unwrap() > 0.0 && summary["mean_contacts"].as_f64().unwrap() > 0.0);
     assert_eq!(summary["equilibrium"], false);
 
@@ -161,7 +162,7 @@ fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
     // summary.json: the same sums; only the wall time and the speed may differ.
     let summary = |d: &Path| {
         let mut v = json(&d.join("summary.json"));
-        for k in ["wall_time_s", "wall_time_per_step_s", "particle_steps_per_s"] {
+        for k in ["wall_time_s", "wall_time_per_step_s", "body_steps_per_s"] {
             assert!(v[k].as_f64().unwrap() > 0.0, "{k}");
             v.as_object_mut().unwrap().remove(k);
         }
@@ -305,7 +306,10 @@ fn servo_walls_get_a_position_column() {
     let out = dir.join("out");
     run_ok(&scene, &out, &[]);
     let series = std::fs::read_to_string(out.join("series.csv")).unwrap();
-    assert_eq!(series.lines().next().unwrap(), format!("{HEADER},base_force,mould_force,lid_force,lid_position"));
+    assert_eq!(
+        series.lines().next().unwrap(),
+        format!("{HEADER},base_force_N,mould_force_N,lid_force_N,lid_position_m")
+    );
     // The lid is pushed down by 0.05 N against its viscosity: it moves down.
     let s: f64 = series.lines().last().unwrap().split(',').next_back().unwrap().parse().unwrap();
     assert!(s > 0.0, "displacement along its normal (−z): {s}");
@@ -327,7 +331,7 @@ fn diverging_run_exits_with_code_1() {
     let r = run(&scene, &out, &[]);
     let stderr = String::from_utf8(r.stderr).unwrap();
     assert_eq!(r.status.code(), Some(1), "stderr: {stderr:?}");
-    assert!(stderr.starts_with("error: step ") && stderr.contains("runaway overlap"), "{stderr:?}");
+    assert!(stderr.starts_with("error: step 1: body ") && stderr.contains("runaway"), "{stderr:?}");
     assert_eq!(stderr.trim_end().lines().count(), 1);
     let fin = json(&out.join("final.json"));
     assert_eq!(fin["step"].as_u64(), Some(0));
@@ -379,6 +383,6 @@ fn invalid_scenes_exit_with_code_2_and_one_line() {
         "law",
         "contact: no [[contact]] between materials 'diorite' and 'steel'",
     );
-    assert_refused(&text, &["--figures"], "figures", "--figures: not available for MD scenes");
+    assert_refused(&text, &["--figures"], "figures", "--figures: not available for md runs");
     assert_refused(&text, &["--checkpoint-every", "nan"], "checkpoint", "--checkpoint-every");
 }

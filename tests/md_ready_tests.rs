@@ -69,7 +69,7 @@ fn karrech_deposit_then_cyclic_load() {
             2710.0 * 4.0 / 3.0 * std::f64::consts::PI * r * r * r * 9.81
         })
         .sum();
-    let base = last[col(&h, "base_force")];
+    let base = last[col(&h, "base_force_N")];
     assert!((base - weight).abs() < 0.03 * weight, "base {base} N vs weight {weight} N");
     let phi = last[col(&h, "packing_fraction")];
     assert!(phi > 0.0 && phi < 0.74, "packing fraction {phi}");
@@ -85,9 +85,9 @@ fn karrech_deposit_then_cyclic_load() {
     assert_eq!(rows.len(), 2, "one row per cycle");
     // Rows at t = k/f, f = 50 Hz, to within a step (2 µs).
     for (k, r) in rows.iter().enumerate() {
-        assert!((r[col(&h, "time")] - (k + 1) as f64 / 50.0).abs() <= 2e-6 + 1e-12);
+        assert!((r[col(&h, "time_s")] - (k + 1) as f64 / 50.0).abs() <= 2e-6 + 1e-12);
     }
-    assert!(h.contains(&"plate_position".to_string()));
+    assert!(h.contains(&"plate_position_m".to_string()));
     assert!(load.join("residual_displacement.png").exists());
 }
 
@@ -128,10 +128,10 @@ fn luding_compression_then_one_cycle() {
         let r_max = f["bodies"].as_array().unwrap().iter().map(|b| b["radius"].as_f64().unwrap()).fold(0.0, f64::max);
         3.0 * 2.0 * r_max * 1.05
     };
-    let l = |a: &str| l0 - last[col(&h, &format!("{a}0_position"))] - last[col(&h, &format!("{a}1_position"))];
+    let l = |a: &str| l0 - last[col(&h, &format!("{a}0_position_m"))] - last[col(&h, &format!("{a}1_position_m"))];
     let (lx, ly, lz) = (l("x"), l("y"), l("z"));
     for (wall, area) in [("x0", ly * lz), ("x1", ly * lz), ("y0", lx * lz), ("z1", lx * ly)] {
-        let s = last[col(&h, &format!("{wall}_force"))] / area;
+        let s = last[col(&h, &format!("{wall}_force_N"))] / area;
         assert!((s - 1000.0).abs() < 20.0, "{wall}: {s} Pa");
     }
 
@@ -147,8 +147,8 @@ fn luding_compression_then_one_cycle() {
     // stress by their relaxation time m/γ = 0.01 s ≪ 10 s, and the box keeps
     // σ_yy at p₀. 3 % (the spheres' own dynamics on 27 spheres).
     let mid = rows.iter().min_by(|a, b| (a[0] - 5.0).abs().total_cmp(&(b[0] - 5.0).abs())).unwrap();
-    assert!((mid[col(&h, "sigma_xx")] - 1200.0).abs() < 36.0, "σ_xx {}", mid[col(&h, "sigma_xx")]);
-    assert!((mid[col(&h, "sigma_yy")] - 1000.0).abs() < 30.0, "σ_yy {}", mid[col(&h, "sigma_yy")]);
+    assert!((mid[col(&h, "sigma_xx_pa")] - 1200.0).abs() < 36.0, "σ_xx {}", mid[col(&h, "sigma_xx_pa")]);
+    assert!((mid[col(&h, "sigma_yy_pa")] - 1000.0).abs() < 30.0, "σ_yy {}", mid[col(&h, "sigma_yy_pa")]);
     let (_, strain) = csv(&cyc.join("strain.csv"));
     assert_eq!(strain.len(), 1);
     assert!(cyc.join("stress_strain_loops.png").exists() && cyc.join("strain_accumulation.svg").exists());

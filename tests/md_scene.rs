@@ -398,7 +398,7 @@ fn syntax_errors_unknown_keys_missing_keys_and_vector_lengths() {
     expect(&edit("duration = 1e-4\n", "duration = 1e-4\n\n[output]\ncycle = 3\n"), &["unknown field `cycle`"]);
     expect(
         &edit("duration = 1e-4\n", "duration = 1e-4\n\n[output]\ncycles = 3\n"),
-        &["line", "expected struct MdCycles"],
+        &["line", "expected struct CyclesSpec"],
     );
     expect(
         &edit("duration = 1e-4\n", "duration = 1e-4\n\n[output]\ncycles = { frequency = -1.0 }\n"),
@@ -455,7 +455,7 @@ fn time_step_duration_and_skin_ranges() {
     );
     expect(
         &edit("duration = 1e-4", "duration = 1e-4\ngravity = [0.0, nan, 0.0]"),
-        &["simulation.gravity: must be finite"],
+        &["simulation.gravity[1]: must be finite"],
     );
 }
 
@@ -674,7 +674,7 @@ fn other_body_and_wall_errors_name_the_entry() {
     expect(&nobody, &["body: the scene has no [[body]]"]);
     expect(&edit("[[material]]", "[output]\nevery = 0\n\n[[material]]"), &["output.every: must be at least 1, got 0"]);
     let eq = |table: &str| edit("duration = 1e-4", &format!("duration = 1e-4\nequilibrium = {table}"));
-    expect(&eq("{ steps = 10 }"), &["simulation.equilibrium: give kinetic_energy, energy_ratio or both"]);
+    expect(&eq("{ steps = 10 }"), &["simulation.equilibrium: give kinetic_energy (J), energy_ratio (E_k/E_p) or both"]);
     expect(&eq("{ kinetic_energy = 0.0 }"), &["simulation.equilibrium.kinetic_energy: must be positive"]);
     expect(&eq("{ energy_ratio = 1e-3, steps = 0 }"), &["simulation.equilibrium.steps: must be at least 1"]);
 }

@@ -5,30 +5,48 @@
 //! measured by `ballast saussine sample` (data/saussine2006/README.md); the
 //! reduced one keeps the tests within seconds.
 
-use ballast::io::cycles::CycleRecorder;
-use ballast::nscd::System;
-use ballast::scenarios::saussine::{loaded_scene, measure_sample, sample_scene, LoadingSpec, SampleSpec, SLEEPER};
+use ballast::run::{RunOptions, Runner, Status};
+use ballast::scenarios::saussine::{loaded_scene, measure_sample, sample_scene, LoadingSpec, SampleSpec};
 use ballast::scene::Scene;
+use std::path::PathBuf;
 use std::sync::OnceLock;
 
 const GRAINS: usize = 121;
 
-/// Deposits the reduced sample of `seed` until its kinetic energy stays below the
-/// scene's equilibrium threshold for the scene's window of steps.
+/// A fresh output folder for this test process.
+fn out_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ballast-saussine-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// Deposits the reduced sample of `seed` with the library's run loop, which stops
+/// once the kinetic energy has stayed below the scene's equilibrium threshold for
+/// the scene's window of steps.
 fn deposit(seed: u64) -> (Scene, f64) {
     let spec = SampleSpec::saussine(seed).scaled(GRAINS);
     let scene = Scene::from_toml_str(&sample_scene(&spec)).unwrap();
-    let eq = scene.simulation.equilibrium.unwrap();
-    let mut sys = scene.build().unwrap();
-    let mut calm = 0;
-    for _ in 0..scene.steps() {
-        let st = sys.step().unwrap();
-        calm = if st.kinetic_energy < eq.kinetic_energy { calm + 1 } else { 0 };
-        if calm >= eq.steps() {
-            break;
-        }
+    let sys = scene.build().unwrap();
+    let dir = out_dir(&format!("deposit{seed}"));
+    let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
+    let run = Runner::from_system(sys.clone(), scene.plan().unwrap()).unwrap().run(&dir, &opts, &mut |_| {}).unwrap();
+    assert_eq!(
+        run.status,
+        Status::Ended(ballast::io::RunEnd::Equilibrium),
+        "the deposit did not reach equilibrium within {} s",
+        scene.simulation.duration
+    );
+    let fin = ballast::io::FinalState::read(&dir.join("final.json")).unwrap();
+    let mut sys = sys;
+    for (i, b) in fin.bodies.iter().enumerate() {
+        sys.bodies.q[i] = [b.position[0], b.position[1], b.angle.unwrap()];
+        let spin = match b.spin {
+            ballast::io::Spin::Planar(w) => w,
+            ballast::io::Spin::Spatial(_) => unreachable!(),
+        };
+        sys.bodies.u[i] = [b.velocity[0], b.velocity[1], spin];
     }
-    assert!(calm >= eq.steps(), "the deposit did not reach equilibrium within {} s", scene.simulation.duration);
+    let _ = std::fs::remove_dir_all(&dir);
     (scene.with_state(&sys), spec.width)
 }
 
@@ -51,19 +69,14 @@ fn settle(scene: &Scene, cycles: u64, stiffness_factor: f64) -> Vec<(f64, f64)> 
         ..LoadingSpec::saussine(cycles).scaled(sample().1)
     };
     let loaded = loaded_scene(scene, &spec).unwrap();
-    let mut sys: System = loaded.build().unwrap();
-    let body = loaded.bodies.iter().position(|b| b.name == SLEEPER).unwrap();
-    let mut rec = CycleRecorder::new(&sys, spec.frequency, body);
-    let mut rows = Vec::new();
-    for _ in 0..loaded.steps() {
-        let st = sys.step().unwrap();
-        if let Some(row) = rec.record(&sys, &st) {
-            let f: Vec<f64> = row.split(',').map(|x| x.parse().unwrap()).collect();
-            rows.push((f[2], f[3]));
-        }
-    }
+    let dir = out_dir(&format!("settle{cycles}_{stiffness_factor}"));
+    let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
+    let runner = Runner::from_system(loaded.build().unwrap(), loaded.plan().unwrap()).unwrap();
+    runner.run(&dir, &opts, &mut |_| {}).unwrap();
+    let rows = ballast::io::cycles::read_nscd(&dir.join("cycles.csv")).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(rows.len() as u64, cycles);
-    rows
+    rows.iter().map(|r| (r.settlement_mean_m, r.settlement_at_min_load_m)).collect()
 }
 
 #[test]

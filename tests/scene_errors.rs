@@ -287,7 +287,7 @@ fn non_positive_quantities() {
 #[test]
 fn non_finite_numbers() {
     expect(&edit("dt = 1.0e-3", "dt = nan"), &["simulation.dt:"]);
-    expect(&edit("gravity = [0.0, -9.81]", "gravity = [0.0, -inf]"), &["simulation.gravity: must be finite"]);
+    expect(&edit("gravity = [0.0, -9.81]", "gravity = [0.0, -inf]"), &["simulation.gravity[1]: must be finite"]);
     expect(&edit("position = [0.2, 0.001]", "position = [0.2, nan]"), &["body[1] 'block': position"]);
     expect(&edit("angle = 0.3", "angle = inf"), &["body[1] 'block': angle: must be finite"]);
     expect(&edit("velocity = [0.1, -0.2]", "velocity = [inf, -0.2]"), &["body[1] 'block': velocity"]);
@@ -329,7 +329,10 @@ fn nscd_settings() {
 
 #[test]
 fn engine() {
-    expect(&edit("engine = \"nscd\"", "engine = \"md\""), &["simulation.engine", "not implemented yet"]);
+    expect(
+        &edit("engine = \"nscd\"", "engine = \"md\""),
+        &["simulation.engine: expected 'nscd', got 'md' (read it with scene::MdScene)"],
+    );
     expect(&edit("engine = \"nscd\"", "engine = \"dem\""), &["simulation.engine: unknown engine 'dem'"]);
 }
 
@@ -431,7 +434,7 @@ fn equilibrium_criterion_is_validated_and_round_trips() {
     expect(&with("{ kinetic_energy = 1e-9, window = 3 }"), &["unknown field `window`"]);
     let scene = Scene::from_toml_str(&with("{ kinetic_energy = 1e-9, steps = 30 }")).unwrap();
     let eq = scene.simulation.equilibrium.unwrap();
-    assert_eq!((eq.kinetic_energy, eq.steps()), (1e-9, 30));
+    assert_eq!((eq.kinetic_energy, eq.steps()), (Some(1e-9), 30));
     let again = Scene::from_toml_str(&scene.to_toml_string().unwrap()).unwrap();
     assert_eq!(again.simulation.equilibrium, scene.simulation.equilibrium);
 }
@@ -441,9 +444,10 @@ fn cycle_output_is_validated_and_round_trips() {
     let with = |c: &str| edit("every = 2\n", &format!("every = 2\ncycles = {c}\n"));
     expect(&with("{ frequency = 20.0, body = \"nobody\" }"), &["output.cycles.body", "unknown body 'nobody'"]);
     expect(&with("{ frequency = -1.0, body = \"block\" }"), &["output.cycles.frequency", "positive"]);
-    expect(&with("{ frequency = 20.0 }"), &["missing field `body`"]);
-    let scene = Scene::from_toml_str(&with("{ frequency = 20.0, body = \"block\" }")).unwrap();
-    assert_eq!(scene.output_cycles(), Some((20.0, 1)));
+    expect(&with("{ frequency = 20.0 }"), &["output.cycles.body", "name the followed body"]);
+    let scene = Scene::from_toml_str(&with("{ frequency = 20.0, body = \"block\", positions = true }")).unwrap();
+    let plan = ballast::run::CyclePlan { frequency: 20.0, body: Some(1), positions: true };
+    assert_eq!(scene.plan().unwrap().cycles, Some(plan));
     let again = Scene::from_toml_str(&scene.to_toml_string().unwrap()).unwrap();
-    assert_eq!(again.output_cycles(), Some((20.0, 1)));
+    assert_eq!(again.plan().unwrap().cycles, Some(plan));
 }

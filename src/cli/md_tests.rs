@@ -17,14 +17,15 @@
 //! Every run is an ordinary `ballast run` of a written scene: progress bar,
 //! checkpoints, `--resume`, `--vtk-every` and the outputs of `ballast run`.
 
-use super::{run, Failure, RunOptions};
+use super::{input, run_scene, Display, Failure};
 use ballast::io::figures::{line_chart, Axes, Series};
 use ballast::md::V3;
+use ballast::run::{default_threads, RunOptions};
 use ballast::scenarios::karrech::{self, KarrechSpec, Loading};
 use ballast::scenarios::luding::{self, LudingSpec};
 use ballast::scene::MdScene;
-use ballast::Error;
 use clap::{Args, Subcommand, ValueEnum};
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// Options shared by every MD test run.
@@ -56,13 +57,18 @@ pub struct RunArgs {
 impl RunArgs {
     fn options(&self) -> RunOptions {
         RunOptions {
-            quiet: self.quiet,
-            checkpoint_every: self.checkpoint_every,
+            checkpoint_every_s: self.checkpoint_every,
             resume: self.resume,
             vtk_every: self.vtk_every,
-            threads: self.threads.unwrap_or_else(super::default_threads),
+            threads: self.threads.unwrap_or_else(default_threads),
             ..RunOptions::default()
         }
+    }
+
+    /// Runs `scene` into the output directory.
+    fn run(&self, scene: &Path) -> Result<(), Failure> {
+        let display = if self.quiet { Display::Quiet } else { Display::Bar };
+        run_scene(scene, &self.out, &self.options(), &display).map(|_| ())
     }
 }
 
@@ -150,15 +156,65 @@ pub enum LudingCommand {
     },
 }
 
-fn input(msg: String) -> Failure {
-    Failure::Input(Error::Scene(msg))
-}
-
 fn write(path: &Path, text: &str) -> Result<(), Failure> {
     if let Some(dir) = path.parent() {
         ballast::io::create_output_dir(dir).map_err(Failure::Run)?;
     }
     std::fs::write(path, text).map_err(|e| Failure::Run(ballast::io::io_error(path, "write", e)))
+}
+
+/// `spec.json`: what a first stage was made with, read by the stages after it.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+struct TestSpec {
+    spheres: usize,
+    seed: u64,
+    /// Time step (s), Karrech.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    dt: Option<f64>,
+    /// Young's modulus (Pa), Karrech.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    young: Option<f64>,
+    /// Friction coefficient, Luding.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    friction: Option<f64>,
+    /// Loading period (s) and cycles, `luding cycle`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    period: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    cycles: Option<u32>,
+}
+
+fn write_spec(dir: &Path, spec: &TestSpec) -> Result<(), Failure> {
+    ballast::io::create_output_dir(dir).map_err(Failure::Run)?;
+    ballast::io::write_json(&dir.join("spec.json"), spec).map(|_| ()).map_err(Failure::Run)
+}
+
+/// One row of `loops.csv` (Pa, dimensionless).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct LoopRow {
+    time_s: f64,
+    sigma_xx_pa: f64,
+    sigma_yy_pa: f64,
+    sigma_d_pa: f64,
+    epsilon_d: f64,
+}
+
+/// One row of `strain.csv`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct StrainRow {
+    cycle: u64,
+    time_s: f64,
+    epsilon_n: f64,
+}
+
+/// One row of `compare.csv`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct CompareRow {
+    run: String,
+    spheres: usize,
+    friction: f64,
+    cycle: u64,
+    epsilon_n: f64,
 }
 
 /// Spheres `(radius, position)` and the built system of a finished run's final scene.
@@ -171,10 +227,8 @@ fn final_state(dir: &Path) -> Result<ballast::md::MdSystem, Failure> {
 }
 
 /// The `spec.json` a first stage left in its output directory.
-fn spec_json(dir: &Path) -> Result<serde_json::Value, Failure> {
-    let path = dir.join("spec.json");
-    let text = std::fs::read_to_string(&path).map_err(|e| Failure::Input(ballast::io::io_error(&path, "read", e)))?;
-    serde_json::from_str(&text).map_err(|e| input(format!("{}: {e}", path.display())))
+fn spec_json(dir: &Path) -> Result<TestSpec, Failure> {
+    ballast::io::read_json(&dir.join("spec.json")).map_err(Failure::Input)
 }
 
 fn spheres_of(sys: &ballast::md::MdSystem) -> Vec<(f64, V3)> {
@@ -193,26 +247,28 @@ pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
             let scene = args.out.join("deposit.toml");
             if !(args.resume && scene.exists()) {
                 write(&scene, &karrech::deposit_scene(&spec, args.every))?;
-                let json = format!("{{\"spheres\":{spheres},\"seed\":{seed},\"dt\":{dt:?},\"young\":{young:?}}}");
-                write(&args.out.join("spec.json"), &json)?;
+                write_spec(
+                    &args.out,
+                    &TestSpec { spheres, seed, dt: Some(dt), young: Some(young), ..TestSpec::default() },
+                )?;
             }
-            run(&scene, &args.out, &args.options())?;
+            args.run(&scene)?;
             deposit_figures(&args.out)
         }
         KarrechCommand::Load { from, mode, cycles, run: args } => {
             let sys = final_state(&from)?;
             let v = spec_json(&from)?;
             let spec = KarrechSpec {
-                dt: v["dt"].as_f64().unwrap_or(1e-7),
-                young: v["young"].as_f64().unwrap_or(46.9e9),
-                ..KarrechSpec::table1(sys.particles.len(), v["seed"].as_u64().unwrap_or(1))
+                dt: v.dt.unwrap_or(1e-7),
+                young: v.young.unwrap_or(46.9e9),
+                ..KarrechSpec::table1(sys.particles.len(), v.seed)
             };
             let loading = if mode == Mode::Full { Loading::FULL } else { Loading::PARTIAL };
             let scene = args.out.join("load.toml");
             if !(args.resume && scene.exists()) {
                 write(&scene, &karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, args.every))?;
             }
-            run(&scene, &args.out, &args.options())?;
+            args.run(&scene)?;
             load_figures(&args.out)
         }
     }
@@ -230,21 +286,14 @@ pub(crate) fn luding_main(cmd: LudingCommand) -> Result<(), Failure> {
             let scene = args.out.join("compress.toml");
             if !(args.resume && scene.exists()) {
                 write(&scene, &luding::compression_scene(&spec, duration, args.every))?;
-                write(
-                    &args.out.join("spec.json"),
-                    &format!("{{\"spheres\":{spheres},\"friction\":{friction:?},\"seed\":{seed}}}"),
-                )?;
+                write_spec(&args.out, &TestSpec { spheres, seed, friction: Some(friction), ..TestSpec::default() })?;
             }
-            run(&scene, &args.out, &args.options())
+            args.run(&scene)
         }
         LudingCommand::Cycle { from, cycles, run: args } => {
             let sys = final_state(&from)?;
             let v = spec_json(&from)?;
-            let spec = LudingSpec::paper(
-                sys.particles.len(),
-                v["friction"].as_f64().unwrap_or(0.1),
-                v["seed"].as_u64().unwrap_or(1),
-            );
+            let spec = LudingSpec::paper(sys.particles.len(), v.friction.unwrap_or(0.1), v.seed);
             let (lo, hi) =
                 box_corners(&sys).ok_or_else(|| input("luding cycle: the compressed scene has no box".into()))?;
             let scene = args.out.join("cycle.toml");
@@ -252,15 +301,17 @@ pub(crate) fn luding_main(cmd: LudingCommand) -> Result<(), Failure> {
                 write(&scene, &luding::cyclic_scene(&spec, &spheres_of(&sys), lo, hi, cycles, args.every))?;
             }
             if !(args.resume && args.out.join("spec.json").exists()) {
-                write(
-                    &args.out.join("spec.json"),
-                    &format!(
-                        "{{\"spheres\":{},\"friction\":{:?},\"seed\":{},\"period\":{:?},\"cycles\":{cycles}}}",
-                        spec.spheres, spec.friction, spec.seed, spec.period
-                    ),
-                )?;
+                let json = TestSpec {
+                    spheres: spec.spheres,
+                    seed: spec.seed,
+                    friction: Some(spec.friction),
+                    period: Some(spec.period),
+                    cycles: Some(cycles),
+                    ..TestSpec::default()
+                };
+                write_spec(&args.out, &json)?;
             }
-            run(&scene, &args.out, &args.options())?;
+            args.run(&scene)?;
             cycle_figures(&args.out, &spec, hi - lo)
         }
         LudingCommand::Compare { runs, out } => compare_figures(&runs, &out),
@@ -270,30 +321,30 @@ pub(crate) fn luding_main(cmd: LudingCommand) -> Result<(), Failure> {
 /// Figs. 3–5 of David et al. from several `luding cycle` runs.
 fn compare_figures(runs: &[PathBuf], out: &Path) -> Result<(), Failure> {
     ballast::io::create_output_dir(out).map_err(Failure::Run)?;
-    let mut table = String::from("run,spheres,friction,cycle,epsilon_N\n");
+    let mut table = Vec::new();
     let (mut strain, mut loops) = (Vec::new(), Vec::new());
     for dir in runs {
         let v = spec_json(dir)?;
-        let (Some(n), Some(mu), Some(period)) = (v["spheres"].as_u64(), v["friction"].as_f64(), v["period"].as_f64())
-        else {
+        let (n, Some(mu), Some(period)) = (v.spheres, v.friction, v.period) else {
             return Err(input(format!(
                 "{}: spec.json has no spheres, friction or period (not a `luding cycle` output)",
                 dir.display()
             )));
         };
         let label = format!("N = {n}, μ = {mu}");
-        let s = columns(&dir.join("strain.csv"), &["cycle", "epsilon_N"])?;
-        for (c, e) in s[0].iter().zip(&s[1]) {
-            table.push_str(&format!("{},{n},{mu:?},{c},{e:e}\n", dir.display()));
+        let s = columns(&dir.join("strain.csv"), &["cycle", "epsilon_n"])?;
+        for (&cycle, &epsilon_n) in s[0].iter().zip(&s[1]) {
+            let cycle = cycle as u64;
+            table.push(CompareRow { run: dir.display().to_string(), spheres: n, friction: mu, cycle, epsilon_n });
         }
         strain.push(curve(&label, &s[0], &s[1]));
-        let l = columns(&dir.join("loops.csv"), &["time", "sigma_D", "epsilon_D"])?;
+        let l = columns(&dir.join("loops.csv"), &["time_s", "sigma_d_pa", "epsilon_d"])?;
         let first: Vec<usize> = (0..l[0].len()).filter(|&k| l[0][k] <= period).collect();
         let e: Vec<f64> = first.iter().map(|&k| l[2][k]).collect();
         let sd: Vec<f64> = first.iter().map(|&k| l[1][k] / 1e3).collect();
         loops.push(curve(&label, &e, &sd));
     }
-    write(&out.join("compare.csv"), &table)?;
+    ballast::io::table::write_all(&out.join("compare.csv"), &table).map_err(Failure::Run)?;
     chart(out, "strain_accumulation", "Accumulated strain ε_N (Figs. 3, 5)", "cycle", "ε_N", false, strain)?;
     chart(out, "first_cycle_loops", "First cycle, σ_D vs ε_D (Fig. 4)", "ε_D", "σ_D (kPa)", false, loops)?;
     println!("compare.csv, strain_accumulation and first_cycle_loops written in {}", out.display());
@@ -318,26 +369,7 @@ fn box_corners(sys: &ballast::md::MdSystem) -> Option<(V3, V3)> {
 
 /// The named columns of a CSV file of numbers.
 fn columns(path: &Path, names: &[&str]) -> Result<Vec<Vec<f64>>, Failure> {
-    let mut reader =
-        csv::Reader::from_path(path).map_err(|e| Failure::Run(Error::Scene(format!("{}: {e}", path.display()))))?;
-    let header = reader.headers().map_err(|e| Failure::Run(Error::Scene(format!("{}: {e}", path.display()))))?.clone();
-    let idx: Vec<usize> = names
-        .iter()
-        .map(|n| {
-            header
-                .iter()
-                .position(|h| h == *n)
-                .ok_or_else(|| Failure::Run(Error::Scene(format!("{}: no column '{n}'", path.display()))))
-        })
-        .collect::<Result<_, _>>()?;
-    let mut out = vec![Vec::new(); names.len()];
-    for rec in reader.records() {
-        let rec = rec.map_err(|e| Failure::Run(Error::Scene(format!("{}: {e}", path.display()))))?;
-        for (k, &i) in idx.iter().enumerate() {
-            out[k].push(rec.get(i).and_then(|s| s.parse().ok()).unwrap_or(f64::NAN));
-        }
-    }
-    Ok(out)
+    ballast::io::table::read_columns(path, names).map_err(Failure::Run)
 }
 
 fn chart(
@@ -365,7 +397,7 @@ fn curve(label: &str, x: &[f64], y: &[f64]) -> Series {
 fn deposit_figures(dir: &Path) -> Result<(), Failure> {
     let c = columns(
         &dir.join("series.csv"),
-        &["time", "base_force", "coordination", "packing_fraction", "kinetic_energy", "potential_energy"],
+        &["time_s", "base_force_N", "coordination", "packing_fraction", "kinetic_energy_J", "potential_energy_J"],
     )?;
     let weight = final_state(dir)?.weight();
     let t = &c[0];
@@ -398,7 +430,7 @@ fn deposit_figures(dir: &Path) -> Result<(), Failure> {
 
 /// Residual displacement per cycle and the plate's motion.
 fn load_figures(dir: &Path) -> Result<(), Failure> {
-    let c = columns(&dir.join("cycles.csv"), &["cycle", "mean_displacement_z", "max_displacement"])?;
+    let c = columns(&dir.join("cycles.csv"), &["cycle", "mean_displacement_z_m", "max_displacement_m"])?;
     let down: Vec<f64> = c[1].iter().map(|v| -v).collect();
     chart(
         dir,
@@ -409,7 +441,7 @@ fn load_figures(dir: &Path) -> Result<(), Failure> {
         false,
         vec![curve("mean settlement of the spheres (−u_z)", &c[0], &down), curve("largest displacement", &c[0], &c[2])],
     )?;
-    let s = columns(&dir.join("series.csv"), &["time", "plate_position", "plate_force"])?;
+    let s = columns(&dir.join("series.csv"), &["time_s", "plate_position_m", "plate_force_N"])?;
     chart(
         dir,
         "plate",
@@ -428,21 +460,21 @@ fn cycle_figures(dir: &Path, spec: &LudingSpec, l0: V3) -> Result<(), Failure> {
     let c = columns(
         &dir.join("series.csv"),
         &[
-            "time",
-            "x0_force",
-            "x1_force",
-            "y0_force",
-            "y1_force",
-            "z0_position",
-            "z1_position",
-            "x0_position",
-            "x1_position",
-            "y0_position",
-            "y1_position",
+            "time_s",
+            "x0_force_N",
+            "x1_force_N",
+            "y0_force_N",
+            "y1_force_N",
+            "z0_position_m",
+            "z1_position_m",
+            "x0_position_m",
+            "x1_position_m",
+            "y0_position_m",
+            "y1_position_m",
         ],
     )?;
     let n = c[0].len();
-    let mut loops = String::from("time,sigma_xx,sigma_yy,sigma_D,epsilon_D\n");
+    let mut loops = Vec::with_capacity(n);
     let (mut sd, mut ed) = (Vec::with_capacity(n), Vec::with_capacity(n));
     #[allow(clippy::needless_range_loop)]
     for k in 0..n {
@@ -450,13 +482,13 @@ fn cycle_figures(dir: &Path, spec: &LudingSpec, l0: V3) -> Result<(), Failure> {
         let sxx = 0.5 * (c[1][k] + c[2][k]) / (l[1] * l[2]);
         let syy = 0.5 * (c[3][k] + c[4][k]) / (l[0] * l[2]);
         let (s, e) = ballast::md::measure::deviatoric(sxx, syy, l, l0);
-        loops.push_str(&format!("{:e},{sxx:e},{syy:e},{s:e},{e:e}\n", c[0][k]));
+        loops.push(LoopRow { time_s: c[0][k], sigma_xx_pa: sxx, sigma_yy_pa: syy, sigma_d_pa: s, epsilon_d: e });
         sd.push(s);
         ed.push(e);
     }
-    write(&dir.join("loops.csv"), &loops)?;
+    ballast::io::table::write_all(&dir.join("loops.csv"), &loops).map_err(Failure::Run)?;
     // ε_N: ε_D at the ends of the cycles (nearest row).
-    let mut strain = String::from("cycle,time,epsilon_N\n");
+    let mut strain = Vec::new();
     let (mut cyc, mut en) = (Vec::new(), Vec::new());
     let total = c[0].last().copied().unwrap_or(0.0);
     let mut k = 0;
@@ -468,11 +500,11 @@ fn cycle_figures(dir: &Path, spec: &LudingSpec, l0: V3) -> Result<(), Failure> {
         while k + 1 < n && (c[0][k + 1] - t).abs() <= (c[0][k] - t).abs() {
             k += 1;
         }
-        strain.push_str(&format!("{cycle},{:e},{:e}\n", c[0][k], ed[k]));
+        strain.push(StrainRow { cycle, time_s: c[0][k], epsilon_n: ed[k] });
         cyc.push(cycle as f64);
         en.push(ed[k]);
     }
-    write(&dir.join("strain.csv"), &strain)?;
+    ballast::io::table::write_all(&dir.join("strain.csv"), &strain).map_err(Failure::Run)?;
     let sd_kpa: Vec<f64> = sd.iter().map(|s| s / 1e3).collect();
     chart(
         dir,

@@ -15,8 +15,9 @@
 //! A sample scaled to fewer grains (`--grains`) is loaded with the sleeper's width
 //! and the load scaled alike (same pressure), unless `--sleeper-width` is given.
 
-use crate::studies::{self, loading_for, StudyArgs};
-use crate::{run, Failure, Prior, RunOptions};
+use super::studies::{self, loading_for, StudyArgs};
+use super::{run_scene, Display, Failure};
+use ballast::run::{default_threads, Prior, RunOptions};
 use ballast::scenarios::saussine::{
     loaded_scene, measure_sample, open_bank, sample_scene, Guide, LoadingSpec, SampleSpec,
 };
@@ -234,7 +235,7 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                 }
                 spec = spec.scaled(n);
             }
-            sample(&spec, &out, resume, quiet, None)
+            sample(&spec, &out, resume, if quiet { &Display::Quiet } else { &Display::Bar })
         }
         SaussineCommand::Load { sample, out, loading } => {
             let scene = Scene::load(&sample).map_err(Failure::Input)?;
@@ -254,15 +255,15 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
             }
             let steps_per_cycle = (1.0 / (spec.frequency * spec.dt)).round().max(1.0) as u64;
             let opts = RunOptions {
-                quiet,
-                checkpoint_every,
+                checkpoint_every_s: checkpoint_every,
                 resume,
                 vtk_every: snapshot_every.saturating_mul(steps_per_cycle),
                 figures: true,
-                threads: crate::default_threads(),
+                threads: default_threads(),
                 ..RunOptions::default()
             };
-            run(&path, &out, &opts)
+            let display = if quiet { Display::Quiet } else { Display::Bar };
+            run_scene(&path, &out, &opts, &display).map(|_| ())
         }
         SaussineCommand::Convergence { sample, policies, loading, study } => {
             studies::convergence(&sample, &policies, &loading, &study)
@@ -287,42 +288,33 @@ pub(crate) fn write_scene(path: &Path, scene: &Scene, what: &str) -> Result<(), 
     write(path, &text)
 }
 
-/// Progress bars of a run inside a group, with a label.
-type Progress = Option<(indicatif::MultiProgress, String)>;
-
 /// Runs `scene_path` into `dir` unless a finished run is there already.
-fn run_stage(scene_path: &Path, dir: &Path, resume: bool, quiet: bool, progress: Progress) -> Result<Scene, Failure> {
+fn run_stage(scene_path: &Path, dir: &Path, resume: bool, display: &Display) -> Result<Scene, Failure> {
     let final_scene = dir.join("final_scene.toml");
     let prior = Prior::of(dir, "final_scene.toml", resume);
     if prior != Prior::Finished {
         let resume = prior == Prior::Checkpointed;
         // One sweep thread per run when deposits run side by side (an ensemble).
-        let threads = if progress.is_some() { 1 } else { crate::default_threads() };
-        let opts = RunOptions { quiet, checkpoint_every: 300.0, resume, progress, threads, ..RunOptions::default() };
-        run(scene_path, dir, &opts)?;
+        let threads = if matches!(display, Display::Group(..)) { 1 } else { default_threads() };
+        let opts = RunOptions { checkpoint_every_s: 300.0, resume, threads, ..RunOptions::default() };
+        run_scene(scene_path, dir, &opts, display)?;
     }
     Scene::load(&final_scene).map_err(Failure::Run)
 }
 
 /// Deposits the sample of `spec` into `out` (`sample.toml`, `sample.json`).
-pub(crate) fn sample(
-    spec: &SampleSpec,
-    out: &Path,
-    resume: bool,
-    quiet: bool,
-    progress: Progress,
-) -> Result<(), Failure> {
+pub(crate) fn sample(spec: &SampleSpec, out: &Path, resume: bool, display: &Display) -> Result<(), Failure> {
     let text = sample_scene(spec);
     Scene::from_toml_str(&text).map_err(Failure::Input)?;
     ballast::io::create_output_dir(out).map_err(Failure::Run)?;
     let deposit = out.join("deposit.toml");
     write(&deposit, &text)?;
-    let mut settled = run_stage(&deposit, &out.join("deposit"), resume, quiet, progress.clone())?;
+    let mut settled = run_stage(&deposit, &out.join("deposit"), resume, display)?;
     if spec.bank {
         let opened = open_bank(&settled).map_err(Failure::Run)?;
         let bank = out.join("bank.toml");
         write_scene(&bank, &opened, "the deposited sample without its mould, to settle into free banks")?;
-        settled = run_stage(&bank, &out.join("bank"), resume, quiet, progress)?;
+        settled = run_stage(&bank, &out.join("bank"), resume, display)?;
     }
     let path = out.join("sample.toml");
     write_scene(&path, &settled, &format!("deposited sample, seed {}", spec.seed))?;

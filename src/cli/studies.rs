@@ -21,18 +21,20 @@
 //! reported in the summary (`status`), the others go on. `--resume` skips the
 //! finished runs and resumes the checkpointed ones.
 
-use crate::saussine::{sample, LoadingArgs};
-use crate::{run, Failure, Prior, RunOptions};
-use ballast::io::cycles::CycleRow;
+use super::saussine::{sample, LoadingArgs};
+use super::{run_scene, Display, Failure};
+use ballast::io::cycles::NscdCycleRow as CycleRow;
 use ballast::io::figures::{self, Axes, Series};
-use ballast::io::series::SeriesRow;
+use ballast::io::series::NscdSeriesRow as SeriesRow;
+use ballast::io::table::TableWriter;
 use ballast::io::{self, RunReport};
+use ballast::run::{cores, default_threads, Prior, RunOptions};
 use ballast::scenarios::saussine::{loaded_scene, LoadingSpec, SampleSpec, GRAIN_PREFIX};
 use ballast::scene::Scene;
 use ballast::Error;
 use indicatif::MultiProgress;
 use rayon::prelude::*;
-use std::fmt::Write as _;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// Settings shared by the studies.
@@ -135,7 +137,7 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
     if !(study.checkpoint_every.is_finite() && study.checkpoint_every >= 0.0) {
         return Err(input(format!("--checkpoint-every: must be non-negative, got {}", study.checkpoint_every)));
     }
-    let threads = study.jobs.unwrap_or_else(crate::cores);
+    let threads = study.jobs.unwrap_or_else(cores);
     if threads == 0 {
         return Err(input("--jobs: must be at least 1".into()));
     }
@@ -155,7 +157,7 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
         };
         let loaded = loaded_scene(&sample, &job.spec).map_err(Failure::Input)?;
         let what = format!("{} of the study in {}, from {}", job.label, out.display(), job.sample.display());
-        crate::saussine::write_scene(&job.scene(out), &loaded, &what)?;
+        super::saussine::write_scene(&job.scene(out), &loaded, &what)?;
     }
     let group = MultiProgress::new();
     let pool = pool(threads)?;
@@ -169,16 +171,16 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
                     return Ok(());
                 }
                 let opts = RunOptions {
-                    quiet: study.quiet,
-                    checkpoint_every: study.checkpoint_every,
+                    checkpoint_every_s: study.checkpoint_every,
                     resume: prior == Prior::Checkpointed,
                     figures: true,
                     // Several runs at once: one sweep thread each, unless one job.
-                    threads: if threads == 1 { crate::default_threads() } else { 1 },
-                    progress: Some((group.clone(), job.label.clone())),
+                    threads: if threads == 1 { default_threads() } else { 1 },
                     ..RunOptions::default()
                 };
-                run(&job.scene(out), &dir, &opts)
+                let display =
+                    if study.quiet { Display::Quiet } else { Display::Group(group.clone(), job.label.clone()) };
+                run_scene(&job.scene(out), &dir, &opts, &display).map(|_| ())
             })
             .collect()
     });
@@ -193,56 +195,83 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
             // A diverged run still wrote its series and summary: keep it in the study.
             Err(Failure::Run(e)) => {
                 eprintln!("run {} failed: {e}", job.label);
-                format!("failed: {}", crate::one_line(&e))
+                format!("failed: {}", super::one_line(&e))
             }
         };
         let report = std::fs::read_to_string(dir.join("summary.json"))
             .ok()
             .and_then(|t| serde_json::from_str::<RunReport>(&t).ok());
-        let series = io::series::read(&dir.join("series.csv")).unwrap_or_default();
+        let series = io::series::read_nscd(&dir.join("series.csv")).unwrap_or_default();
         let cycles_path = dir.join("cycles.csv");
-        let cycles = if cycles_path.exists() { io::cycles::read(&cycles_path).map_err(Failure::Run)? } else { vec![] };
+        let cycles =
+            if cycles_path.exists() { io::cycles::read_nscd(&cycles_path).map_err(Failure::Run)? } else { vec![] };
         outcomes.push(Outcome { status, report, series, cycles });
     }
     Ok(outcomes)
 }
 
-/// A CSV field: quoted if it holds a comma or a quote.
-fn field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
+/// The columns of a study's summary CSVs that describe one run, from its report
+/// and cycles (NaN where the run left nothing).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunColumns {
+    pub mean_iterations: f64,
+    pub mean_contacts: f64,
+    pub wall_time_s: f64,
+    pub wall_time_per_cycle_s: f64,
+    pub unconverged_steps: u64,
+    pub mean_overlap_m: f64,
+    pub max_overlap_m: f64,
+    pub final_total_overlap_m: f64,
+    pub cycles: u64,
+    pub settlement_mean_m: f64,
+    pub settlement_at_min_load_m: f64,
+    pub status: String,
 }
 
-/// Columns shared by the study summaries, from a run's report and cycles.
-const RUN_COLUMNS: &str = "mean_iterations,mean_contacts,wall_time_s,wall_time_per_cycle_s,unconverged_steps,\
-mean_overlap_m,max_overlap_m,final_total_overlap_m,cycles,settlement_mean_m,settlement_at_min_load_m,status";
+/// The names of the [`RunColumns`].
+const RUN_COLUMNS: [&str; 12] = [
+    "mean_iterations",
+    "mean_contacts",
+    "wall_time_s",
+    "wall_time_per_cycle_s",
+    "unconverged_steps",
+    "mean_overlap_m",
+    "max_overlap_m",
+    "final_total_overlap_m",
+    "cycles",
+    "settlement_mean_m",
+    "settlement_at_min_load_m",
+    "status",
+];
 
-fn run_columns(o: &Outcome) -> String {
+fn run_columns(o: &Outcome) -> RunColumns {
     let nan = f64::NAN;
     let r = o.report.as_ref();
     let last = o.cycles.last();
-    format!(
-        "{:e},{:e},{:e},{:e},{},{:e},{:e},{:e},{},{:e},{:e},{}",
-        r.map_or(nan, |r| r.mean_iterations),
-        r.map_or(nan, |r| r.mean_contacts),
-        r.map_or(nan, |r| r.wall_time_s),
-        r.and_then(|r| r.wall_time_per_cycle_s).unwrap_or(nan),
-        r.map_or(0, |r| r.unconverged_steps),
-        r.map_or(nan, |r| r.mean_overlap_m),
-        r.map_or(nan, |r| r.max_overlap_m),
-        o.series.last().map_or(nan, |s| s.total_overlap_m),
-        last.map_or(0, |c| c.cycle),
-        last.map_or(nan, |c| c.settlement_mean_m),
-        last.map_or(nan, |c| c.settlement_at_min_load_m),
-        field(&o.status)
-    )
+    RunColumns {
+        mean_iterations: r.and_then(|r| r.mean_iterations).unwrap_or(nan),
+        mean_contacts: r.map_or(nan, |r| r.mean_contacts),
+        wall_time_s: r.map_or(nan, |r| r.wall_time_s),
+        wall_time_per_cycle_s: r.and_then(|r| r.wall_time_per_cycle_s).unwrap_or(nan),
+        unconverged_steps: r.and_then(|r| r.unconverged_steps).unwrap_or(0),
+        mean_overlap_m: r.map_or(nan, |r| r.mean_overlap_m),
+        max_overlap_m: r.map_or(nan, |r| r.max_overlap_m),
+        final_total_overlap_m: o.series.last().map_or(nan, |s| s.total_overlap_m),
+        cycles: last.map_or(0, |c| c.cycle),
+        settlement_mean_m: last.map_or(nan, |c| c.settlement_mean_m),
+        settlement_at_min_load_m: last.map_or(nan, |c| c.settlement_at_min_load_m),
+        status: o.status.clone(),
+    }
 }
 
-fn write_csv(path: &Path, text: &str) -> Result<(), Failure> {
-    std::fs::write(path, text).map_err(|e| Failure::Run(io::io_error(path, "write", e)))
+/// Writes a study table: the columns `key` then `rest`, one row per item.
+fn write_table<R: Serialize>(path: &Path, key: &[&str], rest: &[&str], rows: &[R]) -> Result<(), Failure> {
+    let header: Vec<&str> = key.iter().chain(rest).copied().collect();
+    let mut t = TableWriter::create(path, &header).map_err(Failure::Run)?;
+    for r in rows {
+        t.write(r).map_err(Failure::Run)?;
+    }
+    t.finish().map_err(Failure::Run)
 }
 
 fn curve(o: &Outcome, label: String, f: fn(&SeriesRow) -> f64, scale: f64) -> Series {
@@ -283,12 +312,14 @@ pub fn convergence(
         .collect();
     let outcomes = run_jobs(&jobs, study)?;
 
-    let mut csv = format!("policy,tolerance,min_iterations,max_iterations,{RUN_COLUMNS}\n");
-    for ((policy, tol), o) in runs.iter().zip(&outcomes) {
-        let _ = writeln!(csv, "{policy},{tol:e},{},{},{}", base.min_iterations, base.max_iterations, run_columns(o));
-    }
+    let rows: Vec<_> = runs
+        .iter()
+        .zip(&outcomes)
+        .map(|((policy, tol), o)| ((policy.clone(), *tol, base.min_iterations, base.max_iterations), run_columns(o)))
+        .collect();
     let out = &study.out;
-    write_csv(&out.join("convergence.csv"), &csv)?;
+    let key = ["policy", "tolerance", "min_iterations", "max_iterations"];
+    write_table(&out.join("convergence.csv"), &key, &RUN_COLUMNS, &rows)?;
 
     let cumulated: Vec<Series> = runs
         .iter()
@@ -305,8 +336,12 @@ pub fn convergence(
     for ((p, t), o) in runs.iter().zip(&outcomes) {
         let Some(r) = &o.report else { continue };
         match per_policy.iter_mut().find(|s| &s.label == p) {
-            Some(s) => s.points.push((*t, r.mean_iterations)),
-            None => per_policy.push(Series { label: p.clone(), points: vec![(*t, r.mean_iterations)], band: vec![] }),
+            Some(s) => s.points.push((*t, r.mean_iterations.unwrap_or(f64::NAN))),
+            None => per_policy.push(Series {
+                label: p.clone(),
+                points: vec![(*t, r.mean_iterations.unwrap_or(f64::NAN))],
+                band: vec![],
+            }),
         }
     }
     per_policy.iter_mut().for_each(|s| s.points.sort_by(|a, b| a.0.total_cmp(&b.0)));
@@ -316,7 +351,7 @@ pub fn convergence(
         &per_policy,
     )
     .map_err(Failure::Run)?;
-    print_table(out, "convergence.csv", &csv);
+    print_table(out, "convergence.csv")?;
     Ok(())
 }
 
@@ -348,11 +383,8 @@ pub fn steps(
     }
     let outcomes = run_jobs(&jobs, study)?;
     let out = &study.out;
-    let mut csv = format!("inclination_deg,dt_s,{RUN_COLUMNS}\n");
-    for ((a, dt), o) in keys.iter().zip(&outcomes) {
-        let _ = writeln!(csv, "{a:e},{dt:e},{}", run_columns(o));
-    }
-    write_csv(&out.join("steps.csv"), &csv)?;
+    let rows: Vec<_> = keys.iter().zip(&outcomes).map(|(&(a, dt), o)| ((a, dt), run_columns(o))).collect();
+    write_table(&out.join("steps.csv"), &["inclination_deg", "dt_s"], &RUN_COLUMNS, &rows)?;
     let mut vs_dt = Vec::new();
     for &a in inclinations {
         let runs: Vec<_> = keys.iter().zip(&outcomes).filter(|((b, _), _)| *b == a).collect();
@@ -384,7 +416,7 @@ pub fn steps(
         &vs_dt,
     )
     .map_err(Failure::Run)?;
-    print_table(out, "steps.csv", &csv);
+    print_table(out, "steps.csv")?;
     Ok(())
 }
 
@@ -432,7 +464,7 @@ pub fn ensemble(
     let out = &study.out;
     let seeds: Vec<u64> = (0..samples).map(|k| first_seed + k).collect();
     // 1. The samples, deposited side by side.
-    let pool = pool(study.jobs.unwrap_or_else(crate::cores).max(1))?;
+    let pool = pool(study.jobs.unwrap_or_else(cores).max(1))?;
     let group = MultiProgress::new();
     let deposited: Vec<Result<(), Failure>> = pool.install(|| {
         seeds
@@ -446,8 +478,9 @@ pub fn ensemble(
                 if study.resume && dir.join("sample.toml").exists() {
                     return Ok(());
                 }
-                let progress = Some((group.clone(), format!("sample {seed}")));
-                sample(&spec, &dir, study.resume, study.quiet, progress)
+                let display =
+                    if study.quiet { Display::Quiet } else { Display::Group(group.clone(), format!("sample {seed}")) };
+                sample(&spec, &dir, study.resume, &display)
             })
             .collect()
     });
@@ -470,15 +503,9 @@ pub fn ensemble(
     }
     let outcomes = run_jobs(&jobs, study)?;
     // 3. Per run, and mean and spread per stiffness and cycle.
-    let mut runs_csv = format!("seed,stiffness_factor,{RUN_COLUMNS}\n");
-    for ((seed, k), o) in keys.iter().zip(&outcomes) {
-        let _ = writeln!(runs_csv, "{seed},{k:e},{}", run_columns(o));
-    }
-    write_csv(&out.join("runs.csv"), &runs_csv)?;
-    let mut csv = String::from(
-        "stiffness_factor,cycle,samples,settlement_mean_m,settlement_std_m,settlement_min_m,settlement_max_m,\
-         settlement_at_min_load_mean_m,settlement_at_min_load_std_m\n",
-    );
+    let rows: Vec<_> = keys.iter().zip(&outcomes).map(|(&(seed, k), o)| ((seed, k), run_columns(o))).collect();
+    write_table(&out.join("runs.csv"), &["seed", "stiffness_factor"], &RUN_COLUMNS, &rows)?;
+    let mut table = Vec::new();
     let mut curves = Vec::new();
     for &k in factors {
         let runs: Vec<&Outcome> = keys.iter().zip(&outcomes).filter(|((_, f), _)| *f == k).map(|(_, o)| o).collect();
@@ -491,37 +518,57 @@ pub fn ensemble(
             let at_min: Vec<f64> = runs.iter().map(|o| o.cycles[c].settlement_at_min_load_m).collect();
             let (s, m) = (Spread::of(&mean), Spread::of(&at_min));
             let cycle = runs[0].cycles[c].cycle;
-            let _ = writeln!(
-                csv,
-                "{k:e},{cycle},{},{:e},{:e},{:e},{:e},{:e},{:e}",
-                runs.len(),
-                s.mean,
-                s.std,
-                s.min,
-                s.max,
-                m.mean,
-                m.std
-            );
+            table.push(EnsembleRow {
+                stiffness_factor: k,
+                cycle,
+                samples: runs.len(),
+                settlement_mean_m: s.mean,
+                settlement_std_m: s.std,
+                settlement_min_m: s.min,
+                settlement_max_m: s.max,
+                settlement_at_min_load_mean_m: m.mean,
+                settlement_at_min_load_std_m: m.std,
+            });
             points.push((cycle as f64, 1e3 * s.mean));
             band.push((cycle as f64, 1e3 * (s.mean - s.std), 1e3 * (s.mean + s.std)));
         }
         curves.push(Series { label: format!("k_N × {k} ({} samples, mean ± 1 sd)", runs.len()), points, band });
     }
-    write_csv(&out.join("ensemble.csv"), &csv)?;
+    io::table::write_all(&out.join("ensemble.csv"), &table).map_err(Failure::Run)?;
     figures::line_chart(
         &out.join("settlement_ensemble"),
         &axes("Settlement of the sleeper vs sublayer stiffness", "cycles", "settlement (mm)", false, false),
         &curves,
     )
     .map_err(Failure::Run)?;
-    print_table(out, "runs.csv", &runs_csv);
+    print_table(out, "runs.csv")?;
     Ok(())
 }
 
-/// Prints a summary CSV as a table, and where the outputs are.
-fn print_table(out: &Path, name: &str, csv: &str) {
-    for line in csv.lines() {
-        println!("{}", line.replace(',', "  "));
+/// One row of `ensemble.csv`: the settlement over the samples of one sublayer
+/// stiffness at one cycle (m).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EnsembleRow {
+    pub stiffness_factor: f64,
+    pub cycle: u64,
+    pub samples: usize,
+    pub settlement_mean_m: f64,
+    pub settlement_std_m: f64,
+    pub settlement_min_m: f64,
+    pub settlement_max_m: f64,
+    pub settlement_at_min_load_mean_m: f64,
+    pub settlement_at_min_load_std_m: f64,
+}
+
+/// Prints a summary CSV of the study as a table, and where the outputs are.
+fn print_table(out: &Path, name: &str) -> Result<(), Failure> {
+    let path = out.join(name);
+    let mut reader = csv::Reader::from_path(&path).map_err(|e| Failure::Run(Error::Io(std::io::Error::other(e))))?;
+    let header = reader.headers().map_err(|e| Failure::Run(Error::Io(std::io::Error::other(e))))?.clone();
+    println!("{}", header.iter().collect::<Vec<_>>().join("  "));
+    for rec in reader.records().flatten() {
+        println!("{}", rec.iter().collect::<Vec<_>>().join("  "));
     }
-    println!("summary: {}; runs in {}", out.join(name).display(), out.join("runs").display());
+    println!("summary: {}; runs in {}", path.display(), out.join("runs").display());
+    Ok(())
 }

@@ -1,19 +1,25 @@
-//! Checkpoints of a long run (`DIR/checkpoint.json`), so that `ballast run --resume`
+//! Checkpoints of a long run (`DIR/checkpoint.json`), from which `--resume`
 //! continues a killed run with the same numbers as an uninterrupted one.
 //!
-//! A checkpoint holds the whole engine state (the serde form of
-//! [`crate::nscd::System`], warm-start impulses and clock included, or of
-//! [`crate::md::MdSystem`], contact memory and neighbour list included; floats are
-//! written so that they read back bit for bit), the text of the scene it was
-//! started from (a resume with another scene is refused), the length of
-//! `series.csv` at that moment (rows written after it by the killed run are cut
-//! off) and the running summary of the run. It is written to a temporary file and
-//! renamed, so a kill during the write leaves the previous checkpoint intact.
+//! A checkpoint holds the whole engine state (its serde form: warm-start
+//! impulses, contact memory, neighbour list, clock; floats written so that they
+//! read back bit for bit), the run's counters (steps, rows and bytes of
+//! `series.csv` and `cycles.csv`, cycles of the positions file), its running
+//! summary, the VTK snapshots listed so far and the per-cycle state. The file is
+//! a first line `ballast-checkpoint crc32=XXXXXXXX` (the CRC-32 of the rest)
+//! followed by the JSON; it is written to a temporary file and renamed, so a
+//! kill during the write leaves the previous checkpoint intact.
+//!
+//! [`Checkpoint::load`] refuses, with one line starting `not a valid
+//! checkpoint:`, a file that is truncated or edited (checksum), of another
+//! engine, version or scene (the CRC-32 of the scene text is recorded), or whose
+//! state does not hold together; the run loop then checks the state against the
+//! scene and the counters against the files (`crate::run`).
 
 use super::io_error;
+use super::vtk::PvdCollection;
 use super::RunSummary;
 use crate::error::{Error, Result};
-use crate::nscd::System;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -21,45 +27,91 @@ use std::path::{Path, PathBuf};
 /// File name of the checkpoint in the output directory.
 pub const CHECKPOINT_FILE: &str = "checkpoint.json";
 
-/// Everything needed to continue a run: of the NSCD engine by default, of the MD
-/// engine as `Checkpoint<MdSystem, MdRunSummary>`.
+/// The first word of a checkpoint file.
+const MAGIC: &str = "ballast-checkpoint";
+
+/// Everything needed to continue a run of engine state `S` with per-cycle state `C`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Checkpoint<S = System, R = RunSummary> {
+#[serde(deny_unknown_fields)]
+pub struct Checkpoint<S, C> {
     /// Crate version that wrote it.
     pub version: String,
-    /// Text of the scene file the run started from.
-    pub scene: String,
-    /// Length of `series.csv` (bytes) and rows in it when the checkpoint was written.
+    /// Engine name.
+    pub engine: String,
+    /// CRC-32 of the text of the scene the run started from (of the serde form
+    /// of the initial system for a system built in code).
+    pub source_crc32: u32,
+    /// Step of the engine when the run started (0 from a scene).
+    pub first_step: u64,
+    /// Steps made by the engine when the checkpoint was written.
+    pub step: u64,
+    /// Length of `series.csv` (bytes) and rows in it.
     pub series_bytes: u64,
     pub series_rows: u64,
+    /// Length of `cycles.csv` (bytes) and rows in it (0 and 0 without cycles).
+    pub cycles_bytes: u64,
+    pub cycles_rows: u64,
     /// Running summary of the run so far.
-    pub summary: R,
+    pub summary: RunSummary,
     /// The engine state.
     pub system: S,
     /// Snapshots listed in `run.pvd` so far (empty without `--vtk-every`).
-    #[serde(default)]
-    pub snapshots: super::vtk::PvdCollection,
-    /// The per-cycle recorder (with `output.cycles`).
-    #[serde(default)]
-    pub cycles: Option<super::cycles::CycleRecorder>,
+    pub snapshots: PvdCollection,
+    /// The per-cycle state (with `output.cycles`).
+    pub cycles: Option<C>,
+    /// Cycles completed.
+    pub cycles_done: u64,
+    /// The followed bodies and their coordinates at the start (with
+    /// `output.cycles.positions`).
+    pub positions: Option<crate::run::Configuration>,
 }
 
-impl<S: Serialize + DeserializeOwned, R: Serialize + DeserializeOwned> Checkpoint<S, R> {
+/// CRC-32 (IEEE) of `bytes`.
+pub fn crc32(bytes: &[u8]) -> u32 {
+    crc32fast::hash(bytes)
+}
+
+fn invalid(path: &Path, msg: impl std::fmt::Display) -> Error {
+    Error::Scene(format!("{}: not a valid checkpoint: {msg}", path.display()))
+}
+
+impl<S: Serialize + DeserializeOwned, C: Serialize + DeserializeOwned> Checkpoint<S, C> {
     /// Writes `DIR/checkpoint.json` atomically.
     pub fn write(&self, dir: &Path) -> Result<PathBuf> {
         let path = dir.join(CHECKPOINT_FILE);
-        let text = serde_json::to_string(self).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        let json = serde_json::to_string(self).map_err(|e| io_error(&path, "serialize", std::io::Error::other(e)))?;
+        let text = format!("{MAGIC} crc32={:08x}\n{json}", crc32(json.as_bytes()));
         super::write_atomic(&path, &text)?;
         Ok(path)
     }
 
-    /// Reads `DIR/checkpoint.json` and checks that it belongs to `scene_text`.
-    pub fn load(dir: &Path, scene_text: &str) -> Result<Self> {
+    /// Reads `DIR/checkpoint.json` and checks its checksum, its engine `engine`,
+    /// its version and that it belongs to the scene whose text has CRC-32 `source_crc32`.
+    pub fn load(dir: &Path, engine: &str, source_crc32: u32) -> Result<Self> {
         let path = dir.join(CHECKPOINT_FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| io_error(&path, "read checkpoint", e))?;
-        let cp: Self = serde_json::from_str(&text)
-            .map_err(|e| Error::Scene(format!("{}: not a valid checkpoint: {e}", path.display())))?;
-        if cp.scene != scene_text {
+        let bytes = std::fs::read(&path).map_err(|e| io_error(&path, "read checkpoint", e))?;
+        let text = String::from_utf8(bytes).map_err(|_| invalid(&path, "not UTF-8 text"))?;
+        let (first, json) = text.split_once('\n').ok_or_else(|| invalid(&path, "no header line"))?;
+        let crc = first
+            .strip_prefix(MAGIC)
+            .and_then(|s| s.trim().strip_prefix("crc32="))
+            .and_then(|s| u32::from_str_radix(s.trim(), 16).ok())
+            .ok_or_else(|| invalid(&path, format!("the first line is not '{MAGIC} crc32=…'")))?;
+        if crc32(json.as_bytes()) != crc {
+            return Err(invalid(&path, "checksum mismatch (the file was edited or cut short)"));
+        }
+        let cp: Self = serde_json::from_str(json).map_err(|e| invalid(&path, e))?;
+        if cp.engine != engine {
+            return Err(invalid(&path, format!("written by the {} engine, the scene is for {engine}", cp.engine)));
+        }
+        let version = env!("CARGO_PKG_VERSION");
+        if cp.version != version {
+            return Err(invalid(
+                &path,
+                format!("written by ballast {}, this is {version}; run without --resume to start again", cp.version),
+            ));
+        }
+        if cp.source_crc32 != source_crc32 {
             return Err(Error::Scene(format!(
                 "{}: the checkpoint was written for another scene; run without --resume to start again",
                 path.display()

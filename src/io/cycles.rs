@@ -1,67 +1,63 @@
-//! `cycles.csv`: per-cycle statistics of a cyclically loaded run (Saussine et al.
-//! 2006, §4: settlement of the sleeper, Fig. 6, 11, 12; mean grain velocity, Fig. 7).
+//! `cycles.csv`: one row per loading cycle of a cyclically loaded run. A cycle of
+//! frequency `f` lasts `1/f` from t = 0; the step that ends within half a step
+//! of `c/f` or past it closes cycle `c` ([`crate::clock::cycles_at`], one clock
+//! for both engines).
 //!
-//! A cycle lasts `1/f` from t = 0. For each cycle, with `y` the vertical position
-//! of the followed body's centre of mass and `y0` its value at the start of the run:
-//! - `settlement_mean_m`: `y0 − ⟨y⟩`, the mean over the steps of the cycle (m,
-//!   positive when the body has gone down);
-//! - `settlement_at_min_load_m`: `y0 − y` at the step of the cycle where the
-//!   magnitude of the body's external load is smallest (m);
-//! - `mean_grain_speed_m_s`: the speed `|v|` of the other non-fixed bodies,
-//!   averaged over bodies and over the steps of the cycle (m/s);
-//! - `contacts`, `iterations`: means per step; `max_overlap_m`: the largest over the cycle.
+//! NSCD ([`NscdCycleRow`]; Saussine et al. 2006, §4: settlement of the sleeper,
+//! Figs. 6, 11, 12; mean grain velocity, Fig. 7), with `y` the vertical position
+//! of the followed body's centre of mass and `y0` its value at the start of the
+//! run: `cycle`, `time_s` (end of the cycle), `settlement_mean_m` (`y0 − ⟨y⟩`
+//! over the steps of the cycle, positive when the body has gone down),
+//! `settlement_at_min_load_m` (`y0 − y` at the step of the cycle where the
+//! magnitude of the body's load is smallest), `mean_grain_speed_m_s` (speed of
+//! the other non-fixed bodies, averaged over bodies and steps), `contacts`,
+//! `iterations` (means per step), `max_overlap_m` (largest over the cycle).
 //!
-//! The recorder is plain data, kept in checkpoints so that a resumed run writes
-//! the same rows.
+//! MD ([`MdCycleRow`]; the residual displacements of Karrech et al. 2007 §3,
+//! taken at the end of each cycle, where the load is back to its base value):
+//! `cycle`, `time_s`, `mean_displacement_x_m`, `…_y_m`, `…_z_m` (mean over the
+//! spheres of the displacement since the start of the run), `max_displacement_m`
+//! (the largest norm), `max_overlap_m` (largest over the cycle), then
+//! `<wall>_position_m` for every servo wall.
+//!
+//! The per-cycle state is plain data, kept in checkpoints so that a resumed run
+//! writes the same rows.
 
-use super::io_error;
 use crate::error::Result;
-use crate::nscd::{StepStats, System};
 use serde::{Deserialize, Serialize};
-use std::io::Write;
 use std::path::Path;
 
-/// Header line of `cycles.csv` (without the newline).
-pub const CYCLES_HEADER: &str = "cycle,time_s,settlement_mean_m,settlement_at_min_load_m,mean_grain_speed_m_s,\
-contacts,iterations,max_overlap_m";
-
-/// Accumulates the steps of the current cycle and emits one row per cycle.
+/// What an NSCD run accumulates over the steps of a cycle.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CycleRecorder {
-    /// Loading frequency (Hz).
-    pub frequency: f64,
+pub struct NscdCycleState {
     /// Index of the followed body.
     pub body: usize,
     /// Its initial vertical position (m).
     pub y0: f64,
-    /// Cycles completed.
-    pub cycle: u64,
-    steps: u64,
-    sum_y: f64,
-    min_load: f64,
-    y_at_min_load: f64,
-    sum_speed: f64,
-    sum_contacts: f64,
-    sum_iterations: f64,
-    max_overlap: f64,
-    /// Positions of every body at the end of the first cycle (for the
+    /// Steps of the cycle under way, and the sums over them.
+    pub steps: u64,
+    pub sum_y: f64,
+    pub min_load: f64,
+    pub y_at_min_load: f64,
+    pub sum_speed: f64,
+    pub sum_contacts: f64,
+    pub sum_iterations: f64,
+    pub max_overlap: f64,
+    /// Positions `(x, y, θ)` of every body at the end of the first cycle (for the
     /// displacement field from cycle 1 to the end of the run).
-    #[serde(default)]
     pub first_cycle_q: Option<Vec<[f64; 3]>>,
 }
 
-impl CycleRecorder {
-    /// Starts following body `body` of `sys` for cycles of `frequency` (Hz).
-    pub fn new(sys: &System, frequency: f64, body: usize) -> Self {
+impl NscdCycleState {
+    /// A cycle state following body `body` from the vertical position `y0` (m).
+    pub fn new(body: usize, y0: f64) -> Self {
         Self {
-            frequency,
             body,
-            y0: sys.bodies.q[body][1],
-            cycle: 0,
+            y0,
             steps: 0,
             sum_y: 0.0,
             min_load: f64::INFINITY,
-            y_at_min_load: 0.0,
+            y_at_min_load: y0,
             sum_speed: 0.0,
             sum_contacts: 0.0,
             sum_iterations: 0.0,
@@ -70,88 +66,17 @@ impl CycleRecorder {
         }
     }
 
-    /// Records the step just made; returns the row of the cycle it completes, if any.
-    pub fn record(&mut self, sys: &System, stats: &StepStats) -> Option<String> {
-        let y = sys.bodies.q[self.body][1];
-        let load: [f64; 2] = sys.bodies.info[self.body].loads.iter().fold([0.0, 0.0], |f, l| {
-            let g = l.at(sys.time);
-            [f[0] + g[0], f[1] + g[1]]
-        });
-        let magnitude = load[0].hypot(load[1]);
-        if magnitude < self.min_load {
-            self.min_load = magnitude;
-            self.y_at_min_load = y;
-        }
-        self.steps += 1;
-        self.sum_y += y;
-        let (mut speed, mut n) = (0.0, 0usize);
-        for (i, (info, u)) in sys.bodies.info.iter().zip(&sys.bodies.u).enumerate() {
-            if i != self.body && !info.fixed {
-                speed += u[0].hypot(u[1]);
-                n += 1;
-            }
-        }
-        self.sum_speed += if n > 0 { speed / n as f64 } else { 0.0 };
-        self.sum_contacts += stats.contacts as f64;
-        self.sum_iterations += stats.iterations as f64;
-        self.max_overlap = self.max_overlap.max(stats.max_overlap);
-        // This step closes the cycle if it ends within half a step of the cycle's
-        // end or past it (the half step absorbs the round-off of the clock).
-        let end = (self.cycle + 1) as f64 / self.frequency;
-        if sys.time + 0.5 * sys.params.dt < end {
-            return None;
-        }
-        let k = self.steps as f64;
-        let row = format!(
-            "{},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
-            self.cycle + 1,
-            sys.time,
-            self.y0 - self.sum_y / k,
-            self.y0 - self.y_at_min_load,
-            self.sum_speed / k,
-            self.sum_contacts / k,
-            self.sum_iterations / k,
-            self.max_overlap
-        );
-        let (y0, cycle) = (self.y0, self.cycle + 1);
-        let first_cycle_q = self.first_cycle_q.take().or_else(|| Some(sys.bodies.q.clone()));
-        *self = Self { y0, cycle, first_cycle_q, ..Self::new(sys, self.frequency, self.body) };
-        Some(row)
+    /// Starts the accumulators of the next cycle (the followed body, `y0` and the
+    /// first cycle's positions stay).
+    pub fn restart(&mut self) {
+        let first = self.first_cycle_q.take();
+        *self = Self { first_cycle_q: first, ..Self::new(self.body, self.y0) };
     }
 }
 
-/// Cuts `path` back to its header and first `rows` rows (a resumed run rewrites the rest).
-pub fn truncate_rows(path: &Path, rows: u64) -> Result<()> {
-    if !path.exists() {
-        return Ok(());
-    }
-    let text = std::fs::read_to_string(path).map_err(|e| io_error(path, "read", e))?;
-    let kept: Vec<&str> = text.lines().take(rows as usize + 1).collect();
-    let mut out = kept.join("\n");
-    out.push('\n');
-    std::fs::write(path, out).map_err(|e| io_error(path, "write", e))
-}
-
-/// Appends `row` (and the header first if the file is new) to `path`.
-pub fn append_row(path: &Path, row: &str) -> Result<()> {
-    append_with_header(path, CYCLES_HEADER, row)
-}
-
-/// Appends `row` to `path`, writing `header` first if the file is new (the
-/// per-cycle files of both engines).
-pub fn append_with_header(path: &Path, header: &str, row: &str) -> Result<()> {
-    let new = !path.exists();
-    let mut f =
-        std::fs::OpenOptions::new().create(true).append(true).open(path).map_err(|e| io_error(path, "open", e))?;
-    if new {
-        writeln!(f, "{header}").map_err(|e| io_error(path, "write", e))?;
-    }
-    writeln!(f, "{row}").map_err(|e| io_error(path, "write", e))
-}
-
-/// One row of `cycles.csv`, as read back by [`read`].
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-pub struct CycleRow {
+/// One row of an NSCD `cycles.csv`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NscdCycleRow {
     pub cycle: u64,
     pub time_s: f64,
     pub settlement_mean_m: f64,
@@ -162,7 +87,58 @@ pub struct CycleRow {
     pub max_overlap_m: f64,
 }
 
-/// Reads a `cycles.csv`; the error names the file and the row.
-pub fn read(path: &Path) -> Result<Vec<CycleRow>> {
-    super::read_csv(path)
+/// The columns of [`NscdCycleRow`].
+pub const NSCD_CYCLE_COLUMNS: [&str; 8] = [
+    "cycle",
+    "time_s",
+    "settlement_mean_m",
+    "settlement_at_min_load_m",
+    "mean_grain_speed_m_s",
+    "contacts",
+    "iterations",
+    "max_overlap_m",
+];
+
+/// What an MD run keeps for its cycles.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MdCycleState {
+    /// Sphere centres at the start of the run (m).
+    pub x0: Vec<[f64; 3]>,
+    /// Largest overlap over the cycle under way (m).
+    pub max_overlap: f64,
+}
+
+/// One row of an MD `cycles.csv`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MdCycleRow {
+    pub cycle: u64,
+    pub time_s: f64,
+    pub mean_displacement_x_m: f64,
+    pub mean_displacement_y_m: f64,
+    pub mean_displacement_z_m: f64,
+    pub max_displacement_m: f64,
+    pub max_overlap_m: f64,
+    /// `<wall>_position_m` for every servo wall.
+    pub walls: Vec<f64>,
+}
+
+/// The fixed columns of [`MdCycleRow`], before the servo walls.
+pub const MD_CYCLE_COLUMNS: [&str; 7] = [
+    "cycle",
+    "time_s",
+    "mean_displacement_x_m",
+    "mean_displacement_y_m",
+    "mean_displacement_z_m",
+    "max_displacement_m",
+    "max_overlap_m",
+];
+
+/// Reads an NSCD `cycles.csv`; the error names the file and the line.
+pub fn read_nscd(path: &Path) -> Result<Vec<NscdCycleRow>> {
+    Ok(super::table::read(path)?.1)
+}
+
+/// Reads an MD `cycles.csv`; the error names the file and the line.
+pub fn read_md(path: &Path) -> Result<Vec<MdCycleRow>> {
+    Ok(super::table::read(path)?.1)
 }

@@ -1,77 +1,87 @@
-//! `final.json`: the time, step and state of every body at the end of a run,
-//! in scene order, e.g.
-//! `{"time": 1.0, "step": 1000, "bodies": [{"name": "block", "position": [x, y],
-//! "angle": a, "velocity": [vx, vy], "spin": w}, …]}`.
-//! Positions and velocities are those of the centre of mass (the system's `q`
-//! and `u`), not of the scene's body-frame origin.
+//! `final.json`: the time, step and state of every body (and, in MD, every wall)
+//! at the end of a run, in scene order. One type for both engines:
+//!
+//! - NSCD: `{"engine": "nscd", "time": 1.0, "step": 1000, "bodies": [{"name":
+//!   "block", "position": [x, y], "angle": a, "velocity": [vx, vy], "spin": w},
+//!   …]}`: centre of mass (m; not the scene's body-frame origin), angle (rad),
+//!   velocity of the centre of mass (m/s), spin (rad/s);
+//! - MD: `{"engine": "md", …, "bodies": [{"name": "s0", "position": [x, y, z],
+//!   "velocity": [vx, vy, vz], "spin": [wx, wy, wz], "radius": r}, …], "walls":
+//!   [{"name": "base", "displacement": s, "force": [fx, fy, fz]}, …]}` (m, m/s,
+//!   rad/s, m; a wall's displacement along its normal since the start in m, and
+//!   the total contact force of the spheres on it in N).
+//!
+//! Written with `serde_json` (floats as the shortest text that reads back to
+//! the same `f64`).
 
 use crate::error::Result;
-use crate::nscd::System;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+
+/// The spin of a body: a scalar in 2D (rad/s, counter-clockwise), a vector in 3D.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Spin {
+    /// 2D spin (rad/s).
+    Planar(f64),
+    /// 3D spin (rad/s).
+    Spatial([f64; 3]),
+}
 
 /// State of one body.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BodyState {
     /// Name from the scene (may be empty).
     pub name: String,
-    /// Centre of mass (m).
-    pub position: [f64; 2],
-    /// Angle (rad).
-    pub angle: f64,
+    /// Centre of mass (m): 2 coordinates in 2D, 3 in 3D.
+    pub position: Vec<f64>,
+    /// Angle (rad), 2D only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle: Option<f64>,
     /// Velocity of the centre of mass (m/s).
-    pub velocity: [f64; 2],
+    pub velocity: Vec<f64>,
     /// Angular velocity (rad/s).
-    pub spin: f64,
+    pub spin: Spin,
+    /// Radius (m), spheres only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+}
+
+/// State of one wall (MD).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WallState {
+    /// Name from the scene.
+    pub name: String,
+    /// Displacement along the normal since the start (m); 0 for a fixed wall.
+    pub displacement: f64,
+    /// Total contact force of the spheres on the wall at the last step (N).
+    pub force: [f64; 3],
 }
 
 /// Contents of `final.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FinalState {
+    /// `"nscd"` or `"md"`.
+    pub engine: String,
     /// Time (s).
     pub time: f64,
     /// Number of steps done.
     pub step: u64,
     /// Every body, in scene order.
     pub bodies: Vec<BodyState>,
+    /// Every wall, in scene order (MD).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub walls: Vec<WallState>,
 }
 
 impl FinalState {
-    /// The current state of `sys`.
-    pub fn of(sys: &System) -> Self {
-        let b = &sys.bodies;
-        let bodies = b
-            .info
-            .iter()
-            .zip(&b.q)
-            .zip(&b.u)
-            .map(|((info, q), u)| BodyState {
-                name: info.name.clone(),
-                position: [q[0], q[1]],
-                angle: q[2],
-                velocity: [u[0], u[1]],
-                spin: u[2],
-            })
-            .collect();
-        Self { time: sys.time, step: sys.step, bodies }
-    }
-
-    /// The JSON text, one body per line.
-    pub fn to_json(&self) -> String {
-        let num = |x: f64| serde_json::to_string(&x).unwrap_or_else(|_| "null".into());
-        let mut text = format!("{{\n  \"time\": {},\n  \"step\": {},\n  \"bodies\": [", num(self.time), self.step);
-        for (i, b) in self.bodies.iter().enumerate() {
-            let body = serde_json::to_string(b).unwrap_or_else(|_| "null".into());
-            text.push_str(if i == 0 { "\n    " } else { ",\n    " });
-            text.push_str(&body);
-        }
-        text.push_str(if self.bodies.is_empty() { "]\n}\n" } else { "\n  ]\n}\n" });
-        text
-    }
-
-    /// Writes [`FinalState::to_json`] to `path`.
+    /// Writes the state as pretty JSON to `path`.
     pub fn write(&self, path: &Path) -> Result<PathBuf> {
-        std::fs::write(path, self.to_json()).map_err(|e| super::io_error(path, "write", e))?;
-        Ok(path.to_path_buf())
+        super::write_json(path, self)
+    }
+
+    /// Reads a `final.json`; the error names the file.
+    pub fn read(path: &Path) -> Result<Self> {
+        super::read_json(path)
     }
 }

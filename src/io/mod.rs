@@ -1,38 +1,37 @@
-//! Output files of a run, all in one output directory:
+//! Output files of a run, all in one output directory (the run loop,
+//! [`crate::run::Runner`], writes them; the same files for both engines):
 //!
 //! - `series.csv`: one row of step statistics every `output.every` steps
-//!   ([`series::SeriesWriter`]);
-//! - `final.json`: the state of every body at the end ([`final_state::FinalState`]);
-//! - `scene.toml`: a byte copy of the input scene ([`copy_scene`]);
+//!   ([`series`], written with [`table::TableWriter`]);
+//! - `cycles.csv`: per-cycle statistics with `output.cycles` ([`cycles`]), and
+//!   with `output.cycles.positions` the positions of every mobile body at each
+//!   cycle end ([`positions`]);
+//! - `final.json`: the state of every body (and wall) at the end ([`FinalState`]);
+//! - `summary.json`: wall time and speed, mean contacts, overlaps, NLGS
+//!   iterations ([`summary::RunReport`]);
+//! - `scene.toml`: a byte copy of the input scene ([`copy_scene`]), or
+//!   `initial_state.json` for a system built in code;
 //! - `final_scene.toml`: the input scene with the final state, to restart from;
 //! - `run.json`: seed, engine, crate version, number of steps, time step ([`RunInfo`]);
-//! - `summary.json`: wall time, mean iterations and contacts per step, overlaps
-//!   ([`summary::RunReport`]);
-//! - `cycles.csv`: per-cycle settlement statistics with `output.cycles` ([`cycles`]);
 //! - `checkpoint.json`: the whole state, every few minutes, for `--resume`
 //!   ([`checkpoint::Checkpoint`]);
-//! - with `--vtk-every N`: `vtk/bodies_*.vtp`, `vtk/contacts_*.vtp` and `run.pvd`,
-//!   snapshots that ParaView opens and animates ([`vtk`]);
+//! - with `--vtk-every N`: `vtk/*.vtp` and `run.pvd`, snapshots that ParaView
+//!   opens and animates ([`vtk`]);
 //! - figures as `<stem>.png` + `<stem>.svg`: curves, force chains, displacement
-//!   fields ([`figures`]).
+//!   fields ([`figures`], [`run_figures`]).
 //!
-//! An MD run writes the same files but for its own `series.csv` columns
-//! ([`md_series`]), `final.json` with 3D spheres and walls ([`md_state`]),
-//! `summary.json` with particle-steps per second ([`summary::MdRunReport`]) and
-//! `vtk/spheres_*.vtp` snapshots ([`vtk::write_spheres`]); no figures, no cycles.
-//!
-//! Every I/O error names the file it happened on.
+//! CSV goes through `csv` and serde row types, JSON through `serde_json`. Every
+//! I/O error names the file it happened on.
 
 pub mod checkpoint;
 pub mod cycles;
 pub mod figures;
 pub mod final_state;
-pub mod md_cycles;
-pub mod md_series;
-pub mod md_state;
+pub mod positions;
 pub mod run_figures;
 pub mod series;
 pub mod summary;
+pub mod table;
 pub mod vtk;
 
 use crate::error::{Error, Result};
@@ -40,11 +39,9 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 pub use checkpoint::{Checkpoint, CHECKPOINT_FILE};
-pub use final_state::{BodyState, FinalState};
-pub use md_series::{md_series_header, md_series_row, MD_SERIES_COLUMNS};
-pub use md_state::{MdFinalState, SphereState, WallState};
-pub use series::{SeriesWriter, SERIES_HEADER};
-pub use summary::{MdRunReport, MdRunSummary, RunReport, RunSummary};
+pub use final_state::{BodyState, FinalState, Spin, WallState};
+pub use summary::{RunEnd, RunReport, RunSummary, StepSummary};
+pub use table::TableWriter;
 
 /// An I/O error with the path it happened on in its message.
 pub fn io_error(path: &Path, what: &str, e: std::io::Error) -> Error {
@@ -115,13 +112,7 @@ impl RunInfo {
 /// Reads the rows of a CSV file with a header into `T` (columns by name); the
 /// error names the file and the line.
 pub fn read_csv<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>> {
-    let mut reader = csv::Reader::from_path(path).map_err(|e| csv_error(path, e))?;
-    reader.deserialize().map(|row| row.map_err(|e| csv_error(path, e))).collect()
-}
-
-fn csv_error(path: &Path, e: csv::Error) -> Error {
-    let line = e.position().map(|p| format!(" (line {})", p.line())).unwrap_or_default();
-    io_error(path, &format!("read{line}"), std::io::Error::other(e.to_string()))
+    table::read_named(path)
 }
 
 /// Writes `value` as pretty JSON (with a final newline) to `path`.
@@ -131,4 +122,10 @@ pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<PathBuf> {
     text.push('\n');
     std::fs::write(path, text).map_err(|e| io_error(path, "write", e))?;
     Ok(path.to_path_buf())
+}
+
+/// Reads the JSON file at `path` into `T`; the error names the file.
+pub fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
+    let text = std::fs::read_to_string(path).map_err(|e| io_error(path, "read", e))?;
+    serde_json::from_str(&text).map_err(|e| io_error(path, "read", std::io::Error::other(e)))
 }

@@ -17,8 +17,8 @@ use crate::nscd::System;
 use std::path::{Path, PathBuf};
 
 /// Series of a settlement curve in millimetres, from `cycles.csv` rows.
-pub fn settlement_series(rows: &[super::cycles::CycleRow], label: &str) -> [Series; 2] {
-    let pick = |f: fn(&super::cycles::CycleRow) -> f64| rows.iter().map(|r| (r.cycle as f64, 1e3 * f(r))).collect();
+pub fn settlement_series(rows: &[super::cycles::NscdCycleRow], label: &str) -> [Series; 2] {
+    let pick = |f: fn(&super::cycles::NscdCycleRow) -> f64| rows.iter().map(|r| (r.cycle as f64, 1e3 * f(r))).collect();
     let sep = if label.is_empty() { "" } else { ", " };
     [
         Series {
@@ -50,7 +50,7 @@ pub fn write_run_figures(dir: &Path, sys: &System, first_cycle_q: Option<&[[f64;
     let mut written = Vec::new();
     let cycles_path = dir.join("cycles.csv");
     if cycles_path.exists() {
-        let rows = super::cycles::read(&cycles_path)?;
+        let rows = super::cycles::read_nscd(&cycles_path)?;
         let stem = dir.join("settlement");
         let axes = Axes {
             title: "Settlement of the sleeper".into(),
@@ -63,8 +63,8 @@ pub fn write_run_figures(dir: &Path, sys: &System, first_cycle_q: Option<&[[f64;
     }
     let series_path = dir.join("series.csv");
     if series_path.exists() {
-        let rows = super::series::read(&series_path)?;
-        let pick = |f: fn(&super::series::SeriesRow) -> f64| rows.iter().map(|r| (r.time_s, 1e6 * f(r))).collect();
+        let rows = super::series::read_nscd(&series_path)?;
+        let pick = |f: fn(&super::series::NscdSeriesRow) -> f64| rows.iter().map(|r| (r.time_s, 1e6 * f(r))).collect();
         let stem = dir.join("interpenetration");
         let axes = Axes {
             title: "Interpenetration".into(),

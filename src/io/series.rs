@@ -1,120 +1,34 @@
-//! `series.csv`: one row of [`StepStats`] per output step.
+//! `series.csv`: one row of step statistics every `output.every` steps (and at
+//! the last step), written with a [`super::table::TableWriter`]. Column names
+//! carry their unit (`_s`, `_J`, `_m`, `_N`); counts and ratios have none.
 //!
-//! Columns ([`SERIES_HEADER`], units in the names): `time_s`, `kinetic_energy_J`,
-//! `contacts`, `active_contacts`, `iterations` (NLGS sweeps), `criterion` (final
-//! value of the convergence norm), `converged` (1 or 0), `mean_overlap_m` (mean
-//! over the active contacts), `max_overlap_m`, `total_overlap_m` (sum over the
-//! contacts: the cumulated interpenetration of Saussine et al. 2006, Fig. 2). Floats are written with `{:e}`, the shortest text that
-//! reads back to the same `f64`.
+//! NSCD ([`NscdSeriesRow`]): `time_s`, `kinetic_energy_J`, `contacts` (detected,
+//! open ones within the alert distance included), `active_contacts` (carrying a
+//! force or overlapping), `iterations` (NLGS sweeps), `criterion` (final value of
+//! the convergence norm), `converged` (1, or 0 when the step hit the iteration
+//! cap), `mean_overlap_m` (over the active contacts), `max_overlap_m`,
+//! `total_overlap_m` (sum over the contacts: the cumulated interpenetration of
+//! Saussine et al. 2006, Fig. 2).
 //!
-//! The writer itself (buffering, cutting back on `--resume`, counting rows) does
-//! not depend on the columns: [`SeriesWriter::with_header`] and
-//! [`SeriesWriter::write_row`] serve the MD series too ([`super::md_series`]).
+//! MD ([`MdSeriesRow`]): `time_s`, `kinetic_energy_J` (translational +
+//! rotational), `elastic_energy_J` (stored in the contacts), `potential_energy_J`
+//! (gravitational above the reference height plus elastic,
+//! [`crate::md::MdSystem::potential_energy`]), `contacts` (sphere–sphere; a
+//! contact with a symmetry image counts half), `wall_contacts`, `max_overlap_m`,
+//! `mean_overlap_m` (over all contacts), `coordination` (`(2 N_c + N_w) / N`),
+//! `packing_fraction` (sphere volume over container section × sample height;
+//! empty when the walls make no container); then `<wall>_force_N` for every
+//! wall in scene order (the normal force the spheres press it with, positive
+//! when pressed; 0 for a cylinder), then `<wall>_position_m` for every servo wall
+//! (its displacement along its normal since the start).
 
-use super::io_error;
 use crate::error::Result;
-use crate::nscd::StepStats;
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
 
-/// Header line of `series.csv` (without the newline).
-pub const SERIES_HEADER: &str =
-    "time_s,kinetic_energy_J,contacts,active_contacts,iterations,criterion,converged,mean_overlap_m,max_overlap_m,\
-total_overlap_m";
-
-/// Buffered writer of `series.csv`.
-#[derive(Debug)]
-pub struct SeriesWriter {
-    path: PathBuf,
-    out: BufWriter<File>,
-    rows: u64,
-}
-
-impl SeriesWriter {
-    /// Creates (truncates) the file at `path` and writes the header.
-    pub fn create(path: &Path) -> Result<Self> {
-        Self::with_header(path, SERIES_HEADER)
-    }
-
-    /// Creates (truncates) the file at `path` and writes the header line `header`
-    /// (without its newline), for rows written with [`SeriesWriter::write_row`].
-    pub fn with_header(path: &Path, header: &str) -> Result<Self> {
-        let file = File::create(path).map_err(|e| io_error(path, "create", e))?;
-        let mut w = Self { path: path.to_path_buf(), out: BufWriter::new(file), rows: 0 };
-        writeln!(w.out, "{header}").map_err(|e| io_error(path, "write", e))?;
-        Ok(w)
-    }
-
-    /// Appends one row given as its text (without the newline).
-    pub fn write_row(&mut self, row: &str) -> Result<()> {
-        writeln!(self.out, "{row}").map_err(|e| io_error(&self.path, "write", e))?;
-        self.rows += 1;
-        Ok(())
-    }
-
-    /// Reopens `series.csv` to continue a run from a checkpoint: the file is cut
-    /// back to `bytes` (its length when the checkpoint was written, so rows of
-    /// the killed run after it disappear) and `rows` rows are counted as written.
-    pub fn resume(path: &Path, bytes: u64, rows: u64) -> Result<Self> {
-        let file = std::fs::OpenOptions::new().write(true).open(path).map_err(|e| io_error(path, "open", e))?;
-        let len = file.metadata().map_err(|e| io_error(path, "read", e))?.len();
-        if len < bytes {
-            return Err(crate::Error::Io(std::io::Error::other(format!(
-                "'{}' is shorter ({len} bytes) than at the checkpoint ({bytes} bytes)",
-                path.display()
-            ))));
-        }
-        file.set_len(bytes).map_err(|e| io_error(path, "truncate", e))?;
-        let mut out = BufWriter::new(file);
-        use std::io::Seek;
-        out.seek(std::io::SeekFrom::End(0)).map_err(|e| io_error(path, "seek", e))?;
-        Ok(Self { path: path.to_path_buf(), out, rows })
-    }
-
-    /// Flushes what is buffered and returns the length of the file (bytes), for a checkpoint.
-    pub fn sync(&mut self) -> Result<u64> {
-        self.out.flush().map_err(|e| io_error(&self.path, "write", e))?;
-        let f = self.out.get_ref();
-        f.sync_data().map_err(|e| io_error(&self.path, "sync", e))?;
-        Ok(f.metadata().map_err(|e| io_error(&self.path, "read", e))?.len())
-    }
-
-    /// Appends the row of one step.
-    pub fn write(&mut self, s: &StepStats) -> Result<()> {
-        writeln!(
-            self.out,
-            "{:e},{:e},{},{},{},{:e},{},{:e},{:e},{:e}",
-            s.time,
-            s.kinetic_energy,
-            s.contacts,
-            s.active_contacts,
-            s.iterations,
-            s.criterion,
-            u8::from(s.converged),
-            s.mean_overlap,
-            s.max_overlap,
-            s.total_overlap
-        )
-        .map_err(|e| io_error(&self.path, "write", e))?;
-        self.rows += 1;
-        Ok(())
-    }
-
-    /// Number of rows written (header excluded).
-    pub fn rows(&self) -> u64 {
-        self.rows
-    }
-
-    /// Flushes the file.
-    pub fn finish(mut self) -> Result<()> {
-        self.out.flush().map_err(|e| io_error(&self.path, "write", e))
-    }
-}
-
-/// One row of `series.csv`, as read back by [`read`].
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
-pub struct SeriesRow {
+/// One row of an NSCD `series.csv`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct NscdSeriesRow {
     pub time_s: f64,
     #[serde(rename = "kinetic_energy_J")]
     pub kinetic_energy_j: f64,
@@ -128,7 +42,60 @@ pub struct SeriesRow {
     pub total_overlap_m: f64,
 }
 
-/// Reads a `series.csv` written by [`SeriesWriter`]; the error names the file and the row.
-pub fn read(path: &Path) -> Result<Vec<SeriesRow>> {
-    super::read_csv(path)
+/// The columns of [`NscdSeriesRow`].
+pub const NSCD_SERIES_COLUMNS: [&str; 10] = [
+    "time_s",
+    "kinetic_energy_J",
+    "contacts",
+    "active_contacts",
+    "iterations",
+    "criterion",
+    "converged",
+    "mean_overlap_m",
+    "max_overlap_m",
+    "total_overlap_m",
+];
+
+/// One row of an MD `series.csv`: the fixed columns, then the wall columns.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MdSeriesRow {
+    pub time_s: f64,
+    #[serde(rename = "kinetic_energy_J")]
+    pub kinetic_energy_j: f64,
+    #[serde(rename = "elastic_energy_J")]
+    pub elastic_energy_j: f64,
+    #[serde(rename = "potential_energy_J")]
+    pub potential_energy_j: f64,
+    pub contacts: f64,
+    pub wall_contacts: usize,
+    pub max_overlap_m: f64,
+    pub mean_overlap_m: f64,
+    pub coordination: f64,
+    pub packing_fraction: Option<f64>,
+    /// `<wall>_force_N` for every wall, then `<wall>_position_m` for every servo wall.
+    pub walls: Vec<f64>,
+}
+
+/// The fixed columns of [`MdSeriesRow`], before the wall columns.
+pub const MD_SERIES_COLUMNS: [&str; 10] = [
+    "time_s",
+    "kinetic_energy_J",
+    "elastic_energy_J",
+    "potential_energy_J",
+    "contacts",
+    "wall_contacts",
+    "max_overlap_m",
+    "mean_overlap_m",
+    "coordination",
+    "packing_fraction",
+];
+
+/// Reads an NSCD `series.csv`; the error names the file and the line.
+pub fn read_nscd(path: &Path) -> Result<Vec<NscdSeriesRow>> {
+    Ok(super::table::read(path)?.1)
+}
+
+/// Reads an MD `series.csv`: its header (with the wall columns) and its rows.
+pub fn read_md(path: &Path) -> Result<(Vec<String>, Vec<MdSeriesRow>)> {
+    super::table::read(path)
 }

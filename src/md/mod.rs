@@ -12,6 +12,7 @@
 //! into the papers' quantities.
 
 pub mod contact;
+pub mod engine;
 pub mod ghosts;
 pub mod integrator;
 pub mod law;

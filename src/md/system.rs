@@ -129,6 +129,8 @@ struct Tail {
     /// Kinetic energy of the chunk after the step (J), non-finite if a position
     /// or velocity is.
     kinetic: f64,
+    /// `Σ m (x · up)` over the chunk after the step (kg·m), for the gravitational energy.
+    height: f64,
     /// First sphere with a non-finite force or torque.
     bad_force: Option<usize>,
 }
@@ -164,6 +166,7 @@ struct Backup {
     last: MdStepStats,
     time: f64,
     step: u64,
+    drive_work: f64,
 }
 
 fn one() -> u64 {
@@ -183,6 +186,15 @@ pub const CHUNKS: usize = 2;
 /// Steps between two copies of the last good state.
 const BACKUP_EVERY: u64 = 100;
 
+/// The energy-growth check stops a run whose spheres hold more than
+/// `E_0 + W + ENERGY_GROWTH (|E_0| + W)`, with `E_0` the mechanical energy at the
+/// start and `W` the work of the servo drives since: without numerical
+/// instability `E_k + E_g ≤ E_0 + W` (contacts, damping and friction dissipate,
+/// the elastic energy is not negative), so only a blow-up (a time step above
+/// the contact time, an unstable damping) exceeds it by a factor, within a few
+/// dozen steps of its exponential growth.
+pub const ENERGY_GROWTH: f64 = 10.0;
+
 /// A 3D MD system of spheres and walls.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct MdSystem {
@@ -192,10 +204,24 @@ pub struct MdSystem {
     pub laws: LawTable,
     pub ghosts: Ghosts,
     pub neighbours: Neighbours,
-    /// Time (s).
+    /// Time (s) at the end of the last step: `time_origin + (step − step_origin) dt`
+    /// ([`crate::clock`]), never accumulated.
     pub time: f64,
     /// Steps made.
     pub step: u64,
+    /// Time (s) and step at which the time step last changed ([`MdSystem::set_dt`]).
+    #[serde(default)]
+    pub time_origin: f64,
+    #[serde(default)]
+    pub step_origin: u64,
+    /// Mechanical energy `E_k + E_g + E_el` (J) when the system was built or its
+    /// configuration last written ([`MdSystem::set_configuration`]): with the work
+    /// of the servo drives, the budget of the energy-growth check.
+    #[serde(default)]
+    pub energy_start: f64,
+    /// Work of the servo walls' drives since then, in absolute value (J).
+    #[serde(default)]
+    pub drive_work: f64,
     /// Gear: scaled derivatives of the positions (rows 0..q).
     gear_x: Vec<[V3; 6]>,
     /// Gear: scaled derivatives of the rotation vector (rows 1..q).
@@ -248,6 +274,10 @@ impl MdSystem {
             ghosts,
             time: 0.0,
             step: 0,
+            time_origin: 0.0,
+            step_origin: 0,
+            energy_start: 0.0,
+            drive_work: 0.0,
             gear_x: Vec::new(),
             gear_w: Vec::new(),
             virial: Matrix3::zeros(),
@@ -263,13 +293,29 @@ impl MdSystem {
             all_x: Vec::new(),
             all_r: Vec::new(),
         };
-        let n = sys.particles.len();
-        sys.wall_hist = vec![History::default(); n * sys.walls.len()];
         sys.gravity_reference = sys.initial_reference();
+        sys.reset_derived();
+        sys
+    }
+
+    /// Rebuilds every state derived from the positions and velocities, as at the
+    /// start of a run: contact memory forgotten, neighbour list and images built,
+    /// forces evaluated (so that the first step starts from the right
+    /// accelerations), Gear derivatives started from them, the energy budget and
+    /// the backup of the last good state taken.
+    fn reset_derived(&mut self) {
+        let settings = self.settings;
+        let skin = self.neighbours.skin;
+        self.neighbours = Neighbours::new(skin);
+        let n = self.particles.len();
+        self.wall_hist = vec![History::default(); n * self.walls.len()];
+        let sys = self;
         sys.rebuild();
         sys.ghosts.update(&sys.particles);
-        let stats = sys.forces(0.0, true, false).map(|(s, _)| s).unwrap_or_default();
-        sys.last = MdStepStats { time: 0.0, kinetic_energy: sys.particles.kinetic_energy(), ..stats };
+        let stats = sys.forces(0.0, true, false).map(|(s, _, _)| s).unwrap_or_default();
+        sys.last = MdStepStats { time: sys.time, kinetic_energy: sys.particles.kinetic_energy(), ..stats };
+        sys.gear_x.clear();
+        sys.gear_w.clear();
         if let Integrator::Gear(set) = settings.integrator {
             let q = set.order();
             let dt = settings.dt;
@@ -295,8 +341,9 @@ impl MdSystem {
                 })
                 .collect();
         }
+        sys.energy_start = sys.last.kinetic_energy + sys.gravitational_energy() + sys.last.elastic_energy;
+        sys.drive_work = 0.0;
         sys.save_backup();
-        sys
     }
 
     fn initial_reference(&self) -> f64 {
@@ -332,13 +379,43 @@ impl MdSystem {
         self.threads.max(1)
     }
 
+    /// Changes the time step (s) from now on, keeping the clock exact.
+    pub fn set_dt(&mut self, dt: f64) {
+        self.time_origin = self.time;
+        self.step_origin = self.step;
+        self.settings.dt = dt;
+    }
+
     /// Makes one time step.
     ///
     /// # Errors
-    /// [`Error::Diverged`] if a force or position becomes non-finite or two bodies
-    /// overlap by more than half the smaller radius; the system then holds the
-    /// last good state (at most [`BACKUP_EVERY`] steps back).
+    /// [`Error::Diverged`] (the step being made and a sphere named) if a force or
+    /// position becomes non-finite, two bodies overlap by more than half the
+    /// smaller radius, or the energy of the spheres grows beyond what they were
+    /// given ([`MdSystem::energy_start`] + [`MdSystem::drive_work`], ×
+    /// [`ENERGY_GROWTH`]); the system then holds the state of the last good step:
+    /// the last backup (at most a hundred steps back) is restored and the steps
+    /// from it to the last good one are made again (the same numbers).
     pub fn step(&mut self) -> Result<MdStepStats> {
+        let good = self.step;
+        match self.advance() {
+            Ok(stats) => Ok(stats),
+            Err(e) => {
+                self.restore_backup();
+                while self.step < good {
+                    if self.advance().is_err() {
+                        // Cannot happen (the same steps succeeded before); keep the backup.
+                        self.restore_backup();
+                        break;
+                    }
+                }
+                Err(e)
+            }
+        }
+    }
+
+    /// One step, leaving the state as it is on failure (see [`MdSystem::step`]).
+    fn advance(&mut self) -> Result<MdStepStats> {
         let n = self.particles.len();
         let parallel = self.threads > 1 && n >= CHUNKS * PAR_MIN;
         if parallel && self.team.threads() < 2 {
@@ -372,24 +449,18 @@ impl MdSystem {
         self.ghosts.update(&self.particles);
         // Phases 2 and 3.
         let measure = (self.step + 1).is_multiple_of(self.measure_every.max(1));
-        let (stats, kinetic) = match self.forces(dt, measure, true) {
-            Ok(r) => r,
-            Err(e) => {
-                self.restore_backup();
-                return Err(e);
-            }
-        };
+        let (stats, kinetic, height) = self.forces(dt, measure, true)?;
         if !kinetic.is_finite() {
             let p = &self.particles;
             let i = (0..p.len())
                 .find(|&i| !(p.x[i].iter().all(|c| c.is_finite()) && p.v[i].iter().all(|c| c.is_finite())))
                 .unwrap_or(0);
-            let e = self.diverged(i, "position or velocity is not finite".into());
-            self.restore_backup();
-            return Err(e);
+            return Err(self.diverged(i, "position or velocity is not finite".into()));
         }
-        walls::advance(&mut self.walls, self.time + dt, dt);
-        self.time += dt;
+        let t_next = crate::clock::time_at(self.time_origin, self.step_origin, self.step + 1, dt);
+        self.drive_work += walls::advance(&mut self.walls, t_next, dt);
+        self.check_energy(kinetic, height)?;
+        self.time = t_next;
         self.step += 1;
         let stats = if measure {
             stats
@@ -407,6 +478,166 @@ impl MdSystem {
             self.save_backup();
         }
         Ok(stats)
+    }
+
+    /// The energy-growth check after a step with kinetic energy `kinetic` (J) and
+    /// `Σ m (x · up) = height` (kg·m); the sphere of largest kinetic energy is named.
+    fn check_energy(&self, kinetic: f64, height: f64) -> Result<()> {
+        let gn = self.settings.gravity.norm();
+        let mass: f64 = self.particles.m.iter().sum();
+        let gravitational = gn * (height - mass * self.gravity_reference);
+        let budget = self.energy_start + self.drive_work;
+        let limit = budget + ENERGY_GROWTH * (self.energy_start.abs() + self.drive_work) + f64::MIN_POSITIVE;
+        let energy = kinetic + gravitational;
+        if energy <= limit {
+            return Ok(());
+        }
+        let p = &self.particles;
+        let ek = |i: usize| p.m[i] * p.v[i].norm_squared() + 0.4 * p.m[i] * p.r[i] * p.r[i] * p.w[i].norm_squared();
+        let i = (0..p.len()).max_by(|&a, &b| ek(a).total_cmp(&ek(b))).unwrap_or(0);
+        Err(self.diverged(
+            i,
+            format!(
+                "runaway energy: the spheres hold {energy:.3e} J (kinetic + gravitational), more than {:.0}× the \
+                 {budget:.3e} J they were given (time step too large for the contacts, or unstable damping?)",
+                ENERGY_GROWTH + 1.0
+            ),
+        ))
+    }
+
+    /// Moves the spheres of `c` to its positions (centre `x, y, z`, m; rotation
+    /// vector of the orientation, rad), sets every velocity and spin to zero (and
+    /// the servo walls' rates), forgets the contact memory and rebuilds every
+    /// derived state — neighbour list, images, forces, Gear derivatives, energy
+    /// budget, backup — so that the next step starts from this configuration
+    /// exactly as a system built there would (on either integrator). The clock
+    /// and the walls' positions go on.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if `c` has not 6 coordinates per sphere, names an unknown
+    /// sphere or holds a non-finite value; the system is then unchanged.
+    pub fn set_configuration(&mut self, c: &crate::run::Configuration) -> Result<()> {
+        c.check(6, self.particles.len())?;
+        let p = &mut self.particles;
+        for (k, &i) in c.bodies.iter().enumerate() {
+            let q = c.body(k);
+            p.x[i] = V3::new(q[0], q[1], q[2]);
+            p.q[i] = UnitQuaternion::from_scaled_axis(V3::new(q[3], q[4], q[5]));
+        }
+        p.v.iter_mut().chain(p.w.iter_mut()).for_each(|v| *v = V3::zeros());
+        for w in &mut self.walls {
+            w.s_dot = 0.0;
+        }
+        self.reset_derived();
+        Ok(())
+    }
+
+    /// Checks that the state holds together (a state read from a checkpoint):
+    /// array lengths, material and partner indices, the neighbour rows, finite
+    /// positions and velocities, the clock. The message names what is wrong.
+    pub fn check_state(&self) -> Result<()> {
+        let bad = |msg: String| Err(Error::Scene(msg));
+        let p = &self.particles;
+        let n = p.len();
+        let lens = [p.v.len(), p.w.len(), p.f.len(), p.t.len(), p.r.len(), p.m.len(), p.inv_m.len()];
+        let more = [p.inv_i.len(), p.material.len(), p.q.len(), p.name.len()];
+        if lens.iter().chain(&more).any(|&l| l != n) {
+            return bad(format!("spheres: arrays of different lengths for {n} spheres"));
+        }
+        let finite = |v: &V3| v.iter().all(|x| x.is_finite());
+        if let Some(i) = (0..n).find(|&i| !(finite(&p.x[i]) && finite(&p.v[i]) && finite(&p.w[i]))) {
+            return bad(format!("sphere {i}: a position or velocity is not finite"));
+        }
+        if let Some(i) = (0..n).find(|&i| !(p.r[i] > 0.0 && p.m[i] > 0.0 && p.inv_m[i].is_finite())) {
+            return bad(format!("sphere {i}: radius or mass is not positive"));
+        }
+        if let Some(i) = (0..n).find(|&i| p.material[i] as usize >= self.laws.n) {
+            return bad(format!("sphere {i}: material {} of {}", p.material[i], self.laws.n));
+        }
+        if self.laws.laws.len() != self.laws.n * self.laws.n {
+            return bad(format!("{} laws for {} materials", self.laws.laws.len(), self.laws.n));
+        }
+        let gear = matches!(self.settings.integrator, Integrator::Gear(_));
+        let expected = if gear { n } else { 0 };
+        if self.gear_x.len() != expected || self.gear_w.len() != expected {
+            return bad(format!("Gear derivatives of {} spheres for {n}", self.gear_x.len()));
+        }
+        let nw = self.walls.len();
+        if !self.wall_hist.is_empty() && self.wall_hist.len() != n * nw {
+            return bad(format!(
+                "wall contact memory of {} entries for {n} spheres and {nw} walls",
+                self.wall_hist.len()
+            ));
+        }
+        let nb = &self.neighbours;
+        let rows_ok = nb.start.is_empty()
+            || (nb.start.len() == n + 1
+                && nb.start[0] == 0
+                && nb.start.windows(2).all(|w| w[0] <= w[1])
+                && nb.start[n] as usize == nb.j.len());
+        if !rows_ok || nb.key.len() != nb.j.len() || nb.hist.len() != nb.j.len() {
+            return bad("neighbour list: rows, partners, keys and memory do not match".into());
+        }
+        let n_all = n + self.ghosts.len();
+        if nb.j.iter().any(|&j| j as usize >= n_all) || !(nb.x_build.is_empty() || nb.x_build.len() == n) {
+            return bad("neighbour list: a partner or build position out of range".into());
+        }
+        let g = &self.ghosts;
+        if g.mask.len() != g.len() || g.key.len() != g.len() || g.origin.iter().any(|&i| i as usize >= n) {
+            return bad("symmetry images: origins, masks and keys do not match".into());
+        }
+        if let Some(w) = self.walls.iter().find(|w| w.candidates.iter().any(|&i| i as usize >= n)) {
+            return bad(format!("wall '{}': a candidate sphere out of range", crate::scene::clip(&w.name)));
+        }
+        if !(self.settings.dt.is_finite() && self.settings.dt > 0.0) {
+            return bad(format!("time step {} s", self.settings.dt));
+        }
+        let t = crate::clock::time_at(self.time_origin, self.step_origin, self.step, self.settings.dt);
+        if self.step < self.step_origin || t.to_bits() != self.time.to_bits() {
+            return bad(format!("clock: time {} s at step {} does not follow from its origin", self.time, self.step));
+        }
+        Ok(())
+    }
+
+    /// Checks that `self` is a state of the model `fresh` (the system built from
+    /// the same scene): the same spheres (names, radii, masses, materials),
+    /// walls (names, shapes, motions), laws, symmetry planes and settings.
+    pub fn check_same_model(&self, fresh: &MdSystem) -> Result<()> {
+        let bad = |what: String| Err(Error::Scene(format!("{what} differs from the scene's")));
+        let (a, b) = (&self.particles, &fresh.particles);
+        if a.len() != b.len() {
+            return bad(format!("the number of spheres ({})", a.len()));
+        }
+        for i in 0..a.len() {
+            let same = a.name[i] == b.name[i]
+                && a.r[i].to_bits() == b.r[i].to_bits()
+                && a.m[i].to_bits() == b.m[i].to_bits()
+                && a.inv_m[i].to_bits() == b.inv_m[i].to_bits()
+                && a.inv_i[i].to_bits() == b.inv_i[i].to_bits()
+                && a.material[i] == b.material[i];
+            if !same {
+                return bad(format!("sphere {i} ('{}')", crate::scene::clip(&b.name[i])));
+            }
+        }
+        if self.walls.len() != fresh.walls.len() {
+            return bad(format!("the number of walls ({})", self.walls.len()));
+        }
+        for (w, f) in self.walls.iter().zip(&fresh.walls) {
+            if w.name != f.name || w.material != f.material || w.shape != f.shape || w.motion != f.motion {
+                return bad(format!("wall '{}'", crate::scene::clip(&f.name)));
+            }
+        }
+        let same = |x: &dyn Fn(&MdSystem) -> serde_json::Value| x(self) == x(fresh);
+        if !same(&|s| serde_json::to_value(&s.laws).unwrap_or_default()) {
+            return bad("the contact laws".into());
+        }
+        if !same(&|s| serde_json::to_value(&s.ghosts.planes).unwrap_or_default()) {
+            return bad("the symmetry planes".into());
+        }
+        if self.settings != fresh.settings {
+            return bad("the [md] settings or time step".into());
+        }
+        Ok(())
     }
 
     /// Names the sphere `body` in a divergence of the step being made.
@@ -449,6 +680,7 @@ impl MdSystem {
         b.last = self.last;
         b.time = self.time;
         b.step = self.step;
+        b.drive_work = self.drive_work;
     }
 
     fn restore_backup(&mut self) {
@@ -486,6 +718,7 @@ impl MdSystem {
         self.last = b.last;
         self.time = b.time;
         self.step = b.step;
+        self.drive_work = b.drive_work;
     }
 
     /// Rebuilds the images, the neighbour list and the wall candidate lists.
@@ -521,9 +754,10 @@ impl MdSystem {
 
     /// Evaluates all forces at the current state (images already mirrored),
     /// advancing the contact memory by `dt` (s), and with `integrate` finishes
-    /// the step (second half kick or corrector). Returns the statistics and the
-    /// kinetic energy after the step (J; 0 without `integrate`).
-    fn forces(&mut self, dt: f64, measure: bool, integrate: bool) -> Result<(MdStepStats, f64)> {
+    /// the step (second half kick or corrector). Returns the statistics, the
+    /// kinetic energy after the step (J) and `Σ m (x · up)` (kg·m; both 0
+    /// without `integrate`).
+    fn forces(&mut self, dt: f64, measure: bool, integrate: bool) -> Result<(MdStepStats, f64, f64)> {
         let n = self.particles.len();
         let nw = self.walls.len();
         self.work.resize_with(CHUNKS, Workspace::default);
@@ -560,6 +794,7 @@ impl MdSystem {
             damping: (s.background_damping, s.background_rotational_damping),
             integrator: s.integrator,
             gravity: s.gravity,
+            up: self.up(),
             dt,
             integrate,
         };
@@ -578,6 +813,7 @@ impl MdSystem {
             tally.add(&w.tally);
         }
         let mut kinetic = 0.0;
+        let mut height = 0.0;
         let mut bad_force = None;
         for (k, wall) in self.walls.iter_mut().enumerate() {
             wall.force = V3::zeros();
@@ -590,6 +826,7 @@ impl MdSystem {
         for t in &self.tails {
             tally.add(&t.tally);
             kinetic += t.kinetic;
+            height += t.height;
             bad_force = bad_force.or(t.bad_force);
         }
         let wall_contacts = self.walls.iter().map(|w| w.contacts).sum::<usize>();
@@ -616,7 +853,7 @@ impl MdSystem {
             mean_overlap: if tally.overlaps > 0 { tally.sum_overlap / tally.overlaps as f64 } else { 0.0 },
             coordination: if n > 0 { (2.0 * contacts + wall_contacts as f64) / n as f64 } else { 0.0 },
         };
-        Ok((stats, kinetic))
+        Ok((stats, kinetic, height))
     }
 }
 
@@ -752,6 +989,8 @@ struct TailContext<'a> {
     damping: (f64, f64),
     integrator: Integrator,
     gravity: V3,
+    /// Unit vector against gravity.
+    up: V3,
     dt: f64,
     /// Finish the step (second half kick or corrector) after the forces.
     integrate: bool,
@@ -824,7 +1063,7 @@ fn tail(c: View, hist: &mut [History], ctx: &TailContext, out: &mut Tail) {
     out.bad_force = out.bad_force.map(|i| lo + i);
     out.tally = tally;
     if ctx.integrate {
-        out.kinetic = second_half(c, ctx.integrator, ctx.gravity, dt);
+        (out.kinetic, out.height) = second_half(c, ctx.integrator, ctx.gravity, ctx.up, dt);
     }
 }
 
@@ -971,9 +1210,10 @@ fn first_half(c: View, integrator: Integrator, g: V3, dt: f64) -> f64 {
 
 /// After the force evaluation: second half kick (Verlet) or corrector (Gear),
 /// orientations; returns the kinetic energy of the chunk (J), non-finite if a
-/// position or velocity is.
-fn second_half(c: View, integrator: Integrator, g: V3, dt: f64) -> f64 {
+/// position or velocity is, and `Σ m (x · up)` (kg·m).
+fn second_half(c: View, integrator: Integrator, g: V3, up: V3, dt: f64) -> (f64, f64) {
     let mut kinetic = 0.0;
+    let mut height = 0.0;
     let mut finite = true;
     match integrator {
         Integrator::Verlet => {
@@ -983,6 +1223,7 @@ fn second_half(c: View, integrator: Integrator, g: V3, dt: f64) -> f64 {
                 rotate(&mut c.q[i], &c.w[i], dt);
                 // Solid sphere: I = 2/5 m r².
                 kinetic += 0.5 * c.m[i] * (c.v[i].norm_squared() + 0.4 * c.r[i] * c.r[i] * c.w[i].norm_squared());
+                height += c.m[i] * c.x[i].dot(&up);
                 finite &= c.x[i].iter().all(|a| a.is_finite());
             }
         }
@@ -1004,13 +1245,14 @@ fn second_half(c: View, integrator: Integrator, g: V3, dt: f64) -> f64 {
                 rotate(&mut c.q[i], &c.w[i], dt);
                 // Solid sphere: I = 2/5 m r².
                 kinetic += 0.5 * c.m[i] * (c.v[i].norm_squared() + 0.4 * c.r[i] * c.r[i] * c.w[i].norm_squared());
+                height += c.m[i] * c.x[i].dot(&up);
                 finite &= c.x[i].iter().all(|a| a.is_finite());
             }
         }
     }
     if finite {
-        kinetic
+        (kinetic, height)
     } else {
-        f64::NAN
+        (f64::NAN, height)
     }
 }

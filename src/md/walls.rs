@@ -203,17 +203,23 @@ pub fn box_area(walls: &[Wall], axis: usize) -> f64 {
     }
 }
 
-/// Advances the servo walls by `dt` (s) at time `t` (s) after a force evaluation.
-pub fn advance(walls: &mut [Wall], t: f64, dt: f64) {
+/// Advances the servo walls by `dt` (s) at time `t` (s) after a force
+/// evaluation; returns the work of their drives over the step in absolute value
+/// (J), `Σ |F_drive Δs|`.
+pub fn advance(walls: &mut [Wall], t: f64, dt: f64) -> f64 {
+    let mut work = 0.0;
     for k in 0..walls.len() {
         if let Motion::Servo { mass, viscosity, .. } = walls[k].motion {
             let axis = walls[k].normal().map(|n| n.iamax()).unwrap_or(0);
             let area = box_area(walls, axis);
             let w = &mut walls[k];
-            let f = w.drive_force(t, area) + w.normal_force();
+            let drive = w.drive_force(t, area);
+            let f = drive + w.normal_force();
             // Semi-implicit in the viscosity: stable for any γ_w dt / m_w.
             w.s_dot = (w.s_dot + dt * f / mass) / (1.0 + dt * viscosity / mass);
             w.s += dt * w.s_dot;
+            work += (drive * dt * w.s_dot).abs();
         }
     }
+    work
 }

@@ -14,6 +14,7 @@ pub mod contact;
 pub mod coulomb;
 pub mod criterion;
 pub mod detection;
+pub mod engine;
 pub mod loads;
 pub mod measure;
 pub mod narrow_phase;

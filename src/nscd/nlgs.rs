@@ -21,19 +21,28 @@ use super::criterion::{evaluate, Policy, SweepNorms};
 use super::split::SplitWorkspace;
 use super::sublayer::SpringRow;
 
-/// NLGS settings.
+/// NLGS settings; [`NlgsSettings::default`] gives the defaults of scenes
+/// (`[nscd]` of `docs/scene-format.md`).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct NlgsSettings {
+    /// Convergence policy ([`super::criterion`]); default [`Policy::Quad`].
     pub policy: Policy,
+    /// Tolerance of the policy (dimensionless), in (0, 1); default 1e-4.
     pub tolerance: f64,
+    /// Sweeps made at least, ≥ 1; default 1.
     pub min_iterations: usize,
+    /// Sweeps made at most, ≥ `min_iterations`; default 1000. A step that
+    /// reaches it without meeting the tolerance is counted as *not converged*:
+    /// its impulses are those of the last sweep.
     pub max_iterations: usize,
-    /// For `quad_max`: the maximum norm may reach `max_factor · tolerance`.
+    /// For `quad_max`: the maximum norm may reach `max_factor · tolerance`, ≥ 1;
+    /// default 4.
     pub max_factor: f64,
-    /// Alternate forward and backward sweeps (symmetric Gauss–Seidel).
+    /// Alternate forward and backward sweeps (symmetric Gauss–Seidel); default false.
     pub symmetric: bool,
     /// Problems of at least this many rows (contacts + springs) are solved split
-    /// in two halves swept side by side ([`super::split`]); 0: never.
+    /// in two halves swept side by side ([`super::split`]); 0: never; default
+    /// [`DEFAULT_SPLIT_MIN_ROWS`].
     #[serde(default = "default_split_min_rows")]
     pub split_min_rows: usize,
 }

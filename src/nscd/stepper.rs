@@ -22,10 +22,13 @@ impl System {
     /// Advances by one step of `params.dt`.
     pub fn step(&mut self) -> Result<StepStats> {
         self.params.check()?;
+        if self.gravity_reference.is_none() {
+            self.gravity_reference = Some(self.lowest_point());
+        }
         let h = self.params.dt;
         let theta = self.params.theta;
         let n = self.bodies.len();
-        let t_f = self.time_origin + (self.step + 1 - self.step_origin) as f64 * h;
+        let t_f = crate::clock::time_at(self.time_origin, self.step_origin, self.step + 1, h);
         let t_m = t_f - theta * h;
         let mut ws = std::mem::take(&mut self.ws);
         ws.q_i.clone_from(&self.bodies.q);

@@ -108,6 +108,18 @@ impl Spring {
         }
     }
 
+    /// Elastic energy (J) in configuration `q`: `½ k_N L0 ε²`, the work of the
+    /// elastic part `−k_N ε` of law (17) from `ε = 0` (0 for a compression-only
+    /// spring in tension, `ε > 0`).
+    pub fn elastic_energy(&self, q: &[[f64; 3]]) -> f64 {
+        let eps = (self.length(q) - self.rest_length) / self.rest_length - self.prestrain;
+        if self.compression_only && eps > 0.0 {
+            0.0
+        } else {
+            0.5 * self.k_n * self.rest_length * eps * eps
+        }
+    }
+
     /// Unit axis from the second end to the first (`a`) in configuration `q`: a
     /// positive `R_N` pushes `a` along it.
     pub fn axis(&self, q: &[[f64; 3]]) -> [f64; 2] {

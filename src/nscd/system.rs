@@ -11,19 +11,35 @@ use super::sublayer::{Spring, SpringRow};
 use crate::geometry::Vec2;
 use serde::{Deserialize, Serialize};
 
-/// Time-stepping parameters.
+/// Default alert distance of a scene, as a fraction of the smallest inner
+/// radius of the non-fixed bodies (of all bodies if none moves) (m/m).
+pub const DEFAULT_ALERT_FRACTION: f64 = 0.01;
+
+/// Time-stepping parameters. [`NscdParams::default`] gives the defaults of
+/// scenes (`[simulation]` and `[nscd]` of `docs/scene-format.md`), but for the
+/// time step, which a scene must give.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NscdParams {
-    /// Time step `h` (s).
+    /// Time step `h` (s), > 0; default 1e-3 (scenes must give it).
     pub dt: f64,
-    /// θ of the θ-method, in [0.5, 1].
+    /// θ of the θ-method, in [0.5, 1]; default 0.5 (Saussine et al. 2006 §2.2:
+    /// θ = 1/2 conserves energy between impacts).
     pub theta: f64,
-    /// Gravity (m/s²).
+    /// Gravity (m/s²); default `[0, −9.81]`.
     pub gravity: [f64; 2],
-    /// Alert distance (m): pairs closer than this are contacts (possibly open).
-    /// Each step it is raised to `2 h v_max` if the fastest body needs it.
+    /// Alert distance (m), ≥ 0: pairs closer than this are contacts (possibly
+    /// open). Each step it is raised to `2 h v_max` if the fastest body needs it.
+    /// Default 1e-4 here; a scene's default is [`DEFAULT_ALERT_FRACTION`] × the
+    /// smallest inner radius of its mobile bodies.
     pub alert_distance: f64,
+    /// NLGS settings ([`NlgsSettings::default`]).
     pub nlgs: NlgsSettings,
+}
+
+impl Default for NscdParams {
+    fn default() -> Self {
+        Self { dt: 1e-3, theta: 0.5, gravity: [0.0, -9.81], alert_distance: 1e-4, nlgs: NlgsSettings::default() }
+    }
 }
 
 impl NscdParams {
@@ -130,6 +146,11 @@ pub struct System {
     /// key: the warm start of the next step.
     pub contacts: Vec<ContactGeom>,
     pub impulses: Vec<[f64; 2]>,
+    /// Zero of the gravitational energy, as a height along `−g` (m): the lowest
+    /// point of the non-fixed bodies when the first step is made (fixed for the
+    /// run, so that `E_k + E_p` is conserved without dissipation).
+    #[serde(default)]
+    pub gravity_reference: Option<f64>,
     #[serde(skip)]
     pub(crate) ws: Workspace,
 }
@@ -149,6 +170,7 @@ impl System {
             step_origin: 0,
             contacts: Vec::new(),
             impulses: Vec::new(),
+            gravity_reference: None,
             ws: Workspace::default(),
         }
     }
@@ -230,4 +252,187 @@ impl System {
     pub fn spring_forces(&self) -> impl Iterator<Item = f64> + '_ {
         self.springs.iter().map(move |s| s.impulse / self.params.dt)
     }
+}
+
+impl System {
+    /// The unit vector against gravity (`+y` without gravity).
+    fn up(&self) -> [f64; 2] {
+        let g = self.params.gravity;
+        let n = g[0].hypot(g[1]);
+        if n > 0.0 {
+            [-g[0] / n, -g[1] / n]
+        } else {
+            [0.0, 1.0]
+        }
+    }
+
+    /// The lowest point of the non-fixed bodies along `−g` (m; their bounding
+    /// circles), 0 if there is none.
+    pub fn lowest_point(&self) -> f64 {
+        let up = self.up();
+        let low = (0..self.bodies.len())
+            .filter(|&i| !self.bodies.info[i].fixed)
+            .map(|i| {
+                let q = self.bodies.q[i];
+                q[0] * up[0] + q[1] * up[1] - self.bodies.info[i].shape.bounding_radius()
+            })
+            .fold(f64::INFINITY, f64::min);
+        if low.is_finite() {
+            low
+        } else {
+            0.0
+        }
+    }
+
+    /// Gravitational energy `Σ m |g| h` of the non-fixed bodies (J), `h` the
+    /// height of the centre of mass above [`System::gravity_reference`] (the
+    /// lowest point now if no step has set it).
+    pub fn gravitational_energy(&self) -> f64 {
+        let g = self.params.gravity;
+        let gn = g[0].hypot(g[1]);
+        if gn == 0.0 {
+            return 0.0;
+        }
+        let up = self.up();
+        let reference = self.gravity_reference.unwrap_or_else(|| self.lowest_point());
+        let b = &self.bodies;
+        (0..b.len())
+            .filter(|&i| !b.info[i].fixed)
+            .map(|i| b.info[i].mass * gn * (b.q[i][0] * up[0] + b.q[i][1] * up[1] - reference))
+            .sum()
+    }
+
+    /// Elastic energy of the sublayer springs (J): `½ k_N L0 ε²` each (law (17),
+    /// [`super::sublayer`]), 0 for a compression-only spring in tension.
+    pub fn spring_energy(&self) -> f64 {
+        self.springs.iter().map(|s| s.elastic_energy(&self.bodies.q)).sum()
+    }
+
+    /// Potential energy `E_p` (J): gravitational plus the springs'.
+    pub fn potential_energy(&self) -> f64 {
+        self.gravitational_energy() + self.spring_energy()
+    }
+
+    /// Moves the bodies of `c` to its positions `(x, y, θ)` (centre of mass, m;
+    /// angle, rad), sets every velocity to zero (an imposed component to its
+    /// value now) and forgets the warm start (contact and spring impulses), so
+    /// that the next step starts from this configuration exactly as a system
+    /// built there would. The clock goes on.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if `c` has not 3 coordinates per body, names an unknown
+    /// or fixed body or holds a non-finite value; the system is then unchanged.
+    pub fn set_configuration(&mut self, c: &crate::run::Configuration) -> crate::Result<()> {
+        c.check(3, self.bodies.len())?;
+        if let Some(&i) = c.bodies.iter().find(|&&i| self.bodies.info[i].fixed) {
+            return Err(crate::Error::Scene(format!(
+                "configuration: body {i} ('{}') is fixed",
+                crate::scene::clip(&self.bodies.info[i].name)
+            )));
+        }
+        for (k, &i) in c.bodies.iter().enumerate() {
+            self.bodies.q[i].copy_from_slice(c.body(k));
+        }
+        for (info, u) in self.bodies.info.iter().zip(self.bodies.u.iter_mut()) {
+            *u = [0.0; 3];
+            if !info.fixed {
+                for (d, v) in u.iter_mut().enumerate() {
+                    if let Some(f) = info.imposed.dof[d] {
+                        *v = f.at(self.time);
+                    }
+                }
+            }
+        }
+        self.contacts.clear();
+        self.impulses.clear();
+        for s in &mut self.springs {
+            s.impulse = 0.0;
+        }
+        Ok(())
+    }
+
+    /// Checks that the state holds together (a state read from a checkpoint):
+    /// array lengths, body and material indices, warm-start keys sorted and in
+    /// range, finite positions and velocities, the parameters' ranges and the
+    /// clock. The message names what is wrong.
+    pub fn check_state(&self) -> crate::Result<()> {
+        let bad = |msg: String| Err(crate::Error::Scene(msg));
+        let b = &self.bodies;
+        let n = b.len();
+        if b.info.len() != n || b.u.len() != n || b.inv_m.len() != n {
+            return bad(format!(
+                "bodies: {} positions, {} velocities, {} inverse masses, {} descriptions",
+                n,
+                b.u.len(),
+                b.inv_m.len(),
+                b.info.len()
+            ));
+        }
+        if let Some(i) = (0..n).find(|&i| b.q[i].iter().chain(&b.u[i]).chain(&b.inv_m[i]).any(|x| !x.is_finite())) {
+            return bad(format!("body {i}: a position, velocity or inverse mass is not finite"));
+        }
+        if self.laws.len() != self.materials * self.materials {
+            return bad(format!("{} contact laws for {} materials", self.laws.len(), self.materials));
+        }
+        if let Some(i) = (0..n).find(|&i| b.info[i].material >= self.materials) {
+            return bad(format!("body {i}: material {} of {}", b.info[i].material, self.materials));
+        }
+        for (k, s) in self.springs.iter().enumerate() {
+            if s.a >= n || s.b.is_some_and(|j| j >= n) {
+                return bad(format!("spring {k}: body out of range ({n} bodies)"));
+            }
+        }
+        if self.impulses.len() != self.contacts.len() {
+            return bad(format!("{} warm-start impulses for {} contacts", self.impulses.len(), self.contacts.len()));
+        }
+        if self.contacts.iter().any(|c| c.key.0 as usize >= n || c.key.1 as usize >= n)
+            || self.contacts.windows(2).any(|w| w[0].key >= w[1].key)
+        {
+            return bad("warm-start contacts: bodies out of range or keys not sorted".into());
+        }
+        self.params.check()?;
+        let t = crate::clock::time_at(self.time_origin, self.step_origin, self.step, self.params.dt);
+        if self.step < self.step_origin || t.to_bits() != self.time.to_bits() {
+            return bad(format!("clock: time {} s at step {} does not follow from its origin", self.time, self.step));
+        }
+        Ok(())
+    }
+
+    /// Checks that `self` is a state of the model `fresh` (the system built from
+    /// the same scene): the same bodies (names, shapes, materials, masses,
+    /// fixed, imposed, loads), springs (but their impulses), contact laws and
+    /// parameters.
+    pub fn check_same_model(&self, fresh: &System) -> crate::Result<()> {
+        let bad = |what: String| Err(crate::Error::Scene(format!("{what} differs from the scene's")));
+        if self.bodies.len() != fresh.bodies.len() {
+            return bad(format!("the number of bodies ({})", self.bodies.len()));
+        }
+        for (i, (a, b)) in self.bodies.info.iter().zip(&fresh.bodies.info).enumerate() {
+            if !same(a, b) {
+                return bad(format!("body {i} ('{}')", crate::scene::clip(&b.name)));
+            }
+        }
+        if self.springs.len() != fresh.springs.len() {
+            return bad(format!("the number of springs ({})", self.springs.len()));
+        }
+        for (k, (a, b)) in self.springs.iter().zip(&fresh.springs).enumerate() {
+            let a = super::Spring { impulse: 0.0, ..a.clone() };
+            let b = super::Spring { impulse: 0.0, ..b.clone() };
+            if !same(&a, &b) {
+                return bad(format!("spring {k}"));
+            }
+        }
+        if self.materials != fresh.materials || !same(&self.laws, &fresh.laws) {
+            return bad("the contact laws".into());
+        }
+        if self.params != fresh.params {
+            return bad("the [nscd] parameters or time step".into());
+        }
+        Ok(())
+    }
+}
+
+/// Whether `a` and `b` have the same serde form (static data of a model).
+pub(crate) fn same<T: Serialize>(a: &T, b: &T) -> bool {
+    serde_json::to_value(a).ok() == serde_json::to_value(b).ok()
 }

@@ -382,7 +382,8 @@ pub fn loaded_scene(sample: &Scene, spec: &LoadingSpec) -> Result<Scene> {
     nscd.max_iterations = Some(spec.max_iterations);
     let output = out.output.get_or_insert_with(Default::default);
     output.every = Some(spec.output_every);
-    output.cycles = Some(crate::scene::CyclesSpec { frequency: spec.frequency, body: SLEEPER.into() });
+    output.cycles =
+        Some(crate::scene::CyclesSpec { frequency: spec.frequency, body: Some(SLEEPER.into()), positions: None });
     // A stiffer sublayer carries the same static load: each spring's prestrain is
     // reset so that its force at the current length is unchanged (scaling k_N alone
     // would release the stored compression and launch the layer).

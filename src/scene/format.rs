@@ -5,36 +5,22 @@
 //! exactly the keys the user gave; the defaults live in the accessor methods and
 //! the `DEFAULT_*` constants. All quantities are SI.
 
+pub use super::common::{CyclesSpec, OutputSection, Simulation, DEFAULT_OUTPUT_EVERY};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
 use std::marker::PhantomData;
 
-/// Default gravity (m/s²).
+/// Default gravity of a 2D scene (m/s²).
 pub const DEFAULT_GRAVITY: [f64; 2] = [0.0, -9.81];
 /// Default out-of-plane thickness (m).
 pub const DEFAULT_THICKNESS: f64 = 1.0;
-/// Default θ of the Moreau–Jean θ-method.
-pub const DEFAULT_THETA: f64 = 0.5;
-/// Default convergence criterion of the NLGS.
-pub const DEFAULT_CRITERION: &str = "quad";
-/// Default NLGS tolerance (dimensionless).
-pub const DEFAULT_TOLERANCE: f64 = 1.0e-4;
-/// Default minimum number of NLGS sweeps per step.
-pub const DEFAULT_MIN_ITERATIONS: usize = 1;
-/// Default maximum number of NLGS sweeps per step.
-pub const DEFAULT_MAX_ITERATIONS: usize = 1000;
-/// Default `max_factor` of the `quad_max` criterion.
-pub const DEFAULT_MAX_FACTOR: f64 = 4.0;
-/// Default alert distance, as a fraction of the smallest inner radius (m/m).
-pub const DEFAULT_ALERT_FRACTION: f64 = 0.01;
-/// Default number of steps between two rows of `series.csv`.
-pub const DEFAULT_OUTPUT_EVERY: u64 = 1;
 
 /// A whole scene file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
-    /// `[simulation]`: engine, time step, duration, gravity, thickness, seed.
+    /// `[simulation]`: engine, time step, duration, gravity, thickness, seed,
+    /// equilibrium stop (shared with MD scenes).
     pub simulation: Simulation,
     /// `[nscd]`: settings of the NSCD engine (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -54,64 +40,6 @@ pub struct Scene {
     /// `[[spring]]` entries: viscoelastic sublayer springs.
     #[serde(default, rename = "spring", skip_serializing_if = "Vec::is_empty")]
     pub springs: Vec<SpringSpec>,
-}
-
-/// `[simulation]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Simulation {
-    /// Engine name; only `"nscd"` is implemented.
-    pub engine: String,
-    /// Time step `h` (s), > 0.
-    pub dt: f64,
-    /// Simulated duration (s), > 0; the run makes `round(duration / dt)` steps.
-    pub duration: f64,
-    /// Gravity (m/s²); default [`DEFAULT_GRAVITY`].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[serde(deserialize_with = "opt_pair")]
-    pub gravity: Option<[f64; 2]>,
-    /// Out-of-plane thickness (m), > 0; default [`DEFAULT_THICKNESS`]. A body
-    /// of area `A` (m²) and density `ρ` (kg/m³) has mass `ρ A thickness` (kg).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub thickness: Option<f64>,
-    /// Random seed, recorded in the outputs; default 0.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub seed: Option<u64>,
-    /// Ends the run early at static equilibrium (a deposit): see [`Equilibrium`].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub equilibrium: Option<Equilibrium>,
-}
-
-/// `simulation.equilibrium`: the run ends once the kinetic energy has stayed
-/// below `kinetic_energy` (J) for `steps` consecutive steps (default 100; a window,
-/// so that the momentary rest at the top of a bounce does not count).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Equilibrium {
-    /// Threshold on the kinetic energy of the non-fixed bodies (J), > 0.
-    pub kinetic_energy: f64,
-    /// Consecutive steps below the threshold, ≥ 1; default 100.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub steps: Option<u64>,
-}
-
-impl Equilibrium {
-    /// Consecutive steps required.
-    pub fn steps(&self) -> u64 {
-        self.steps.unwrap_or(100)
-    }
-}
-
-impl Simulation {
-    /// Gravity (m/s²).
-    pub fn gravity(&self) -> [f64; 2] {
-        self.gravity.unwrap_or(DEFAULT_GRAVITY)
-    }
-
-    /// Out-of-plane thickness (m).
-    pub fn thickness(&self) -> f64 {
-        self.thickness.unwrap_or(DEFAULT_THICKNESS)
-    }
 }
 
 /// `[nscd]`: every key is optional.
@@ -143,29 +71,6 @@ pub struct NscdSection {
     /// smallest inner radius of the non-fixed bodies (of all bodies if none moves).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub alert_distance: Option<f64>,
-}
-
-/// `[output]`.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct OutputSection {
-    /// Steps between two rows of `series.csv`, ≥ 1 (the last step always has a row).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub every: Option<u64>,
-    /// Per-cycle statistics of a cyclically loaded run (`cycles.csv`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub cycles: Option<CyclesSpec>,
-}
-
-/// `output.cycles`: one row of `cycles.csv` per loading cycle of `frequency` (Hz),
-/// following the body named `body` (the sleeper).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CyclesSpec {
-    /// Loading frequency (Hz), > 0: a cycle lasts `1/frequency` s from t = 0.
-    pub frequency: f64,
-    /// Name of the followed body.
-    pub body: String,
 }
 
 /// `[[material]]`.

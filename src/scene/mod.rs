@@ -24,6 +24,7 @@
 //! ```
 
 mod build;
+pub mod common;
 mod format;
 pub mod md;
 mod parse;
@@ -73,7 +74,7 @@ pub fn engine_of_named(text: &str, name: &str) -> Result<String> {
     if ENGINES.contains(&engine.as_str()) {
         Ok(engine)
     } else {
-        Err(Error::Scene(format!("simulation.engine: unknown engine '{engine}', expected 'nscd' or 'md'")))
+        Err(Error::Scene(format!("simulation.engine: unknown engine '{}', expected 'nscd' or 'md'", clip(&engine))))
     }
 }
 
@@ -118,23 +119,36 @@ impl Scene {
 
     /// Number of time steps of the run, `round(duration / dt)` (0 if `dt` is not positive).
     pub fn steps(&self) -> u64 {
-        validate::steps_of(self.simulation.dt, self.simulation.duration)
+        self.simulation.steps()
     }
 
     /// Random seed recorded in the outputs (default 0).
     pub fn seed(&self) -> u64 {
-        self.simulation.seed.unwrap_or(0)
+        self.simulation.seed()
     }
 
     /// Number of steps between two rows of `series.csv` (default 1, never 0).
-    /// The per-cycle output, if any: `(frequency Hz, index of the followed body)`.
-    pub fn output_cycles(&self) -> Option<(f64, usize)> {
-        let c = self.output.as_ref()?.cycles.as_ref()?;
-        let body = self.bodies.iter().position(|b| b.name == c.body)?;
-        Some((c.frequency, body))
-    }
-
     pub fn output_every(&self) -> u64 {
         self.output.as_ref().and_then(|o| o.every).unwrap_or(DEFAULT_OUTPUT_EVERY).max(1)
     }
+
+    /// The run plan of the scene: steps, output, equilibrium stop, cycles, seed.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if the scene is invalid.
+    pub fn plan(&self) -> Result<crate::run::RunPlan> {
+        let cycles = validate::check(self)?.cycles;
+        Ok(common::run_plan(&self.simulation, self.output.as_ref(), cycles))
+    }
+}
+
+/// A user's string for an error message: at most 64 characters (longer ones cut
+/// with `…`), control characters replaced.
+pub fn clip(s: &str) -> String {
+    const MAX: usize = 64;
+    let mut out: String = s.chars().take(MAX).map(|c| if c.is_control() { '?' } else { c }).collect();
+    if s.chars().count() > MAX {
+        out.push('…');
+    }
+    out
 }

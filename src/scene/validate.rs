@@ -4,13 +4,11 @@
 //! `body[3] 'block': polygon: non-convex polygon: the turn at vertex 2 is clockwise`
 //! or, for a compound body, `body[3] 'sleeper': parts[1]: non-convex polygon: …`.
 
-use super::format::{
-    BodySpec, Drive, Scene, DEFAULT_ALERT_FRACTION, DEFAULT_CRITERION, DEFAULT_MAX_FACTOR, DEFAULT_MAX_ITERATIONS,
-    DEFAULT_MIN_ITERATIONS, DEFAULT_THETA, DEFAULT_TOLERANCE,
-};
+use super::format::{BodySpec, Drive, Scene};
 use crate::error::{Error, Result};
 use crate::geometry::{rotate, Compound, ConvexPolygon, GeometryError, Shape, Vec2};
-use crate::nscd::{NlgsSettings, Policy};
+use crate::nscd::system::DEFAULT_ALERT_FRACTION;
+use crate::nscd::{NlgsSettings, NscdParams, Policy};
 use std::collections::HashMap;
 
 /// Largest number of steps a scene may ask for (2⁵³, where `f64` stops counting exactly).
@@ -58,6 +56,8 @@ pub(crate) struct Checked {
     pub alert_distance: f64,
     pub bodies: Vec<CheckedBody>,
     pub springs: Vec<CheckedSpring>,
+    /// The per-cycle output, followed body resolved.
+    pub cycles: Option<crate::run::CyclePlan>,
 }
 
 /// `v` in plain notation when that is short, else in scientific notation.
@@ -222,54 +222,37 @@ fn check_drive(ctx: &str, d: Drive) -> Result<()> {
 /// Checks the whole scene and resolves names, shapes and defaults.
 pub(crate) fn check(scene: &Scene) -> Result<Checked> {
     // [simulation]
-    let sim = &scene.simulation;
-    match sim.engine.as_str() {
-        "nscd" => {}
-        "md" => {
-            return err(
-                "simulation.engine: 'md' is not implemented yet by the NSCD Scene: read MD scenes with scene::MdScene"
-                    .into(),
-            )
-        }
-        other => return err(format!("simulation.engine: unknown engine '{other}', expected 'nscd'")),
-    }
-    check_time(sim.dt, sim.duration)?;
-    finite2("simulation.gravity", sim.gravity())?;
-    let thickness = positive("simulation.thickness", sim.thickness())?;
-    if let Some(eq) = &sim.equilibrium {
-        positive("simulation.equilibrium.kinetic_energy", eq.kinetic_energy)?;
-        if eq.steps() == 0 {
-            return err("simulation.equilibrium.steps: must be at least 1, got 0".into());
-        }
-    }
+    super::common::check_simulation(&scene.simulation, "nscd", 2)?;
+    let thickness = scene.simulation.thickness();
 
     // [nscd]
     let ns = scene.nscd.clone().unwrap_or_default();
-    let theta = ns.theta.unwrap_or(DEFAULT_THETA);
+    let defaults = NscdParams::default();
+    let theta = ns.theta.unwrap_or(defaults.theta);
     if !(0.5..=1.0).contains(&theta) {
         return err(format!("nscd.theta: must be in [0.5, 1], got {}", num(theta)));
     }
-    let criterion = ns.criterion.as_deref().unwrap_or(DEFAULT_CRITERION);
+    let criterion = ns.criterion.as_deref().unwrap_or(defaults.nlgs.policy.name());
     let Some(policy) = policy(criterion) else {
         return err(format!(
             "nscd.criterion: unknown criterion '{criterion}', expected one of 'strict', 'quad', 'quad_max', 'energy'"
         ));
     };
-    let tolerance = ns.tolerance.unwrap_or(DEFAULT_TOLERANCE);
+    let tolerance = ns.tolerance.unwrap_or(defaults.nlgs.tolerance);
     if !(tolerance > 0.0 && tolerance < 1.0) {
         return err(format!("nscd.tolerance: must be in (0, 1), got {}", num(tolerance)));
     }
-    let min_iterations = ns.min_iterations.unwrap_or(DEFAULT_MIN_ITERATIONS);
+    let min_iterations = ns.min_iterations.unwrap_or(defaults.nlgs.min_iterations);
     if min_iterations < 1 {
         return err(format!("nscd.min_iterations: must be at least 1, got {min_iterations}"));
     }
-    let max_iterations = ns.max_iterations.unwrap_or(DEFAULT_MAX_ITERATIONS.max(min_iterations));
+    let max_iterations = ns.max_iterations.unwrap_or(defaults.nlgs.max_iterations.max(min_iterations));
     if max_iterations < min_iterations {
         return err(format!(
             "nscd.max_iterations: must be at least min_iterations = {min_iterations}, got {max_iterations}"
         ));
     }
-    let max_factor = ns.max_factor.unwrap_or(DEFAULT_MAX_FACTOR);
+    let max_factor = ns.max_factor.unwrap_or(defaults.nlgs.max_factor);
     if !(max_factor.is_finite() && max_factor >= 1.0) {
         return err(format!("nscd.max_factor: must be finite and at least 1, got {}", num(max_factor)));
     }
@@ -286,15 +269,8 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
         max_iterations,
         max_factor,
         symmetric: ns.symmetric.unwrap_or(false),
-        split_min_rows: crate::nscd::nlgs::DEFAULT_SPLIT_MIN_ROWS,
+        split_min_rows: defaults.nlgs.split_min_rows,
     };
-
-    // [output]
-    if let Some(every) = scene.output.as_ref().and_then(|o| o.every) {
-        if every < 1 {
-            return err(format!("output.every: must be at least 1, got {every}"));
-        }
-    }
 
     // [[material]]
     let mut materials: HashMap<&str, usize> = HashMap::new();
@@ -472,12 +448,8 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
         }
     };
 
-    if let Some(c) = scene.output.as_ref().and_then(|o| o.cycles.as_ref()) {
-        positive("output.cycles.frequency", c.frequency)?;
-        if !names.contains_key(c.body.as_str()) || c.body.is_empty() {
-            return err(format!("output.cycles.body: unknown body '{}'", c.body));
-        }
-    }
+    // [output]
+    let cycles = super::common::check_output(scene.output.as_ref(), true, |name| names.get(name).copied())?;
 
-    Ok(Checked { nlgs, theta, alert_distance, bodies, springs })
+    Ok(Checked { nlgs, theta, alert_distance, bodies, springs, cycles })
 }

@@ -113,18 +113,7 @@ fn body(out: &mut String, b: &BodySpec) {
 /// The scene as TOML text.
 pub(crate) fn to_toml(scene: &Scene) -> String {
     let mut out = String::new();
-    let sim = &scene.simulation;
-    out.push_str("[simulation]\n");
-    let _ = writeln!(out, "engine = {}", string(&sim.engine));
-    let _ = writeln!(out, "dt = {}", float(sim.dt));
-    let _ = writeln!(out, "duration = {}", float(sim.duration));
-    opt(&mut out, "gravity", sim.gravity, pair);
-    opt(&mut out, "thickness", sim.thickness, float);
-    opt(&mut out, "seed", sim.seed, |s| s.to_string());
-    opt(&mut out, "equilibrium", sim.equilibrium, |e| match e.steps {
-        Some(n) => format!("{{ kinetic_energy = {}, steps = {n} }}", float(e.kinetic_energy)),
-        None => format!("{{ kinetic_energy = {} }}", float(e.kinetic_energy)),
-    });
+    super::common::write_simulation(&mut out, &scene.simulation);
     if let Some(n) = &scene.nscd {
         out.push_str("\n[nscd]\n");
         opt(&mut out, "theta", n.theta, float);
@@ -136,13 +125,7 @@ pub(crate) fn to_toml(scene: &Scene) -> String {
         opt(&mut out, "symmetric", n.symmetric, |b| b.to_string());
         opt(&mut out, "alert_distance", n.alert_distance, float);
     }
-    if let Some(o) = &scene.output {
-        out.push_str("\n[output]\n");
-        opt(&mut out, "every", o.every, |e| e.to_string());
-        opt(&mut out, "cycles", o.cycles.as_ref(), |c| {
-            format!("{{ frequency = {}, body = {} }}", float(c.frequency), string(&c.body))
-        });
-    }
+    super::common::write_output(&mut out, scene.output.as_ref());
     for m in &scene.materials {
         out.push_str("\n[[material]]\n");
         let _ = writeln!(out, "name = {}", string(&m.name));

@@ -7,13 +7,12 @@
 //! user gave; the defaults live in the accessor methods and the `DEFAULT_*`
 //! constants. Vectors are arrays of exactly 3 numbers. All quantities are SI.
 
+use crate::scene::common::{OutputSection, Simulation};
 use crate::scene::format::{array, opt_array};
 use serde::{Deserialize, Serialize};
 
 /// Default gravity (m/s²).
 pub const DEFAULT_MD_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
-/// Default consecutive steps of the equilibrium condition.
-pub const DEFAULT_EQUILIBRIUM_STEPS: u64 = 100;
 /// Default skin, as a fraction of the mean sphere diameter (m/m).
 pub const DEFAULT_SKIN_FRACTION: f64 = 0.1;
 
@@ -22,13 +21,13 @@ pub const DEFAULT_SKIN_FRACTION: f64 = 0.1;
 #[serde(deny_unknown_fields)]
 pub struct MdScene {
     /// `[simulation]`: engine, dimension, time step, duration, gravity, seed, equilibrium stop.
-    pub simulation: MdSimulation,
+    pub simulation: Simulation,
     /// `[md]`: integrator, skin, background damping, threads (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub md: Option<MdSection>,
     /// `[output]` (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub output: Option<MdOutput>,
+    pub output: Option<OutputSection>,
     /// `[[symmetry]]` planes: 0, 1 or 2 (perpendicular).
     #[serde(default, rename = "symmetry", skip_serializing_if = "Vec::is_empty")]
     pub symmetry: Vec<SymmetrySpec>,
@@ -44,70 +43,6 @@ pub struct MdScene {
     /// `[[body]]` entries: the spheres, in order (sphere `i` of the system is `bodies[i]`).
     #[serde(default, rename = "body", skip_serializing_if = "Vec::is_empty")]
     pub bodies: Vec<SphereSpec>,
-}
-
-/// `[simulation]` of an MD scene.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MdSimulation {
-    /// `"md"`.
-    pub engine: String,
-    /// Space dimension; must be 3 if given.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub dimension: Option<i64>,
-    /// Time step (s), > 0.
-    pub dt: f64,
-    /// Simulated duration (s), > 0; the run makes `round(duration / dt)` steps.
-    pub duration: f64,
-    /// Gravity (m/s²); default [`DEFAULT_MD_GRAVITY`].
-    #[serde(default, skip_serializing_if = "Option::is_none", deserialize_with = "opt_array")]
-    pub gravity: Option<[f64; 3]>,
-    /// Random seed, recorded in the outputs; default 0.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub seed: Option<u64>,
-    /// Ends the run early once the sample is at rest (a deposit).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub equilibrium: Option<MdEquilibrium>,
-}
-
-impl MdSimulation {
-    /// Gravity (m/s²).
-    pub fn gravity(&self) -> [f64; 3] {
-        self.gravity.unwrap_or(DEFAULT_MD_GRAVITY)
-    }
-}
-
-/// `simulation.equilibrium`: the run ends once every condition given has held
-/// for `steps` consecutive steps: the kinetic energy `E_k` below
-/// `kinetic_energy` (J), and `E_k` below `energy_ratio` times the potential
-/// energy `E_p` (gravitational + elastic, [`crate::md::MdSystem::potential_energy`]).
-/// The steps count only after a first step that failed the conditions: a
-/// sample released from rest is not at equilibrium before it has moved.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MdEquilibrium {
-    /// Threshold on `E_k` (J), > 0.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub kinetic_energy: Option<f64>,
-    /// Threshold on `E_k / E_p`, > 0.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub energy_ratio: Option<f64>,
-    /// Consecutive steps, ≥ 1; default [`DEFAULT_EQUILIBRIUM_STEPS`].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub steps: Option<u64>,
-}
-
-impl MdEquilibrium {
-    /// Consecutive steps required.
-    pub fn steps(&self) -> u64 {
-        self.steps.unwrap_or(DEFAULT_EQUILIBRIUM_STEPS)
-    }
-
-    /// Whether a step with kinetic energy `ek` (J) and potential energy `ep` (J)
-    /// meets every condition given.
-    pub fn holds(&self, ek: f64, ep: f64) -> bool {
-        self.kinetic_energy.is_none_or(|k| ek < k) && self.energy_ratio.is_none_or(|r| ek < r * ep)
-    }
 }
 
 /// `[md]`: settings of the MD engine; every key is optional.
@@ -133,26 +68,6 @@ pub struct MdSection {
     /// default is 2 on a machine with 2 cores or more).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub threads: Option<usize>,
-}
-
-/// `[output]` of an MD scene.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MdOutput {
-    /// Steps between two rows of `series.csv`, ≥ 1; default 1 (the last step always has a row).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub every: Option<u64>,
-    /// `[output.cycles]`: one row of `cycles.csv` per loading cycle.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub cycles: Option<MdCycles>,
-}
-
-/// `[output.cycles]` of an MD scene: the loading frequency (Hz, > 0); a row of
-/// `cycles.csv` at every multiple of `1/frequency` (`io::md_cycles`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MdCycles {
-    pub frequency: f64,
 }
 
 /// `[[symmetry]]`: a symmetry plane (mirror images of the spheres near it).

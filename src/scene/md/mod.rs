@@ -43,7 +43,7 @@ mod write;
 pub use format::*;
 
 use crate::error::{Error, Result};
-use crate::scene::{parse, validate::steps_of, Scene, DEFAULT_OUTPUT_EVERY};
+use crate::scene::{parse, Scene, DEFAULT_OUTPUT_EVERY};
 use std::path::Path;
 
 impl MdScene {
@@ -79,17 +79,26 @@ impl MdScene {
 
     /// Number of time steps of the run, `round(duration / dt)` (0 if `dt` is not positive).
     pub fn steps(&self) -> u64 {
-        steps_of(self.simulation.dt, self.simulation.duration)
+        self.simulation.steps()
     }
 
     /// Random seed recorded in the outputs (default 0).
     pub fn seed(&self) -> u64 {
-        self.simulation.seed.unwrap_or(0)
+        self.simulation.seed()
     }
 
     /// Number of steps between two rows of `series.csv` (default 1, never 0).
     pub fn output_every(&self) -> u64 {
         self.output.as_ref().and_then(|o| o.every).unwrap_or(DEFAULT_OUTPUT_EVERY).max(1)
+    }
+
+    /// The run plan of the scene: steps, output, equilibrium stop, cycles, seed.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if the scene is invalid.
+    pub fn plan(&self) -> Result<crate::run::RunPlan> {
+        let cycles = validate::check(self)?.cycles;
+        Ok(crate::scene::common::run_plan(&self.simulation, self.output.as_ref(), cycles))
     }
 
     /// Force-evaluation threads the scene asks for (`md.threads`), if any.

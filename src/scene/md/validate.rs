@@ -7,10 +7,10 @@
 //! `contact[1].normal_stiffness: not a key of model 'hertz' (only of 'linear')`.
 //! Overlapping initial spheres are allowed.
 
-use super::format::{MdContact, MdScene, ServoSpec, WallSpec, DEFAULT_SKIN_FRACTION};
+use super::format::{MdContact, MdScene, ServoSpec, WallSpec, DEFAULT_MD_GRAVITY, DEFAULT_SKIN_FRACTION};
 use crate::error::Result;
 use crate::md::{self, Drive, GearSet, History1, Integrator, MdSettings, Motion, Shape, SymmetryPlane, Wall, V3};
-use crate::scene::validate::{check_time, err, finite, label, non_negative, num, positive, MAX_LENGTH, MIN_SIZE};
+use crate::scene::validate::{err, finite, label, non_negative, num, positive, MAX_LENGTH, MIN_SIZE};
 use std::collections::HashMap;
 
 /// Two unit vectors are perpendicular (symmetry planes) or along an axis (box
@@ -53,6 +53,8 @@ pub(crate) struct CheckedMd {
     pub walls: Vec<Wall>,
     pub planes: Vec<SymmetryPlane>,
     pub threads: Option<usize>,
+    /// The per-cycle output.
+    pub cycles: Option<crate::run::CyclePlan>,
 }
 
 /// `ctx: must be finite, got [x, y, z]` unless every component is finite.
@@ -110,34 +112,8 @@ const AXES: [&str; 3] = ["x", "y", "z"];
 pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
     // [simulation]
     let sim = &scene.simulation;
-    match sim.engine.as_str() {
-        "md" => {}
-        "nscd" => {
-            return err("simulation.engine: expected 'md', got 'nscd' (an NSCD scene: read it with scene::Scene)".into())
-        }
-        other => return err(format!("simulation.engine: unknown engine '{other}', expected 'md'")),
-    }
-    if let Some(d) = sim.dimension {
-        if d != 3 {
-            return err(format!("simulation.dimension: must be 3 for the md engine, got {d}"));
-        }
-    }
-    check_time(sim.dt, sim.duration)?;
-    let gravity = finite3("simulation.gravity", sim.gravity())?;
-    if let Some(eq) = &sim.equilibrium {
-        if eq.kinetic_energy.is_none() && eq.energy_ratio.is_none() {
-            return err("simulation.equilibrium: give kinetic_energy, energy_ratio or both".into());
-        }
-        if let Some(k) = eq.kinetic_energy {
-            positive("simulation.equilibrium.kinetic_energy", k)?;
-        }
-        if let Some(r) = eq.energy_ratio {
-            positive("simulation.equilibrium.energy_ratio", r)?;
-        }
-        if eq.steps() == 0 {
-            return err("simulation.equilibrium.steps: must be at least 1, got 0".into());
-        }
-    }
+    crate::scene::common::check_simulation(sim, "md", 3)?;
+    let gravity = V3::from(sim.gravity_or(DEFAULT_MD_GRAVITY));
 
     // [md]
     let ms = scene.md.clone().unwrap_or_default();
@@ -172,16 +148,7 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
     }
 
     // [output]
-    if let Some(every) = scene.output.as_ref().and_then(|o| o.every) {
-        if every < 1 {
-            return err(format!("output.every: must be at least 1, got {every}"));
-        }
-    }
-    if let Some(c) = scene.output.as_ref().and_then(|o| o.cycles) {
-        if !(c.frequency.is_finite() && c.frequency > 0.0) {
-            return err(format!("output.cycles.frequency: must be positive and finite, got {}", c.frequency));
-        }
-    }
+    let cycles = crate::scene::common::check_output(scene.output.as_ref(), false, |_| None)?;
 
     // [[symmetry]]
     if scene.symmetry.len() > 2 {
@@ -352,7 +319,7 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
     let skin = ms.skin.unwrap_or(DEFAULT_SKIN_FRACTION * diameters / scene.bodies.len() as f64);
     let settings =
         MdSettings { dt: sim.dt, gravity, integrator, skin, background_damping, background_rotational_damping };
-    Ok(CheckedMd { settings, materials, sphere_materials, laws, walls, planes, threads: ms.threads })
+    Ok(CheckedMd { settings, materials, sphere_materials, laws, walls, planes, threads: ms.threads, cycles })
 }
 
 /// Checks one `[[contact]]` between materials `a` and `b`.

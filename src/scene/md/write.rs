@@ -5,21 +5,12 @@
 //! that reads back to the same `f64` (the helpers of the NSCD writer).
 
 use super::format::{MdContact, MdScene, ServoSpec, SphereSpec, WallSpec};
+use crate::scene::common::inline;
 use crate::scene::write::{float, opt, string};
 use std::fmt::Write;
 
 fn triple(v: [f64; 3]) -> String {
     format!("[{}, {}, {}]", float(v[0]), float(v[1]), float(v[2]))
-}
-
-/// `{ k = v, … }` of the entries that are present.
-fn inline(entries: &[(&str, Option<String>)]) -> String {
-    let parts: Vec<String> = entries.iter().filter_map(|(k, v)| v.as_ref().map(|v| format!("{k} = {v}"))).collect();
-    if parts.is_empty() {
-        "{}".into()
-    } else {
-        format!("{{ {} }}", parts.join(", "))
-    }
 }
 
 fn servo(s: &ServoSpec) -> String {
@@ -91,21 +82,7 @@ fn body(out: &mut String, b: &SphereSpec) {
 /// The scene as TOML text.
 pub(crate) fn to_toml(scene: &MdScene) -> String {
     let mut out = String::new();
-    let sim = &scene.simulation;
-    out.push_str("[simulation]\n");
-    let _ = writeln!(out, "engine = {}", string(&sim.engine));
-    opt(&mut out, "dimension", sim.dimension, |d| d.to_string());
-    let _ = writeln!(out, "dt = {}", float(sim.dt));
-    let _ = writeln!(out, "duration = {}", float(sim.duration));
-    opt(&mut out, "gravity", sim.gravity, triple);
-    opt(&mut out, "seed", sim.seed, |s| s.to_string());
-    opt(&mut out, "equilibrium", sim.equilibrium, |e| {
-        inline(&[
-            ("kinetic_energy", e.kinetic_energy.map(float)),
-            ("energy_ratio", e.energy_ratio.map(float)),
-            ("steps", e.steps.map(|n| n.to_string())),
-        ])
-    });
+    crate::scene::common::write_simulation(&mut out, &scene.simulation);
     if let Some(m) = &scene.md {
         out.push_str("\n[md]\n");
         opt(&mut out, "integrator", m.integrator.as_deref(), string);
@@ -115,13 +92,7 @@ pub(crate) fn to_toml(scene: &MdScene) -> String {
         opt(&mut out, "background_rotational_damping", m.background_rotational_damping, float);
         opt(&mut out, "threads", m.threads, |t| t.to_string());
     }
-    if let Some(o) = &scene.output {
-        out.push_str("\n[output]\n");
-        opt(&mut out, "every", o.every, |e| e.to_string());
-        if let Some(c) = o.cycles {
-            let _ = writeln!(out, "cycles = {{ frequency = {} }}", float(c.frequency));
-        }
-    }
+    crate::scene::common::write_output(&mut out, scene.output.as_ref());
     for s in &scene.symmetry {
         out.push_str("\n[[symmetry]]\n");
         let _ = writeln!(out, "point = {}", triple(s.point));

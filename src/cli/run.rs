@@ -1,0 +1,55 @@
+//! `ballast run SCENE --out DIR`: one scene file of either engine through the
+//! library's run loop ([`ballast::run::run_file`]).
+
+use super::{run_scene, Display, Failure};
+use ballast::run::{default_threads, RunOptions};
+use std::path::PathBuf;
+
+/// The arguments of `ballast run`.
+#[derive(Debug, clap::Args)]
+pub struct RunArgs {
+    /// The scene file (TOML, see docs/scene-format.md).
+    scene: PathBuf,
+    /// Output directory (created if needed; existing output files are overwritten).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+    /// Wall-clock seconds between checkpoints (`DIR/checkpoint.json`); 0 disables them.
+    #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
+    checkpoint_every: f64,
+    /// Continue a killed or stopped run from `DIR/checkpoint.json` (same scene file).
+    #[arg(long)]
+    resume: bool,
+    /// Stop after this many steps in this invocation, with a checkpoint to resume from.
+    #[arg(long, value_name = "STEPS")]
+    stop_after: Option<u64>,
+    /// Write VTK snapshots (`DIR/vtk/*.vtp`, listed in `DIR/run.pvd`) every N steps; 0: none.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    vtk_every: u64,
+    /// Threads of the NLGS sweeps (NSCD: large problems are swept as two halves
+    /// side by side) or of the force evaluation (MD: two chunks side by side; the
+    /// scene's `md.threads` wins). The numbers do not depend on it. Default: 2 if
+    /// the machine has 2 cores.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// At the end, draw the run's figures (PNG + SVG): settlement and interpenetration
+    /// curves, force chains, displacement field.
+    #[arg(long)]
+    figures: bool,
+}
+
+/// `ballast run`.
+pub fn main(a: RunArgs) -> Result<(), Failure> {
+    let opts = RunOptions {
+        checkpoint_every_s: a.checkpoint_every,
+        resume: a.resume,
+        stop_after: a.stop_after,
+        vtk_every: a.vtk_every,
+        threads: a.threads.unwrap_or_else(default_threads),
+        figures: a.figures,
+    };
+    let display = if a.quiet { Display::Quiet } else { Display::Bar };
+    run_scene(&a.scene, &a.out, &opts, &display).map(|_| ())
+}

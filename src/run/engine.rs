@@ -1,0 +1,224 @@
+//! The engine interface: what the run loop ([`super::Runner`]) and a cyclic
+//! driver need of an engine, implemented by [`crate::nscd::System`] (rigid 2D
+//! polygons, non-smooth contact dynamics) and [`crate::md::MdSystem`] (soft 3D
+//! spheres, molecular dynamics).
+//!
+//! An engine is plain serde data (a checkpoint is its serde form) that makes one
+//! time step at a time on an exact clock (`t = t_0 + (k − k_0) h`,
+//! [`crate::clock`]), reports what the step measured, and writes its own output
+//! rows, final state and snapshots. For a cyclic driver (Karrech et al. 2007,
+//! Fig. 10: compute k cycles, fit, extrapolate, write back, relax) it exposes the
+//! generalised positions of its mobile bodies ([`Configuration`]) and takes them
+//! back with the velocities zeroed and every derived state rebuilt, so that the
+//! next step starts exactly from the written configuration.
+
+use crate::error::Result;
+use crate::io::summary::StepSummary;
+use crate::io::vtk::PvdCollection;
+use crate::io::FinalState;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Energies of the equilibrium rule ([`super::Equilibrium`]) at the end of a step (J).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Energies {
+    /// Kinetic energy of everything that moves (J).
+    pub kinetic: f64,
+    /// Potential energy, gravitational + elastic (J); 0 when not asked for.
+    pub potential: f64,
+}
+
+/// The generalised positions of some bodies of an engine: `dof` coordinates per
+/// body, body after body.
+///
+/// In 2D (NSCD) `dof = 3`: the centre of mass `x`, `y` (m) and the angle `θ`
+/// (rad). In 3D (MD) `dof = 6`: the centre `x`, `y`, `z` (m) and the rotation
+/// vector of the orientation (axis × angle, rad, angle in [0, π]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Configuration {
+    /// Coordinates per body.
+    pub dof: usize,
+    /// Index of each body in the engine (its order in the scene).
+    pub bodies: Vec<usize>,
+    /// Coordinate `d` of the `k`-th body is `q[k * dof + d]` (m or rad).
+    pub q: Vec<f64>,
+}
+
+impl Configuration {
+    /// The coordinates of the `k`-th body of the configuration.
+    pub fn body(&self, k: usize) -> &[f64] {
+        &self.q[k * self.dof..(k + 1) * self.dof]
+    }
+
+    /// The coordinates of the `k`-th body, mutable.
+    pub fn body_mut(&mut self, k: usize) -> &mut [f64] {
+        &mut self.q[k * self.dof..(k + 1) * self.dof]
+    }
+
+    /// Number of bodies.
+    pub fn len(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// True if there are no bodies.
+    pub fn is_empty(&self) -> bool {
+        self.bodies.is_empty()
+    }
+
+    /// Checks the shape of the configuration against an engine with `bodies`
+    /// bodies and `dof` coordinates each, and that every number is finite; the
+    /// message names the first offending body.
+    pub fn check(&self, dof: usize, bodies: usize) -> Result<()> {
+        let bad = |msg: String| Err(crate::Error::Scene(format!("configuration: {msg}")));
+        if self.dof != dof {
+            return bad(format!("{} coordinates per body, the engine has {dof}", self.dof));
+        }
+        if self.q.len() != self.bodies.len() * dof {
+            return bad(format!("{} coordinates for {} bodies of {dof}", self.q.len(), self.bodies.len()));
+        }
+        for (k, &i) in self.bodies.iter().enumerate() {
+            if i >= bodies {
+                return bad(format!("body {i} does not exist (the engine has {bodies})"));
+            }
+            if let Some(d) = self.body(k).iter().position(|x| !x.is_finite()) {
+                return bad(format!("body {i}: coordinate {d} is not finite ({})", self.body(k)[d]));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A time-stepping engine driven by the run loop and by cyclic drivers.
+pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
+    /// The engine's name in scenes and outputs (`"nscd"`, `"md"`).
+    const NAME: &'static str;
+    /// Generalised coordinates per body in a [`Configuration`].
+    const DOF: usize;
+    /// Whether a step solves an iterative problem (NSCD: NLGS sweeps), whose
+    /// iterations and unconverged steps the summary reports.
+    const ITERATIVE: bool;
+    /// What one step measured.
+    type Stats: Copy + std::fmt::Debug;
+    /// One row of `series.csv` (serde, written and read back by
+    /// [`crate::io::series`]; the columns carry their unit in their name).
+    type Row: Serialize + DeserializeOwned + Clone + std::fmt::Debug;
+    /// What the per-cycle output accumulates over the steps of a cycle (kept in
+    /// checkpoints).
+    type CycleState: Clone + std::fmt::Debug + Serialize + DeserializeOwned + Send;
+    /// One row of `cycles.csv`.
+    type CycleRow: Serialize + DeserializeOwned + Clone + std::fmt::Debug;
+
+    /// Makes one time step.
+    ///
+    /// # Errors
+    /// [`crate::Error::Diverged`] (step and body named) on a non-finite value, a
+    /// runaway overlap or runaway energy; the engine then holds the state of the
+    /// last good step.
+    fn step(&mut self) -> Result<Self::Stats>;
+
+    /// Time at the end of the last step (s), on the exact clock.
+    fn time(&self) -> f64;
+
+    /// Steps made since the engine was built.
+    fn steps_done(&self) -> u64;
+
+    /// Time step (s).
+    fn dt(&self) -> f64;
+
+    /// Threads of a step (1 or 2); the numbers do not depend on it.
+    fn set_threads(&mut self, threads: usize);
+
+    /// Number of bodies (bodies or spheres, walls not included).
+    fn body_count(&self) -> usize;
+
+    /// The numbers every engine reports for a step.
+    fn summary(stats: &Self::Stats) -> StepSummary;
+
+    /// What the state as built measures before the first step (MD: the overlaps
+    /// present at the start), folded into the run's summary; `None` if nothing.
+    fn initial_summary(&self) -> Option<StepSummary> {
+        None
+    }
+
+    /// The energies of the equilibrium rule after the step that returned
+    /// `stats`; the potential energy only if `potential` (it may cost a loop).
+    fn energies(&self, stats: &Self::Stats, potential: bool) -> Energies;
+
+    /// The header of `series.csv` (the row's columns, then any per-wall columns).
+    fn series_header(&self) -> Vec<String>;
+
+    /// The row of `series.csv` of the step that returned `stats`.
+    fn series_row(&self, stats: &Self::Stats) -> Self::Row;
+
+    /// The state of every body (and wall) for `final.json`.
+    fn final_state(&self) -> FinalState;
+
+    /// Writes a ParaView snapshot of the current state into `dir` and lists it in `pvd`.
+    fn snapshot(&self, dir: &Path, pvd: &mut PvdCollection) -> Result<()>;
+
+    /// Checks that the state is internally consistent (array lengths, indices,
+    /// clock): a state read from a checkpoint must pass before it runs.
+    fn check_state(&self) -> Result<()>;
+
+    /// Checks that `self` (read from a checkpoint) is a state of the model `fresh`
+    /// (built from the scene): same bodies, materials and walls.
+    fn check_same_model(&self, fresh: &Self) -> Result<()>;
+
+    /// Starts the per-cycle output: `body` is the index of the followed body
+    /// (NSCD: the sleeper, required; MD: none).
+    fn cycle_start(&self, body: Option<usize>) -> Result<Self::CycleState>;
+
+    /// Adds the step that returned `stats` to the cycle under way.
+    fn cycle_step(&self, state: &mut Self::CycleState, stats: &Self::Stats);
+
+    /// Closes cycle `cycle` (1, 2, …) at the current step: its row; the
+    /// accumulators start again.
+    fn cycle_end(&self, state: &mut Self::CycleState, cycle: u64) -> Self::CycleRow;
+
+    /// The header of `cycles.csv`.
+    fn cycle_header(&self) -> Vec<String>;
+
+    /// The settlement shown by a progress display (m, positive downwards), if the
+    /// cycle output follows one.
+    fn settlement(&self, _state: &Self::CycleState) -> Option<f64> {
+        None
+    }
+
+    /// Draws the figures of a finished run in `dir` (PNG + SVG); `cycles` is the
+    /// per-cycle state if the run had one.
+    ///
+    /// # Errors
+    /// [`crate::Error::Scene`] if the engine has no figures.
+    fn figures(&self, _dir: &Path, _cycles: Option<&Self::CycleState>) -> Result<Vec<PathBuf>> {
+        Err(crate::Error::Scene(format!("--figures: not available for {} runs", Self::NAME)))
+    }
+
+    /// Whether [`Engine::figures`] draws anything.
+    fn has_figures() -> bool {
+        false
+    }
+
+    /// The bodies a driver may move: every body that is not fixed (NSCD) or
+    /// every sphere (MD).
+    fn mobile_bodies(&self) -> Vec<usize>;
+
+    /// The generalised positions of `bodies` ([`Configuration`]).
+    fn configuration_of(&self, bodies: &[usize]) -> Configuration;
+
+    /// The generalised positions of every mobile body.
+    fn configuration(&self) -> Configuration {
+        self.configuration_of(&self.mobile_bodies())
+    }
+
+    /// Moves the bodies of `c` to its positions, sets every velocity to zero
+    /// (an imposed velocity component to its value now) and rebuilds every
+    /// derived state (contact memory, warm start, neighbour lists, forces,
+    /// integrator history), so that the next step starts exactly from this
+    /// configuration, as a system built there would. The clock goes on.
+    ///
+    /// # Errors
+    /// [`crate::Error::Scene`] if `c` does not fit the engine (coordinates per
+    /// body, unknown or fixed body, non-finite value); the engine is then unchanged.
+    fn set_configuration(&mut self, c: &Configuration) -> Result<()>;
+}

@@ -1,0 +1,600 @@
+//! The run loop, one for both engines: steps an [`Engine`] to the end of its
+//! plan or to equilibrium, writes the outputs of the run folder, checkpoints
+//! every few minutes and resumes from a checkpoint with the same numbers.
+//!
+//! Data flow of a run: the system (built from a scene, or in code) → for each
+//! step: `step()` → running summary → equilibrium rule → a row of `series.csv`
+//! every `output_every` steps (and at the last) → per-cycle state, a row of
+//! `cycles.csv` and the positions of the mobile bodies when a loading cycle ends
+//! → a VTK snapshot every `vtk_every` steps → the progress callback → a
+//! checkpoint when the wall clock says so. At the end: `final.json`,
+//! `summary.json`, the figures if asked, the state as a restartable scene.
+//! A step that diverges stops the run with the step and body named; the engine
+//! then holds its last good step, whose row, `final.json` and `summary.json` are
+//! written before the error is returned.
+
+use super::engine::Engine;
+use super::equilibrium::Equilibrium;
+use crate::clock::cycles_at;
+use crate::error::{Error, Result};
+use crate::io::checkpoint::{crc32, Checkpoint, CHECKPOINT_FILE};
+use crate::io::positions::{PositionsWriter, BODIES_FILE, DISPLACEMENTS_FILE};
+use crate::io::summary::{RunEnd, RunReport, RunSummary};
+use crate::io::table::TableWriter;
+use crate::io::vtk::PvdCollection;
+use crate::io::{self, RunInfo};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The output files of a run folder.
+pub mod files {
+    /// Step statistics.
+    pub const SERIES: &str = "series.csv";
+    /// Per-cycle statistics.
+    pub const CYCLES: &str = "cycles.csv";
+    /// State at the end.
+    pub const FINAL: &str = "final.json";
+    /// Statistics of the run.
+    pub const SUMMARY: &str = "summary.json";
+    /// Seed, engine, version, steps.
+    pub const RUN_INFO: &str = "run.json";
+    /// Byte copy of the scene file.
+    pub const SCENE: &str = "scene.toml";
+    /// Serde form of the initial system of a run built in code.
+    pub const INITIAL_STATE: &str = "initial_state.json";
+    /// The final state as a scene to restart from.
+    pub const FINAL_SCENE: &str = "final_scene.toml";
+    /// ParaView collection of the snapshots.
+    pub const PVD: &str = "run.pvd";
+    /// Folder of the snapshots.
+    pub const VTK_DIR: &str = "vtk";
+}
+
+/// What a run is asked to do, besides its system.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunPlan {
+    /// Steps to make (the run may end earlier at equilibrium).
+    pub steps: u64,
+    /// Steps between two rows of `series.csv`, ≥ 1 (the last step always has a row).
+    pub output_every: u64,
+    /// The equilibrium stop, if any.
+    pub equilibrium: Option<Equilibrium>,
+    /// The per-cycle output, if any.
+    pub cycles: Option<CyclePlan>,
+    /// Random seed of the scene, recorded in `run.json`.
+    pub seed: u64,
+}
+
+impl RunPlan {
+    /// `steps` steps with a row of `series.csv` every `output_every` steps.
+    pub fn new(steps: u64, output_every: u64) -> Self {
+        Self { steps, output_every, equilibrium: None, cycles: None, seed: 0 }
+    }
+}
+
+/// The per-cycle output of a run (`cycles.csv`, and the positions file).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CyclePlan {
+    /// Loading frequency (Hz): a cycle lasts `1/frequency` from t = 0.
+    pub frequency: f64,
+    /// The followed body (NSCD: the sleeper).
+    pub body: Option<usize>,
+    /// Write the positions of every mobile body at each cycle end
+    /// ([`crate::io::positions`]).
+    pub positions: bool,
+}
+
+/// How a run is carried out; the numbers do not depend on any of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOptions {
+    /// Wall-clock seconds between checkpoints (`checkpoint.json`); 0: none.
+    pub checkpoint_every_s: f64,
+    /// Continue from the checkpoint in the output folder.
+    pub resume: bool,
+    /// Stop after this many steps in this invocation, leaving a checkpoint.
+    pub stop_after: Option<u64>,
+    /// A VTK snapshot every this many steps (0: none).
+    pub vtk_every: u64,
+    /// Threads of a step (1 or 2).
+    pub threads: usize,
+    /// Draw the run's figures at the end.
+    pub figures: bool,
+}
+
+impl Default for RunOptions {
+    /// Checkpoints every 5 minutes, no snapshots, no figures, 2 threads on a
+    /// machine with 2 cores or more.
+    fn default() -> Self {
+        Self {
+            checkpoint_every_s: 300.0,
+            resume: false,
+            stop_after: None,
+            vtk_every: 0,
+            threads: default_threads(),
+            figures: false,
+        }
+    }
+}
+
+/// Cores of the machine (1 if unknown).
+pub fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// Threads of a single run: 2 when the machine has 2 cores or more (the split
+/// NLGS solver and the MD force evaluation use at most 2).
+pub fn default_threads() -> usize {
+    cores().min(2)
+}
+
+/// What the progress callback sees after each step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Progress {
+    /// Steps made by the engine, and the step the run ends at.
+    pub step: u64,
+    pub end_step: u64,
+    /// Time at the end of the step (s).
+    pub time: f64,
+    /// Kinetic energy (J) and contacts of the step.
+    pub kinetic_energy: f64,
+    pub contacts: f64,
+    /// Loading cycles completed, and in the whole run.
+    pub cycles: Option<(u64, u64)>,
+    /// Settlement of the followed body (m, positive downwards).
+    pub settlement: Option<f64>,
+}
+
+/// How a call of [`Runner::run`] ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// The run ended ([`RunEnd::Finished`] or [`RunEnd::Equilibrium`]).
+    Ended(RunEnd),
+    /// Stopped on request (`stop_after`), with a checkpoint to resume from.
+    Stopped,
+}
+
+/// What a call of [`Runner::run`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOutcome {
+    pub status: Status,
+    /// Steps made by the engine and its time (s) at the end of the call.
+    pub step: u64,
+    pub time: f64,
+    /// The step the run ends at.
+    pub end_step: u64,
+    /// Kinetic energy (J) of the last step.
+    pub kinetic_energy: f64,
+    /// The report of the run (also in `summary.json` once it has ended).
+    pub report: RunReport,
+    /// Wall time of this call (s).
+    pub elapsed_s: f64,
+    /// The output folder.
+    pub out: PathBuf,
+}
+
+/// Writes the final state of a system as a scene text.
+pub type Restart<E> = Box<dyn Fn(&E) -> Result<String> + Send + Sync>;
+
+/// Where the system of a run comes from.
+enum Origin {
+    /// A scene file: its path (for the copy and the header) and text.
+    Scene { path: PathBuf, text: String },
+    /// Built in code: the serde form of the initial system.
+    Code { json: String },
+}
+
+/// A run of an engine: its initial system, its plan and where it came from.
+pub struct Runner<E: Engine> {
+    system: E,
+    plan: RunPlan,
+    origin: Origin,
+    restart: Option<Restart<E>>,
+}
+
+/// The state of a run in progress.
+struct Live<E: Engine> {
+    sys: E,
+    summary: RunSummary,
+    series: TableWriter,
+    snapshots: PvdCollection,
+    cycles: Option<(E::CycleState, TableWriter)>,
+    cycles_done: u64,
+    positions: Option<PositionsWriter>,
+    first_step: u64,
+}
+
+impl<E: Engine> Runner<E> {
+    /// A run of `system`, built from the scene file at `path` whose text is
+    /// `text`; `restart` writes a system's state as a scene to restart from
+    /// (`final_scene.toml`).
+    pub fn from_scene(system: E, plan: RunPlan, path: &Path, text: String, restart: Option<Restart<E>>) -> Self {
+        Self { system, plan, origin: Origin::Scene { path: path.to_path_buf(), text }, restart }
+    }
+
+    /// A run of a system built in code. Its serde form is written to the output
+    /// folder (`initial_state.json`) as the record of the run's input.
+    pub fn from_system(system: E, plan: RunPlan) -> Result<Self> {
+        let json = serde_json::to_string(&system).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        Ok(Self { system, plan, origin: Origin::Code { json }, restart: None })
+    }
+
+    /// The plan of the run.
+    pub fn plan(&self) -> &RunPlan {
+        &self.plan
+    }
+
+    fn source_crc32(&self) -> u32 {
+        match &self.origin {
+            Origin::Scene { text, .. } => crc32(text.as_bytes()),
+            Origin::Code { json } => crc32(json.as_bytes()),
+        }
+    }
+
+    /// Runs into the folder `out` (created if needed; existing output files of an
+    /// earlier run are replaced), calling `progress` after every step.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] for invalid options or an invalid checkpoint
+    /// (`--resume`); [`Error::Io`] naming the file if an output cannot be
+    /// written; [`Error::Diverged`] if a step diverges, after the last good
+    /// state has been written (`series.csv` row, `final.json`, `summary.json`).
+    pub fn run(&self, out: &Path, opts: &RunOptions, progress: &mut dyn FnMut(&Progress)) -> Result<RunOutcome> {
+        check_options(opts)?;
+        if opts.figures && !E::has_figures() {
+            return Err(Error::Scene(format!("--figures: not available for {} runs", E::NAME)));
+        }
+        let plan = &self.plan;
+        if plan.output_every == 0 {
+            return Err(Error::Scene("output.every: must be at least 1, got 0".into()));
+        }
+        let mut live = if opts.resume { self.resume(out)? } else { self.start(out, opts)? };
+        let end_step = live.first_step.saturating_add(plan.steps);
+        live.sys.set_threads(opts.threads.max(1));
+        let last = opts.stop_after.map_or(end_step, |n| end_step.min(live.sys.steps_done().saturating_add(n)));
+        let cycles_total = plan.cycles.map(|c| {
+            let total = end_step.saturating_sub(live.first_step) as f64 * self.system.dt();
+            (c.frequency * total).round() as u64
+        });
+        let (vtk_dir, pvd_path) = (out.join(files::VTK_DIR), out.join(files::PVD));
+        let wall0 = live.summary.wall_time_s;
+        let started = Instant::now();
+        let mut checkpointed = Instant::now();
+        let mut last_stats: Option<(E::Stats, bool)> = None;
+        let mut diverged = None;
+        let mut at_equilibrium = false;
+        let potential = plan.equilibrium.is_some_and(|e| e.needs_potential());
+        while live.sys.steps_done() < last {
+            let stats = match live.sys.step() {
+                Ok(s) => s,
+                Err(e) => {
+                    diverged = Some(e);
+                    break;
+                }
+            };
+            let k = live.sys.steps_done();
+            let common = E::summary(&stats);
+            live.summary.add(&common);
+            if let Some(rule) = &plan.equilibrium {
+                let en = live.sys.energies(&stats, potential);
+                at_equilibrium = live.summary.equilibrium.observe(rule, rule.holds(en.kinetic, en.potential));
+            }
+            let written = k % plan.output_every == 0 || k == end_step || at_equilibrium;
+            if written {
+                live.series.write(&live.sys.series_row(&stats))?;
+            }
+            last_stats = Some((stats, written));
+            if let (Some(c), Some((state, table))) = (plan.cycles, live.cycles.as_mut()) {
+                live.sys.cycle_step(state, &stats);
+                let done = cycles_at(live.sys.time(), c.frequency, live.sys.dt());
+                if done > live.cycles_done {
+                    table.write(&live.sys.cycle_end(state, done))?;
+                    live.cycles_done = done;
+                    if let Some(p) = live.positions.as_mut() {
+                        let bodies = p.reference().bodies.clone();
+                        p.append(&live.sys.configuration_of(&bodies))?;
+                    }
+                }
+            }
+            if opts.vtk_every > 0 && k % opts.vtk_every == 0 {
+                io::create_output_dir(&vtk_dir)?;
+                live.sys.snapshot(&vtk_dir, &mut live.snapshots)?;
+                live.snapshots.write(&pvd_path)?;
+            }
+            progress(&Progress {
+                step: k,
+                end_step,
+                time: common.time,
+                kinetic_energy: common.kinetic_energy,
+                contacts: common.contacts,
+                cycles: cycles_total.map(|t| (live.cycles_done, t)),
+                settlement: live.cycles.as_ref().and_then(|(s, _)| live.sys.settlement(s)),
+            });
+            if opts.checkpoint_every_s > 0.0 && checkpointed.elapsed().as_secs_f64() >= opts.checkpoint_every_s {
+                live.summary.wall_time_s = wall0 + started.elapsed().as_secs_f64();
+                self.checkpoint(out, &mut live)?;
+                checkpointed = Instant::now();
+            }
+            if at_equilibrium {
+                break;
+            }
+        }
+        live.summary.wall_time_s = wall0 + started.elapsed().as_secs_f64();
+        let end = match (&diverged, at_equilibrium) {
+            (Some(_), _) => RunEnd::Diverged,
+            (None, true) => RunEnd::Equilibrium,
+            (None, false) => RunEnd::Finished,
+        };
+        let report = RunReport::new(
+            E::NAME,
+            E::ITERATIVE,
+            &live.summary,
+            end,
+            live.sys.body_count(),
+            opts.threads.max(1),
+            live.sys.dt(),
+            live.sys.time(),
+            plan.cycles.map(|_| live.cycles_done),
+        );
+        let kinetic_energy = last_stats.map_or(0.0, |(s, _)| E::summary(&s).kinetic_energy);
+        let (step, time) = (live.sys.steps_done(), live.sys.time());
+        let outcome = |status| RunOutcome {
+            status,
+            step,
+            time,
+            end_step,
+            kinetic_energy,
+            report: report.clone(),
+            elapsed_s: started.elapsed().as_secs_f64(),
+            out: out.to_path_buf(),
+        };
+        if diverged.is_none() && !at_equilibrium && step < end_step {
+            // Stopped on request: a checkpoint and nothing that looks final.
+            self.checkpoint(out, &mut live)?;
+            live.series.finish()?;
+            return Ok(outcome(Status::Stopped));
+        }
+        if let Some((stats, false)) = last_stats {
+            // The run stopped off the output grid: its last good step gets a row.
+            live.series.write(&live.sys.series_row(&stats))?;
+        }
+        live.series.finish()?;
+        let state = live.cycles.take().map(|(state, table)| (state, table.finish()));
+        if let Some((_, Err(e))) = state {
+            return Err(e);
+        }
+        let cycle_state = state.map(|(s, _)| s);
+        live.sys.final_state().write(&out.join(files::FINAL))?;
+        io::write_json(&out.join(files::SUMMARY), &report)?;
+        if opts.figures {
+            live.sys.figures(out, cycle_state.as_ref())?;
+        }
+        if let Some(e) = diverged {
+            return Err(e);
+        }
+        io::remove_stale(out, CHECKPOINT_FILE)?;
+        if let (Some(restart), Origin::Scene { path, .. }) = (&self.restart, &self.origin) {
+            let text = format!(
+                "# Written by ballast {}: the state of {} at t = {} s (step {}).\n\
+                 # Rerun it with `ballast run`; time restarts at 0.\n\n{}",
+                env!("CARGO_PKG_VERSION"),
+                path.display().to_string().replace(char::is_control, "?"),
+                live.sys.time(),
+                live.sys.steps_done(),
+                restart(&live.sys)?
+            );
+            io::write_text(out, files::FINAL_SCENE, &text)?;
+        }
+        Ok(outcome(Status::Ended(end)))
+    }
+
+    /// A fresh run: the output folder prepared, the first rows and snapshot written.
+    fn start(&self, out: &Path, opts: &RunOptions) -> Result<Live<E>> {
+        let sys = self.system.clone();
+        io::create_output_dir(out)?;
+        // Files left by an earlier run would pass for this run's.
+        for stale in [
+            files::FINAL_SCENE,
+            CHECKPOINT_FILE,
+            files::CYCLES,
+            files::FINAL,
+            files::SUMMARY,
+            BODIES_FILE,
+            DISPLACEMENTS_FILE,
+            files::SCENE,
+            files::INITIAL_STATE,
+        ] {
+            io::remove_stale(out, stale)?;
+        }
+        match &self.origin {
+            Origin::Scene { path, .. } => {
+                io::copy_scene(path, out)?;
+            }
+            Origin::Code { json } => {
+                io::write_text(out, files::INITIAL_STATE, json)?;
+            }
+        }
+        let info = RunInfo {
+            seed: self.plan.seed,
+            engine: E::NAME.to_string(),
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            steps: self.plan.steps,
+            dt: sys.dt(),
+        };
+        info.write(out)?;
+        let series = TableWriter::create(&out.join(files::SERIES), &sys.series_header())?;
+        let mut snapshots = PvdCollection::new();
+        if opts.vtk_every > 0 {
+            // The initial state is the first snapshot.
+            let vtk_dir = out.join(files::VTK_DIR);
+            io::create_output_dir(&vtk_dir)?;
+            sys.snapshot(&vtk_dir, &mut snapshots)?;
+            snapshots.write(&out.join(files::PVD))?;
+        }
+        let mut summary = RunSummary::default();
+        if let Some(s) = sys.initial_summary() {
+            summary.max_overlap = s.max_overlap;
+        }
+        let (cycles, positions) = match self.plan.cycles {
+            Some(c) => {
+                let state = sys.cycle_start(c.body)?;
+                let table = TableWriter::create(&out.join(files::CYCLES), &sys.cycle_header())?;
+                let positions = if c.positions {
+                    let reference = sys.configuration();
+                    let names = reference.bodies.iter().map(|&i| body_name(&sys, i)).collect::<Vec<_>>();
+                    Some(PositionsWriter::create(out, reference, &names)?)
+                } else {
+                    None
+                };
+                (Some((state, table)), positions)
+            }
+            None => (None, None),
+        };
+        let first_step = sys.steps_done();
+        Ok(Live { sys, summary, series, snapshots, cycles, cycles_done: 0, positions, first_step })
+    }
+
+    /// The run continued from the checkpoint in `out`, checked against the plan,
+    /// the initial system and the files.
+    fn resume(&self, out: &Path) -> Result<Live<E>> {
+        let cp = Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source_crc32())?;
+        let path = out.join(CHECKPOINT_FILE);
+        let bad = |msg: String| Error::Scene(format!("{}: not a valid checkpoint: {msg}", path.display()));
+        cp.system.check_state().map_err(|e| bad(e.to_string()))?;
+        cp.system.check_same_model(&self.system).map_err(|e| bad(e.to_string()))?;
+        let plan = &self.plan;
+        let first = self.system.steps_done();
+        let end = first.saturating_add(plan.steps);
+        let step = cp.system.steps_done();
+        if cp.first_step != first || cp.step != step || !(first..=end).contains(&step) {
+            return Err(bad(format!(
+                "its step {} (engine at {step}, started at {}) is not within this run's steps {first}..={end}",
+                cp.step, cp.first_step
+            )));
+        }
+        if cp.summary.steps != step - first {
+            return Err(bad(format!(
+                "its summary counts {} steps, the engine made {}",
+                cp.summary.steps,
+                step - first
+            )));
+        }
+        let every = plan.output_every.max(1);
+        let rows = step / every - first / every;
+        if cp.series_rows != rows {
+            return Err(bad(format!("{} rows of series.csv, {rows} expected after step {step}", cp.series_rows)));
+        }
+        let series = TableWriter::resume(&out.join(files::SERIES), cp.series_bytes, cp.series_rows)?;
+        let (cycles, positions) = match (plan.cycles, cp.cycles) {
+            (Some(c), Some(state)) => {
+                let done = cycles_at(cp.system.time(), c.frequency, cp.system.dt());
+                if cp.cycles_done != done || cp.cycles_rows != done {
+                    return Err(bad(format!(
+                        "{} cycles recorded ({} rows), {done} completed at t = {} s",
+                        cp.cycles_done,
+                        cp.cycles_rows,
+                        cp.system.time()
+                    )));
+                }
+                let table = TableWriter::resume(&out.join(files::CYCLES), cp.cycles_bytes, cp.cycles_rows)?;
+                let positions = match (c.positions, cp.positions) {
+                    (true, Some(reference)) => {
+                        reference.check(E::DOF, cp.system.body_count()).map_err(|e| bad(e.to_string()))?;
+                        Some(PositionsWriter::resume(out, reference, done)?)
+                    }
+                    (false, None) => None,
+                    _ => return Err(bad("the positions output does not match the scene's".into())),
+                };
+                (Some((state, table)), positions)
+            }
+            (None, None) => (None, None),
+            _ => return Err(bad("the per-cycle output does not match the scene's".into())),
+        };
+        if cp.snapshots.entries().iter().any(|e| !e.parts.iter().all(|p| out.join(&p.file).is_file())) {
+            return Err(bad("a snapshot it lists is missing".into()));
+        }
+        io::remove_stale(out, files::FINAL_SCENE)?;
+        Ok(Live {
+            sys: cp.system,
+            summary: cp.summary,
+            series,
+            snapshots: cp.snapshots,
+            cycles,
+            cycles_done: cp.cycles_done,
+            positions,
+            first_step: first,
+        })
+    }
+
+    /// Writes `checkpoint.json` for the run in progress.
+    fn checkpoint(&self, out: &Path, live: &mut Live<E>) -> Result<()> {
+        let series_bytes = live.series.sync()?;
+        let (cycles_bytes, cycles_rows) = match live.cycles.as_mut() {
+            Some((_, t)) => (t.sync()?, t.rows()),
+            None => (0, 0),
+        };
+        if let Some(p) = live.positions.as_mut() {
+            p.sync()?;
+        }
+        Checkpoint {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            engine: E::NAME.to_string(),
+            source_crc32: self.source_crc32(),
+            first_step: live.first_step,
+            step: live.sys.steps_done(),
+            series_bytes,
+            series_rows: live.series.rows(),
+            cycles_bytes,
+            cycles_rows,
+            summary: live.summary,
+            system: live.sys.clone(),
+            snapshots: live.snapshots.clone(),
+            cycles: live.cycles.as_ref().map(|(s, _)| s.clone()),
+            cycles_done: live.cycles_done,
+            positions: live.positions.as_ref().map(|p| p.reference().clone()),
+        }
+        .write(out)?;
+        Ok(())
+    }
+}
+
+fn body_name<E: Engine>(sys: &E, i: usize) -> String {
+    sys.final_state().bodies.get(i).map(|b| b.name.clone()).unwrap_or_default()
+}
+
+/// Checks the options; the message names the option.
+pub fn check_options(opts: &RunOptions) -> Result<()> {
+    if !(opts.checkpoint_every_s.is_finite() && opts.checkpoint_every_s >= 0.0) {
+        return Err(Error::Scene(format!(
+            "--checkpoint-every: must be a non-negative number of seconds, got {}",
+            opts.checkpoint_every_s
+        )));
+    }
+    if opts.threads == 0 {
+        return Err(Error::Scene("--threads: must be at least 1, got 0".into()));
+    }
+    Ok(())
+}
+
+/// What an output folder holds for `--resume`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Prior {
+    /// A finished run: `marker` is there and no checkpoint.
+    Finished,
+    /// A run to continue from its checkpoint.
+    Checkpointed,
+    /// Nothing to continue: start afresh.
+    Nothing,
+}
+
+impl Prior {
+    /// The state of `dir` as `--resume` (`resume`) sees it; without `--resume`, always `Nothing`.
+    pub fn of(dir: &Path, marker: &str, resume: bool) -> Self {
+        let checkpoint = dir.join(CHECKPOINT_FILE).exists();
+        match (resume, checkpoint) {
+            (false, _) => Prior::Nothing,
+            (true, true) => Prior::Checkpointed,
+            (true, false) if dir.join(marker).exists() => Prior::Finished,
+            (true, false) => Prior::Nothing,
+        }
+    }
+}

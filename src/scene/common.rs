@@ -1,0 +1,221 @@
+//! The sections every scene has, whatever its engine: `[simulation]` (engine,
+//! dimension, time step, duration, gravity, seed, equilibrium stop) and
+//! `[output]` (rows of `series.csv`, per-cycle output). They are parsed by the
+//! same serde types for NSCD and MD scenes, checked by the same functions
+//! ([`check_simulation`], [`check_output`]) and written back by the same code;
+//! [`run_plan`] turns them into the run loop's [`RunPlan`].
+
+use super::validate::{check_time, err, finite, positive, steps_of};
+use super::write::{float, opt, string};
+use crate::error::Result;
+use crate::run::{CyclePlan, Equilibrium, RunPlan};
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+
+/// Default number of steps between two rows of `series.csv`.
+pub const DEFAULT_OUTPUT_EVERY: u64 = 1;
+
+/// `[simulation]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Simulation {
+    /// Engine name: `"nscd"` or `"md"`.
+    pub engine: String,
+    /// Space dimension: 2 for NSCD scenes, 3 for MD scenes (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dimension: Option<i64>,
+    /// Time step `h` (s), > 0.
+    pub dt: f64,
+    /// Simulated duration (s), > 0; the run makes `round(duration / dt)` steps.
+    pub duration: f64,
+    /// Gravity (m/s²): 2 components in 2D, 3 in 3D; default `[0, -9.81]` in 2D,
+    /// `[0, 0, -9.81]` in 3D.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<Vec<f64>>,
+    /// Out-of-plane thickness (m), > 0, 2D only; default 1. A body of area `A`
+    /// (m²) and density `ρ` (kg/m³) has mass `ρ A thickness` (kg).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<f64>,
+    /// Random seed, recorded in the outputs; default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    /// Ends the run early at equilibrium (a deposit): see [`Equilibrium`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub equilibrium: Option<Equilibrium>,
+}
+
+impl Simulation {
+    /// Number of time steps of the run, `round(duration / dt)` (0 if `dt` is not positive).
+    pub fn steps(&self) -> u64 {
+        steps_of(self.dt, self.duration)
+    }
+
+    /// Random seed recorded in the outputs (default 0).
+    pub fn seed(&self) -> u64 {
+        self.seed.unwrap_or(0)
+    }
+
+    /// Out-of-plane thickness of a 2D scene (m); default 1.
+    pub fn thickness(&self) -> f64 {
+        self.thickness.unwrap_or(super::format::DEFAULT_THICKNESS)
+    }
+
+    /// The gravity of a scene of dimension `N` (m/s²): the scene's, or `default`
+    /// if it has none or not `N` components (refused by [`check_simulation`]).
+    pub fn gravity_or<const N: usize>(&self, default: [f64; N]) -> [f64; N] {
+        self.gravity.as_deref().and_then(|g| g.try_into().ok()).unwrap_or(default)
+    }
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSection {
+    /// Steps between two rows of `series.csv`, ≥ 1 (the last step always has a row).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub every: Option<u64>,
+    /// Per-cycle output of a cyclically loaded run (`cycles.csv`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycles: Option<CyclesSpec>,
+}
+
+/// `output.cycles`: one row of `cycles.csv` per loading cycle of `frequency` (Hz).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CyclesSpec {
+    /// Loading frequency (Hz), > 0: a cycle lasts `1/frequency` s from t = 0.
+    pub frequency: f64,
+    /// Name of the followed body (NSCD: required, the sleeper; MD: not used).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<String>,
+    /// Also write the positions of every mobile body at the end of each cycle
+    /// (`cycle_bodies.csv`, `cycle_displacements.npy`); default false.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub positions: Option<bool>,
+}
+
+/// Checks `[simulation]` of a scene for `engine` in `dimension` (2 or 3); the
+/// message names the field.
+pub(crate) fn check_simulation(sim: &Simulation, engine: &str, dimension: i64) -> Result<()> {
+    if !super::ENGINES.contains(&sim.engine.as_str()) {
+        return err(format!(
+            "simulation.engine: unknown engine '{}', expected 'nscd' or 'md'",
+            super::clip(&sim.engine)
+        ));
+    }
+    if sim.engine != engine {
+        let other = if engine == "nscd" { "scene::MdScene" } else { "scene::Scene" };
+        return err(format!(
+            "simulation.engine: expected '{engine}', got '{}' (read it with {other})",
+            super::clip(&sim.engine)
+        ));
+    }
+    if let Some(d) = sim.dimension.filter(|&d| d != dimension) {
+        return err(format!("simulation.dimension: must be {dimension} for the {engine} engine, got {d}"));
+    }
+    check_time(sim.dt, sim.duration)?;
+    if let Some(g) = &sim.gravity {
+        if g.len() != dimension as usize {
+            return err(format!(
+                "simulation.gravity: a {dimension}D scene needs {dimension} components, got {}",
+                g.len()
+            ));
+        }
+        for (k, &x) in g.iter().enumerate() {
+            finite(&format!("simulation.gravity[{k}]"), x)?;
+        }
+    }
+    if let Some(t) = sim.thickness {
+        if dimension != 2 {
+            return err("simulation.thickness: only for 2D scenes".into());
+        }
+        positive("simulation.thickness", t)?;
+    }
+    if let Some(e) = &sim.equilibrium {
+        e.check()?;
+    }
+    Ok(())
+}
+
+/// Checks `[output]`; `body_index` resolves a body name. Returns the per-cycle
+/// plan, with the followed body resolved; `need_body`: the engine follows a body.
+pub(crate) fn check_output(
+    out: Option<&OutputSection>,
+    need_body: bool,
+    body_index: impl Fn(&str) -> Option<usize>,
+) -> Result<Option<CyclePlan>> {
+    let Some(out) = out else { return Ok(None) };
+    if out.every == Some(0) {
+        return err("output.every: must be at least 1, got 0".into());
+    }
+    let Some(c) = &out.cycles else { return Ok(None) };
+    positive("output.cycles.frequency", c.frequency)?;
+    let body = match (&c.body, need_body) {
+        (Some(name), true) => match body_index(name).filter(|_| !name.is_empty()) {
+            Some(i) => Some(i),
+            None => return err(format!("output.cycles.body: unknown body '{}'", super::clip(name))),
+        },
+        (None, true) => return err("output.cycles.body: name the followed body (the sleeper)".into()),
+        (Some(_), false) => {
+            return err("output.cycles.body: not used by this engine (the cycles follow every sphere)".into())
+        }
+        (None, false) => None,
+    };
+    Ok(Some(CyclePlan { frequency: c.frequency, body, positions: c.positions.unwrap_or(false) }))
+}
+
+/// The run plan of a validated scene with these sections.
+pub(crate) fn run_plan(sim: &Simulation, out: Option<&OutputSection>, cycles: Option<CyclePlan>) -> RunPlan {
+    RunPlan {
+        steps: sim.steps(),
+        output_every: out.and_then(|o| o.every).unwrap_or(DEFAULT_OUTPUT_EVERY).max(1),
+        equilibrium: sim.equilibrium,
+        cycles,
+        seed: sim.seed(),
+    }
+}
+
+/// Appends `[simulation]` as TOML (only the keys the scene has).
+pub(crate) fn write_simulation(out: &mut String, sim: &Simulation) {
+    out.push_str("[simulation]\n");
+    let _ = writeln!(out, "engine = {}", string(&sim.engine));
+    opt(out, "dimension", sim.dimension, |d| d.to_string());
+    let _ = writeln!(out, "dt = {}", float(sim.dt));
+    let _ = writeln!(out, "duration = {}", float(sim.duration));
+    opt(out, "gravity", sim.gravity.as_ref(), |g| {
+        format!("[{}]", g.iter().map(|&x| float(x)).collect::<Vec<_>>().join(", "))
+    });
+    opt(out, "thickness", sim.thickness, float);
+    opt(out, "seed", sim.seed, |s| s.to_string());
+    opt(out, "equilibrium", sim.equilibrium, |e| {
+        inline(&[
+            ("kinetic_energy", e.kinetic_energy.map(float)),
+            ("energy_ratio", e.energy_ratio.map(float)),
+            ("steps", e.steps.map(|n| n.to_string())),
+        ])
+    });
+}
+
+/// Appends `[output]` as TOML, if the scene has it.
+pub(crate) fn write_output(out: &mut String, o: Option<&OutputSection>) {
+    let Some(o) = o else { return };
+    out.push_str("\n[output]\n");
+    opt(out, "every", o.every, |e| e.to_string());
+    opt(out, "cycles", o.cycles.as_ref(), |c| {
+        inline(&[
+            ("frequency", Some(float(c.frequency))),
+            ("body", c.body.as_deref().map(string)),
+            ("positions", c.positions.map(|p| p.to_string())),
+        ])
+    });
+}
+
+/// `{ k = v, … }` of the entries that are present.
+pub(crate) fn inline(entries: &[(&str, Option<String>)]) -> String {
+    let parts: Vec<String> = entries.iter().filter_map(|(k, v)| v.as_ref().map(|v| format!("{k} = {v}"))).collect();
+    if parts.is_empty() {
+        "{}".into()
+    } else {
+        format!("{{ {} }}", parts.join(", "))
+    }
+}
