@@ -51,7 +51,7 @@ pub mod files {
 }
 
 /// What a run is asked to do, besides its system.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct RunPlan {
     /// Steps to make (the run may end earlier at equilibrium).
     pub steps: u64,
@@ -73,7 +73,7 @@ impl RunPlan {
 }
 
 /// The per-cycle output of a run (`cycles.csv`, and the positions file).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct CyclePlan {
     /// Loading frequency (Hz): a cycle lasts `1/frequency` from t = 0.
     pub frequency: f64,
@@ -179,7 +179,7 @@ pub type Restart<E> = Box<dyn Fn(&E) -> Result<String> + Send + Sync>;
 enum Origin {
     /// A scene file: its path (for the copy and the header) and text.
     Scene { path: PathBuf, text: String },
-    /// Built in code: the serde form of the initial system.
+    /// Built in code: the serde form of the initial system and of the plan.
     Code { json: String },
 }
 
@@ -211,10 +211,16 @@ impl<E: Engine> Runner<E> {
         Self { system, plan, origin: Origin::Scene { path: path.to_path_buf(), text }, restart }
     }
 
-    /// A run of a system built in code. Its serde form is written to the output
-    /// folder (`initial_state.json`) as the record of the run's input.
+    /// A run of a system built in code. Its serde form and the plan's are written
+    /// to the output folder (`initial_state.json`) as the record of the run's input.
     pub fn from_system(system: E, plan: RunPlan) -> Result<Self> {
-        let json = serde_json::to_string(&system).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        #[derive(serde::Serialize)]
+        struct Input<'a, E> {
+            plan: &'a RunPlan,
+            system: &'a E,
+        }
+        let json = serde_json::to_string(&Input { plan: &plan, system: &system })
+            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
         Ok(Self { system, plan, origin: Origin::Code { json }, restart: None })
     }
 

@@ -1,0 +1,315 @@
+//! The library's run loop (`ballast::run::Runner`), the same tests on both
+//! engines: a run stopped twice and resumed writes the same bytes as the
+//! uninterrupted run; the equilibrium stop ends at the same step after a resume
+//! inside its window; a diverging run stops with the step and body named and
+//! leaves the last good state and its row; every CSV it writes reads back
+//! through the library's row types.
+
+use ballast::io::{FinalState, RunEnd};
+use ballast::run::{Engine, RunOptions, RunPlan, Runner, Status};
+use ballast::scene::{MdScene, Scene};
+use ballast::Error;
+use std::path::{Path, PathBuf};
+
+/// A fresh directory under the system temp dir, unique to this test and process.
+fn temp_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ballast-run-loop-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// NSCD: a block dropped on a floor and a pentagon beside it, 5 cycles of 10 ms
+/// followed on the block, with the positions of the mobile bodies per cycle.
+const NSCD: &str = r#"
+[simulation]
+engine = "nscd"
+dt = 1.0e-3
+duration = 0.05
+seed = 42
+
+[output]
+every = 7
+cycles = { frequency = 100.0, body = "block", positions = true }
+
+[[material]]
+name = "grain"
+density = 2700.0
+
+[[contact]]
+between = ["grain", "grain"]
+friction = 0.5
+
+[[body]]
+name = "floor"
+material = "grain"
+polygon = [[-0.5, -0.1], [0.5, -0.1], [0.5, 0.0], [-0.5, 0.0]]
+position = [0.0, 0.0]
+fixed = true
+
+[[body]]
+name = "block"
+material = "grain"
+polygon = [[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]]
+position = [0.0, 0.06]
+
+[[body]]
+name = "pebble"
+material = "grain"
+regular = { sides = 5, radius = 0.02 }
+position = [0.2, 0.1]
+"#;
+
+/// MD: two Hertz spheres dropped on a base inside a cylinder (the example
+/// scene, shortened), with `lid` a servo lid above them, cycles of 5 ms.
+fn md_scene(duration: f64, with_lid: bool) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/md_two_spheres.toml");
+    let lid = "[[wall]]\nname = \"lid\"\nmaterial = \"steel\"\n\
+               disc = { point = [0.0, 0.0, 0.03], normal = [0.0, 0.0, -1.0], radius = 0.0075 }\n\
+               servo = { mass = 0.01, viscosity = 1.0, force = 0.05 }\n\n[[body]]";
+    let text = std::fs::read_to_string(path).unwrap();
+    let out = text
+        .replace("duration = 0.2\n", &format!("duration = {duration}\n"))
+        .replace("every = 500\n", "every = 300\ncycles = { frequency = 200.0, positions = true }\n")
+        .replacen("[[body]]", if with_lid { lid } else { "[[body]]" }, 1);
+    assert!(out.contains("cycles = ") && out.contains("name = \"lid\"") == with_lid, "example scene changed");
+    out
+}
+
+fn quiet() -> RunOptions {
+    RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() }
+}
+
+/// The files two runs must share byte for byte.
+fn outputs(dir: &Path) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = ["series.csv", "cycles.csv", "final.json", "run.pvd"]
+        .iter()
+        .chain(&["cycle_bodies.csv", "cycle_displacements.npy"])
+        .map(|f| dir.join(f))
+        .collect();
+    if let Ok(entries) = std::fs::read_dir(dir.join("vtk")) {
+        let mut vtk: Vec<PathBuf> = entries.map(|e| e.unwrap().path()).collect();
+        vtk.sort();
+        files.extend(vtk);
+    }
+    files
+}
+
+fn summary_without_wall_time(dir: &Path) -> serde_json::Value {
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    for k in ["wall_time_s", "wall_time_per_step_s", "wall_time_per_cycle_s", "body_steps_per_s", "threads"] {
+        v.as_object_mut().unwrap().remove(k);
+    }
+    v
+}
+
+/// Runs `runner` whole, then stopped at `stop` and at `2 stop` and resumed, with
+/// a snapshot every `vtk` steps: the same bytes; a checkpoint left after the
+/// first stop is refused by a runner of another scene.
+fn resume_is_bit_identical<E: Engine>(runner: &Runner<E>, other: &Runner<E>, stop: u64, vtk: u64, test: &str) {
+    let dir = temp_dir(test);
+    let (whole, parts) = (dir.join("whole"), dir.join("parts"));
+    let opts = RunOptions { vtk_every: vtk, ..quiet() };
+    let done = runner.run(&whole, &opts, &mut |_| {}).unwrap();
+    assert_eq!(done.status, Status::Ended(RunEnd::Finished));
+    let first = runner.run(&parts, &RunOptions { stop_after: Some(stop), ..opts.clone() }, &mut |_| {}).unwrap();
+    assert_eq!((first.status, first.step), (Status::Stopped, stop));
+    assert!(parts.join("checkpoint.json").is_file() && !parts.join("final.json").exists());
+    let err = other.run(&parts, &RunOptions { resume: true, ..opts.clone() }, &mut |_| {}).unwrap_err();
+    assert!(err.to_string().contains("another scene"), "{err}");
+    let resume = RunOptions { resume: true, ..opts.clone() };
+    let second = runner.run(&parts, &RunOptions { stop_after: Some(stop), ..resume.clone() }, &mut |_| {}).unwrap();
+    assert_eq!((second.status, second.step), (Status::Stopped, 2 * stop));
+    // A kill after the checkpoint leaves rows it does not know: they go.
+    let mut f = std::fs::OpenOptions::new().append(true).open(parts.join("series.csv")).unwrap();
+    std::io::Write::write_all(&mut f, b"9e9,9e9,9,9,9,9e9,1,9e9,9e9,9e9\n").unwrap();
+    drop(f);
+    let end = runner.run(&parts, &resume, &mut |_| {}).unwrap();
+    assert_eq!(end.status, Status::Ended(RunEnd::Finished));
+    assert!(!parts.join("checkpoint.json").exists());
+    for f in outputs(&whole) {
+        let name = f.file_name().unwrap();
+        let g = parts.join(f.strip_prefix(&whole).unwrap());
+        assert_eq!(std::fs::read(&f).unwrap(), std::fs::read(&g).unwrap(), "{name:?} differs");
+    }
+    assert_eq!(summary_without_wall_time(&whole), summary_without_wall_time(&parts));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn nscd_resume_is_bit_identical() {
+    let scene = Scene::from_toml_str(NSCD).unwrap();
+    let runner = Runner::from_system(scene.build().unwrap(), scene.plan().unwrap()).unwrap();
+    let other_scene = Scene::from_toml_str(&NSCD.replace("every = 7", "every = 8")).unwrap();
+    let other = Runner::from_system(other_scene.build().unwrap(), other_scene.plan().unwrap()).unwrap();
+    // Stops at 17 and 34: between rows and inside cycles.
+    resume_is_bit_identical(&runner, &other, 17, 10, "nscd_resume");
+}
+
+#[test]
+fn md_resume_is_bit_identical() {
+    let text = md_scene(0.02, true);
+    let scene = MdScene::from_toml_str(&text).unwrap();
+    let runner = Runner::from_system(scene.build().unwrap(), scene.plan().unwrap()).unwrap();
+    let other_scene = MdScene::from_toml_str(&text.replace("every = 300", "every = 301")).unwrap();
+    let other = Runner::from_system(other_scene.build().unwrap(), other_scene.plan().unwrap()).unwrap();
+    // 10 000 steps of 2 µs; stops at 3 333 and 6 666: off the row and cycle grids.
+    resume_is_bit_identical(&runner, &other, 3333, 2500, "md_resume");
+}
+
+/// Runs to equilibrium; the last row is the stop step; stopped 10 steps before
+/// the stop and resumed, the same stop and bytes.
+fn equilibrium_stop_survives_a_resume<E: Engine>(runner: &Runner<E>, test: &str) -> u64 {
+    let dir = temp_dir(test);
+    let (whole, parts) = (dir.join("whole"), dir.join("parts"));
+    let done = runner.run(&whole, &quiet(), &mut |_| {}).unwrap();
+    assert_eq!(done.status, Status::Ended(RunEnd::Equilibrium));
+    assert!(done.step < done.end_step, "stopped early: {} of {}", done.step, done.end_step);
+    let fin = FinalState::read(&whole.join("final.json")).unwrap();
+    assert_eq!(fin.step, done.step);
+    let series = std::fs::read_to_string(whole.join("series.csv")).unwrap();
+    let last_time: f64 = series.lines().last().unwrap().split(',').next().unwrap().parse().unwrap();
+    assert_eq!(last_time, fin.time, "the stop step is the last row");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(whole.join("summary.json")).unwrap()).unwrap();
+    assert_eq!((report["end"].as_str(), report["equilibrium"].as_bool()), (Some("equilibrium"), Some(true)));
+    runner.run(&parts, &RunOptions { stop_after: Some(done.step - 10), ..quiet() }, &mut |_| {}).unwrap();
+    runner.run(&parts, &RunOptions { resume: true, ..quiet() }, &mut |_| {}).unwrap();
+    for f in ["series.csv", "final.json"] {
+        assert_eq!(std::fs::read(whole.join(f)).unwrap(), std::fs::read(parts.join(f)).unwrap(), "{f} differs");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    done.step
+}
+
+#[test]
+fn nscd_equilibrium_stop() {
+    // The block (1 mm up) and the pebble (8 cm up) land within 0.13 s; the
+    // 50-step window follows: far before the 2 s asked for.
+    let text = NSCD
+        .replace("duration = 0.05", "duration = 2.0")
+        .replace("seed = 42", "seed = 42\nequilibrium = { kinetic_energy = 1e-12, steps = 50 }");
+    let scene = Scene::from_toml_str(&text).unwrap();
+    let runner = Runner::from_system(scene.build().unwrap(), scene.plan().unwrap()).unwrap();
+    let stop = equilibrium_stop_survives_a_resume(&runner, "nscd_equilibrium");
+    assert!((130..1000).contains(&stop), "stopped at step {stop}");
+}
+
+#[test]
+fn md_equilibrium_stop() {
+    // E_k below 1e-8 J for 2000 steps (4 ms, longer than the top of a bounce)
+    // once the spheres have landed (the lower one falls 0.8 mm: 12.8 ms).
+    let text =
+        md_scene(0.4, false).replace("seed = 1\n", "seed = 1\nequilibrium = { kinetic_energy = 1e-8, steps = 2000 }\n");
+    let scene = MdScene::from_toml_str(&text).unwrap();
+    let runner = Runner::from_system(scene.build().unwrap(), scene.plan().unwrap()).unwrap();
+    let stop = equilibrium_stop_survives_a_resume(&runner, "md_equilibrium");
+    assert!(stop > 6400, "stopped at step {stop}, before the lower sphere landed");
+}
+
+/// A run whose step `k + 1` diverges: the error names that step and a body; the
+/// run folder holds the state of step `k` (`final.json`), whose row ends
+/// `series.csv`, and `summary.json` says it diverged.
+fn divergence_keeps_the_last_good_state<E: Engine>(runner: &Runner<E>, body: &str, test: &str) {
+    let dir = temp_dir(test);
+    let err = runner.run(&dir, &quiet(), &mut |_| {}).unwrap_err();
+    let Error::Diverged { step, name, .. } = &err else { panic!("{err}") };
+    assert_eq!(name, body, "{err}");
+    assert_eq!(err.to_string().lines().count(), 1);
+    let fin = FinalState::read(&dir.join("final.json")).unwrap();
+    assert_eq!(fin.step + 1, *step, "final.json holds the step before the failure: {err}");
+    assert!(fin.bodies.iter().all(|b| b.position.iter().chain(&b.velocity).all(|x| x.is_finite())));
+    let series = std::fs::read_to_string(dir.join("series.csv")).unwrap();
+    let last_time: f64 = series.lines().last().unwrap().split(',').next().unwrap().parse().unwrap();
+    assert_eq!(last_time, fin.time, "the last good step is the last row");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!((report["end"].as_str(), report["steps"].as_u64()), (Some("diverged"), Some(fin.step)));
+    assert!(!dir.join("final_scene.toml").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn nscd_divergence_keeps_the_last_good_state() {
+    // A block squeezed between the floor and a press whose velocity is imposed:
+    // nothing stops the press, the overlap runs away.
+    let text = NSCD
+        .replace("[output]\nevery = 7\ncycles = { frequency = 100.0, body = \"block\", positions = true }\n", "")
+        + "\n[[body]]\nname = \"press\"\nmaterial = \"grain\"\n\
+           polygon = [[-0.1, 0.0], [0.1, 0.0], [0.1, 0.05], [-0.1, 0.05]]\nposition = [0.0, 0.12]\n\
+           imposed = { vx = 0.0, vy = -1.0, spin = 0.0 }\n";
+    let scene = Scene::from_toml_str(&text.replace("position = [0.0, 0.06]", "position = [0.0, 0.05]")).unwrap();
+    let runner = Runner::from_system(scene.build().unwrap(), RunPlan::new(100, 10)).unwrap();
+    divergence_keeps_the_last_good_state(&runner, "block", "nscd_diverge");
+}
+
+#[test]
+fn md_divergence_keeps_the_last_good_state() {
+    // Two soft spheres (E = 1 MPa) thrown at each other at 20 m/s each: the Hertz
+    // contact cannot stop them before the overlap passes half a radius (contact
+    // near step 150 of 10 µs, a replay from the backup at step 100).
+    let text = format!(
+        "[simulation]\nengine = \"md\"\ndt = 1e-5\nduration = 0.01\ngravity = [0.0, 0.0, 0.0]\n\n\
+         [[material]]\nname = \"soft\"\ndensity = 2000.0\nyoung = 1e6\npoisson = 0.25\n\n\
+         [[contact]]\nbetween = [\"soft\", \"soft\"]\nmodel = \"hertz\"\nfriction = 0.5\nnormal_damping_ratio = 0.3\n\n\
+         [[body]]\nname = \"left\"\nmaterial = \"soft\"\nsphere = 0.005\nposition = [-0.035, 0.0, 0.1]\nvelocity = [20.0, 0.0, 0.0]\n\n\
+         [[body]]\nname = \"right\"\nmaterial = \"soft\"\nsphere = 0.005\nposition = [0.035, 0.0, 0.1]\nvelocity = [-20.0, 0.0, 0.0]\n"
+    );
+    let scene = MdScene::from_toml_str(&text).unwrap();
+    let runner = Runner::from_system(scene.build().unwrap(), RunPlan::new(1000, 7)).unwrap();
+    let dir = temp_dir("md_diverge_probe");
+    let err = runner.run(&dir, &quiet(), &mut |_| {}).unwrap_err();
+    let _ = std::fs::remove_dir_all(&dir);
+    let Error::Diverged { name, .. } = &err else { panic!("{err}") };
+    divergence_keeps_the_last_good_state(&runner, name, "md_diverge");
+}
+
+/// Every CSV of a run of each engine reads back through the library's row types.
+#[test]
+fn outputs_read_back_through_the_row_types() {
+    use ballast::io::{cycles, positions, series};
+    let dir = temp_dir("read_back");
+    let scene = Scene::from_toml_str(NSCD).unwrap();
+    let nscd = dir.join("nscd");
+    Runner::from_system(scene.build().unwrap(), scene.plan().unwrap())
+        .unwrap()
+        .run(&nscd, &quiet(), &mut |_| {})
+        .unwrap();
+    let rows = series::read_nscd(&nscd.join("series.csv")).unwrap();
+    assert_eq!(rows.len(), 8, "steps 7, 14, …, 49 and 50");
+    assert_eq!(rows.last().unwrap().time_s, 0.05);
+    let c = cycles::read_nscd(&nscd.join("cycles.csv")).unwrap();
+    assert_eq!(c.iter().map(|r| r.cycle).collect::<Vec<_>>(), [1, 2, 3, 4, 5]);
+    let p = positions::read(&nscd).unwrap();
+    assert_eq!((p.reference.bodies.clone(), p.cycles.len()), (vec![1, 2], 5));
+    assert_eq!(p.names, ["block", "pebble"]);
+    // The last cycle ends with the run: its positions are the final state's, to
+    // the float32 resolution of the stored displacement (7 digits of it).
+    let fin = FinalState::read(&nscd.join("final.json")).unwrap();
+    for (k, &i) in p.reference.bodies.iter().enumerate() {
+        let (q, q0) = (p.cycles[4].body(k), p.reference.body(k));
+        let want = [fin.bodies[i].position[0], fin.bodies[i].position[1], fin.bodies[i].angle.unwrap()];
+        for d in 0..3 {
+            assert!((q[d] - want[d]).abs() <= 1e-7 * (want[d] - q0[d]).abs() + 1e-300, "body {i} coordinate {d}");
+        }
+    }
+
+    let md = dir.join("md");
+    let text = md_scene(0.01, true);
+    let scene = MdScene::from_toml_str(&text).unwrap();
+    Runner::from_system(scene.build().unwrap(), scene.plan().unwrap())
+        .unwrap()
+        .run(&md, &quiet(), &mut |_| {})
+        .unwrap();
+    let (header, rows) = series::read_md(&md.join("series.csv")).unwrap();
+    assert_eq!(&header[header.len() - 4..], ["base_force_N", "mould_force_N", "lid_force_N", "lid_position_m"]);
+    assert!(rows.iter().all(|r| r.walls.len() == 4), "three wall forces and one servo position per row");
+    assert!(rows.last().unwrap().walls[3] > 0.0, "the lid moved down along its normal");
+    let c = cycles::read_md(&md.join("cycles.csv")).unwrap();
+    assert_eq!(c.len(), 2, "two 5 ms cycles in 10 ms");
+    assert_eq!(c[1].walls, [rows.last().unwrap().walls[3]], "the lid at the end of the run");
+    let p = positions::read(&md).unwrap();
+    assert_eq!((p.reference.dof, p.reference.bodies.clone(), p.cycles.len()), (6, vec![0, 1], 2));
+    let _ = std::fs::remove_dir_all(&dir);
+}
