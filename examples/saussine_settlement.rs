@@ -18,7 +18,6 @@ use ballast::io::cycles::CycleRecorder;
 use ballast::io::figures::{self, Axes, Series};
 use ballast::io::vtk;
 use ballast::scenarios::saussine::{loaded_scene, measure_sample, sample_scene, LoadingSpec, SampleSpec, SLEEPER};
-use ballast::scene::Scene;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -33,7 +32,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // 1. Deposit.
     let spec = SampleSpec::saussine(seed).scaled(grains);
-    let scene = Scene::from_toml_str(&sample_scene(&spec))?;
+    let scene = sample_scene(&spec)?;
     let eq = scene.simulation.equilibrium.expect("the sample scene stops at equilibrium");
     let mut sys = scene.build()?;
     let start = Instant::now();

@@ -189,9 +189,13 @@ fn deposit(grains: usize, width: f64, seed: u64, dt: f64, duration: f64, out: &P
             "deposit: need at least one grain and a positive width, got {grains} grains and {width} m"
         ))));
     }
-    let text = pentagon_deposit(&DepositSpec { dt, duration, ..DepositSpec::saussine(grains, width, seed) });
     // The generated scene goes through the same validation as any scene file.
-    Scene::from_toml_str(&text).map_err(Failure::Input)?;
+    let scene = pentagon_deposit(&DepositSpec { dt, duration, ..DepositSpec::saussine(grains, width, seed) })
+        .map_err(Failure::Input)?;
+    let text = format!(
+        "# Loose pentagon deposit: {grains} grains, seed {seed}.\n{}",
+        scene.to_toml_string().map_err(Failure::Run)?
+    );
     std::fs::write(out, text).map_err(|e| Failure::Run(Error::Io(e)))?;
     println!("wrote {} ({grains} grains, seed {seed})", out.display());
     Ok(())

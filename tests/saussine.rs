@@ -17,7 +17,7 @@ const GRAINS: usize = 121;
 /// scene's equilibrium threshold for the scene's window of steps.
 fn deposit(seed: u64) -> (Scene, f64) {
     let spec = SampleSpec::saussine(seed).scaled(GRAINS);
-    let scene = Scene::from_toml_str(&sample_scene(&spec)).unwrap();
+    let scene = sample_scene(&spec).unwrap();
     let eq = scene.simulation.equilibrium.unwrap();
     let mut sys = scene.build().unwrap();
     let mut calm = 0;

@@ -161,6 +161,11 @@ fn write(path: &Path, text: &str) -> Result<(), Failure> {
     std::fs::write(path, text).map_err(|e| Failure::Run(ballast::io::io_error(path, "write", e)))
 }
 
+/// The TOML text of a generated scene (invalid parameters are input errors).
+fn text(scene: ballast::Result<MdScene>) -> Result<String, Failure> {
+    scene.map_err(Failure::Input)?.to_toml_string().map_err(Failure::Run)
+}
+
 /// Spheres `(radius, position)` and the built system of a finished run's final scene.
 fn final_state(dir: &Path) -> Result<ballast::md::MdSystem, Failure> {
     let path = dir.join("final_scene.toml");
@@ -192,7 +197,7 @@ pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
             let spec = KarrechSpec { dt, duration, young, ..KarrechSpec::table1(spheres, seed) };
             let scene = args.out.join("deposit.toml");
             if !(args.resume && scene.exists()) {
-                write(&scene, &karrech::deposit_scene(&spec, args.every))?;
+                write(&scene, &text(karrech::deposit_scene(&spec, args.every))?)?;
                 let json = format!("{{\"spheres\":{spheres},\"seed\":{seed},\"dt\":{dt:?},\"young\":{young:?}}}");
                 write(&args.out.join("spec.json"), &json)?;
             }
@@ -210,7 +215,7 @@ pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
             let loading = if mode == Mode::Full { Loading::FULL } else { Loading::PARTIAL };
             let scene = args.out.join("load.toml");
             if !(args.resume && scene.exists()) {
-                write(&scene, &karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, args.every))?;
+                write(&scene, &text(karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, args.every))?)?;
             }
             run(&scene, &args.out, &args.options())?;
             load_figures(&args.out)
@@ -229,7 +234,7 @@ pub(crate) fn luding_main(cmd: LudingCommand) -> Result<(), Failure> {
             let spec = LudingSpec::paper(spheres, friction, seed);
             let scene = args.out.join("compress.toml");
             if !(args.resume && scene.exists()) {
-                write(&scene, &luding::compression_scene(&spec, duration, args.every))?;
+                write(&scene, &text(luding::compression_scene(&spec, duration, args.every))?)?;
                 write(
                     &args.out.join("spec.json"),
                     &format!("{{\"spheres\":{spheres},\"friction\":{friction:?},\"seed\":{seed}}}"),
@@ -249,7 +254,7 @@ pub(crate) fn luding_main(cmd: LudingCommand) -> Result<(), Failure> {
                 box_corners(&sys).ok_or_else(|| input("luding cycle: the compressed scene has no box".into()))?;
             let scene = args.out.join("cycle.toml");
             if !(args.resume && scene.exists()) {
-                write(&scene, &luding::cyclic_scene(&spec, &spheres_of(&sys), lo, hi, cycles, args.every))?;
+                write(&scene, &text(luding::cyclic_scene(&spec, &spheres_of(&sys), lo, hi, cycles, args.every))?)?;
             }
             if !(args.resume && args.out.join("spec.json").exists()) {
                 write(

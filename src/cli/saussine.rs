@@ -312,11 +312,10 @@ pub(crate) fn sample(
     quiet: bool,
     progress: Progress,
 ) -> Result<(), Failure> {
-    let text = sample_scene(spec);
-    Scene::from_toml_str(&text).map_err(Failure::Input)?;
+    let scene = sample_scene(spec).map_err(Failure::Input)?;
     ballast::io::create_output_dir(out).map_err(Failure::Run)?;
     let deposit = out.join("deposit.toml");
-    write(&deposit, &text)?;
+    write_scene(&deposit, &scene, &format!("stage 1 (deposit) of the sample, seed {}", spec.seed))?;
     let mut settled = run_stage(&deposit, &out.join("deposit"), resume, quiet, progress.clone())?;
     if spec.bank {
         let opened = open_bank(&settled).map_err(Failure::Run)?;
