@@ -142,9 +142,8 @@ impl SampleSpec {
 /// of the deposit (and between a row's ends and the walls).
 pub const CLEARANCE: f64 = 0.001;
 
-/// Checks the sample `spec`; returns the number of grains, the smallest and the
-/// largest circumradius (m).
-fn check_sample(spec: &SampleSpec) -> Result<(usize, f64, f64)> {
+/// Checks the sample `spec`; returns the number of grains.
+fn check_sample(spec: &SampleSpec) -> Result<usize> {
     let (n, r_min, r_max) = super::grading("sample", &spec.grading)?;
     let width = positive("sample: width (m)", spec.width)?;
     let min_width = spec.min_width();
@@ -184,7 +183,7 @@ fn check_sample(spec: &SampleSpec) -> Result<(usize, f64, f64)> {
     non_negative("sample: friction", spec.friction)?;
     positive("sample: dt (s)", spec.dt)?;
     positive("sample: max_duration (s)", spec.max_duration)?;
-    Ok((n, r_min, r_max))
+    Ok(n)
 }
 
 /// Height (m) of the mould's lower edge above the pads' top faces.
@@ -198,11 +197,12 @@ const MOULD_GAP: f64 = 0.001;
 /// [`Error::Scene`] naming the parameter: a grading without grains or with a
 /// radius that is not positive, a `width` narrower than [`SampleSpec::min_width`]
 /// (a grading [scaled](SampleSpec::scaled) to fewer than [`MIN_SCALED_GRAINS`]
-/// grains), pads that do not fit, a size, stiffness, density, time step or
+/// grains), pads that do not fit, with `bank` a smallest grain that would pass
+/// under the mould (1 mm above the pads), a size, stiffness, density, time step or
 /// duration that is not positive (or, for `pad_gap`, `bank_margin`, `k_n`, `nu`
 /// and `friction`, non-negative) and finite.
 pub fn sample_scene(spec: &SampleSpec) -> Result<Scene> {
-    let (n, _, _) = check_sample(spec)?;
+    let n = check_sample(spec)?;
     let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
     let radii = super::deposit::shuffled_radii(&spec.grading, &mut rng);
 
