@@ -15,7 +15,7 @@ fn settled(n: usize) -> MdSystem {
     if let Some(sys) = std::fs::read_to_string(&path).ok().and_then(|t| serde_json::from_str(&t).ok()) {
         return sys;
     }
-    let mut sys = bed_system(&BedSpec::peers(n, 12345));
+    let mut sys = bed_system(&BedSpec::peers(n, 12345)).expect("the peers' bed");
     sys.set_threads(2);
     for _ in 0..120_000 {
         sys.step().expect("settling the bed");

@@ -5,7 +5,6 @@
 //! (defaults: 536 grains, 0.4 m, seed 1, `data/pentagon_pile_536.toml`).
 
 use ballast::scenarios::{pentagon_deposit, DepositSpec};
-use ballast::scene::Scene;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -15,7 +14,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let seed: u64 = args.get(3).map_or(Ok(1), |s| s.parse())?;
     let out = args.get(4).cloned().unwrap_or_else(|| format!("data/pentagon_pile_{n}.toml"));
     let spec = DepositSpec { duration: 2.5, ..DepositSpec::saussine(n, width, seed) };
-    let scene = Scene::from_toml_str(&pentagon_deposit(&spec))?;
+    let scene = pentagon_deposit(&spec)?;
     let mut sys = scene.build()?;
     let start = Instant::now();
     let (mut iters, mut steps) = (0usize, 0usize);

@@ -19,7 +19,13 @@ fn main() {
     let cached: Option<MdSystem> =
         cache.as_ref().and_then(|f| std::fs::read_to_string(f).ok()).and_then(|t| serde_json::from_str(&t).ok());
     let settle = if cached.is_some() { 0 } else { settle };
-    let mut sys = cached.unwrap_or_else(|| bed_system(&BedSpec::peers(n, 12345)));
+    let mut sys = match cached.map_or_else(|| bed_system(&BedSpec::peers(n, 12345)), Ok) {
+        Ok(sys) => sys,
+        Err(e) => {
+            eprintln!("{e}");
+            std::process::exit(2);
+        }
+    };
     sys.set_threads(2);
     let t0 = Instant::now();
     for k in 0..settle {

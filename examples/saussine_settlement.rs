@@ -32,7 +32,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // 1. Deposit, until equilibrium.
     let spec = SampleSpec::saussine(seed).scaled(grains);
     let deposit = out.join("deposit.toml");
-    std::fs::write(&deposit, sample_scene(&spec))?;
+    std::fs::write(&deposit, sample_scene(&spec)?.to_toml_string()?)?;
     let done = run_file(&deposit, &out.join("deposit"), &RunOptions::default(), &mut |_| {})?;
     let sample = Scene::load(out.join("deposit").join("final_scene.toml"))?;
     let r = measure_sample(&sample)?;

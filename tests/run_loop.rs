@@ -249,14 +249,12 @@ fn md_divergence_keeps_the_last_good_state() {
     // Two soft spheres (E = 1 MPa) thrown at each other at 20 m/s each: the Hertz
     // contact cannot stop them before the overlap passes half a radius (contact
     // near step 150 of 10 µs, a replay from the backup at step 100).
-    let text = format!(
-        "[simulation]\nengine = \"md\"\ndt = 1e-5\nduration = 0.01\ngravity = [0.0, 0.0, 0.0]\n\n\
+    let text = "[simulation]\nengine = \"md\"\ndt = 1e-5\nduration = 0.01\ngravity = [0.0, 0.0, 0.0]\n\n\
          [[material]]\nname = \"soft\"\ndensity = 2000.0\nyoung = 1e6\npoisson = 0.25\n\n\
          [[contact]]\nbetween = [\"soft\", \"soft\"]\nmodel = \"hertz\"\nfriction = 0.5\nnormal_damping_ratio = 0.3\n\n\
          [[body]]\nname = \"left\"\nmaterial = \"soft\"\nsphere = 0.005\nposition = [-0.035, 0.0, 0.1]\nvelocity = [20.0, 0.0, 0.0]\n\n\
-         [[body]]\nname = \"right\"\nmaterial = \"soft\"\nsphere = 0.005\nposition = [0.035, 0.0, 0.1]\nvelocity = [-20.0, 0.0, 0.0]\n"
-    );
-    let scene = MdScene::from_toml_str(&text).unwrap();
+         [[body]]\nname = \"right\"\nmaterial = \"soft\"\nsphere = 0.005\nposition = [0.035, 0.0, 0.1]\nvelocity = [-20.0, 0.0, 0.0]\n";
+    let scene = MdScene::from_toml_str(text).unwrap();
     let runner = Runner::from_system(scene.build().unwrap(), RunPlan::new(1000, 7)).unwrap();
     let dir = temp_dir("md_diverge_probe");
     let err = runner.run(&dir, &quiet(), &mut |_| {}).unwrap_err();

@@ -25,7 +25,7 @@ fn out_dir(name: &str) -> PathBuf {
 /// the scene's window of steps.
 fn deposit(seed: u64) -> (Scene, f64) {
     let spec = SampleSpec::saussine(seed).scaled(GRAINS);
-    let scene = Scene::from_toml_str(&sample_scene(&spec)).unwrap();
+    let scene = sample_scene(&spec).unwrap();
     let sys = scene.build().unwrap();
     let dir = out_dir(&format!("deposit{seed}"));
     let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };

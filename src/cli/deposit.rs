@@ -1,7 +1,6 @@
 //! `ballast deposit`: writes the scene of a loose pentagon deposit.
 
 use super::{input, Failure};
-use ballast::scene::Scene;
 use std::path::PathBuf;
 
 /// The arguments of `ballast deposit`.
@@ -37,9 +36,14 @@ pub fn main(a: DepositArgs) -> Result<(), Failure> {
         )));
     }
     let spec = DepositSpec { dt: a.dt, duration: a.duration, ..DepositSpec::saussine(a.grains, a.width, a.seed) };
-    let text = pentagon_deposit(&spec);
     // The generated scene goes through the same validation as any scene file.
-    Scene::from_toml_str(&text).map_err(Failure::Input)?;
+    let scene = pentagon_deposit(&spec).map_err(Failure::Input)?;
+    let text = format!(
+        "# Loose pentagon deposit: {} grains, seed {}.\n{}",
+        a.grains,
+        a.seed,
+        scene.to_toml_string().map_err(Failure::Run)?
+    );
     std::fs::write(&a.out, text).map_err(|e| Failure::Run(ballast::io::io_error(&a.out, "write", e)))?;
     println!("wrote {} ({} grains, seed {})", a.out.display(), a.grains, a.seed);
     Ok(())

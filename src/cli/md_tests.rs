@@ -217,6 +217,11 @@ struct CompareRow {
     epsilon_n: f64,
 }
 
+/// The TOML text of a generated scene (invalid parameters are input errors).
+fn text(scene: ballast::Result<MdScene>) -> Result<String, Failure> {
+    scene.map_err(Failure::Input)?.to_toml_string().map_err(Failure::Run)
+}
+
 /// Spheres `(radius, position)` and the built system of a finished run's final scene.
 fn final_state(dir: &Path) -> Result<ballast::md::MdSystem, Failure> {
     let path = dir.join("final_scene.toml");
@@ -246,7 +251,7 @@ pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
             let spec = KarrechSpec { dt, duration, young, ..KarrechSpec::table1(spheres, seed) };
             let scene = args.out.join("deposit.toml");
             if !(args.resume && scene.exists()) {
-                write(&scene, &karrech::deposit_scene(&spec, args.every))?;
+                write(&scene, &text(karrech::deposit_scene(&spec, args.every))?)?;
                 write_spec(
                     &args.out,
                     &TestSpec { spheres, seed, dt: Some(dt), young: Some(young), ..TestSpec::default() },
@@ -266,7 +271,7 @@ pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
             let loading = if mode == Mode::Full { Loading::FULL } else { Loading::PARTIAL };
             let scene = args.out.join("load.toml");
             if !(args.resume && scene.exists()) {
-                write(&scene, &karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, args.every))?;
+                write(&scene, &text(karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, args.every))?)?;
             }
             args.run(&scene)?;
             load_figures(&args.out)
@@ -285,7 +290,7 @@ pub(crate) fn luding_main(cmd: LudingCommand) -> Result<(), Failure> {
             let spec = LudingSpec::paper(spheres, friction, seed);
             let scene = args.out.join("compress.toml");
             if !(args.resume && scene.exists()) {
-                write(&scene, &luding::compression_scene(&spec, duration, args.every))?;
+                write(&scene, &text(luding::compression_scene(&spec, duration, args.every))?)?;
                 write_spec(&args.out, &TestSpec { spheres, seed, friction: Some(friction), ..TestSpec::default() })?;
             }
             args.run(&scene)
@@ -298,7 +303,7 @@ pub(crate) fn luding_main(cmd: LudingCommand) -> Result<(), Failure> {
                 box_corners(&sys).ok_or_else(|| input("luding cycle: the compressed scene has no box".into()))?;
             let scene = args.out.join("cycle.toml");
             if !(args.resume && scene.exists()) {
-                write(&scene, &luding::cyclic_scene(&spec, &spheres_of(&sys), lo, hi, cycles, args.every))?;
+                write(&scene, &text(luding::cyclic_scene(&spec, &spheres_of(&sys), lo, hi, cycles, args.every))?)?;
             }
             if !(args.resume && args.out.join("spec.json").exists()) {
                 let json = TestSpec {

@@ -304,11 +304,10 @@ fn run_stage(scene_path: &Path, dir: &Path, resume: bool, display: &Display) -> 
 
 /// Deposits the sample of `spec` into `out` (`sample.toml`, `sample.json`).
 pub(crate) fn sample(spec: &SampleSpec, out: &Path, resume: bool, display: &Display) -> Result<(), Failure> {
-    let text = sample_scene(spec);
-    Scene::from_toml_str(&text).map_err(Failure::Input)?;
+    let scene = sample_scene(spec).map_err(Failure::Input)?;
     ballast::io::create_output_dir(out).map_err(Failure::Run)?;
     let deposit = out.join("deposit.toml");
-    write(&deposit, &text)?;
+    write_scene(&deposit, &scene, &format!("stage 1 (deposit) of the sample, seed {}", spec.seed))?;
     let mut settled = run_stage(&deposit, &out.join("deposit"), resume, display)?;
     if spec.bank {
         let opened = open_bank(&settled).map_err(Failure::Run)?;

@@ -114,7 +114,9 @@ pub fn loading_for(sample: &Scene, args: &LoadingArgs) -> Result<LoadingSpec, Fa
     }
     let mut scaled = spec.clone().scaled(f);
     if let Some(w) = args.sleeper_width {
+        // The given sleeper keeps its bars.
         scaled.sleeper_width = w;
+        scaled.bar_size = spec.bar_size;
     }
     Ok(scaled)
 }

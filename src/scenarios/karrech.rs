@@ -18,18 +18,25 @@
 //!   top (radius R, Δσ = 14.15 kPa, f = 50 Hz); partially confined, 80 % of the
 //!   top's area (radius R √0.8, Δσ = 5.87 kPa, f = 10 Hz);
 //! - the time step: 1e-7 s (the paper's order of magnitude, §2.3).
+//!
+//! [`deposit_scene`] and [`loading_scene`] build [`MdScene`] values, validated
+//! like a scene file; save them with [`MdScene::to_toml_string`].
 
-use super::md_text::{material, plane, sphere, v3};
+use super::{md_material, md_plane, md_sphere, non_negative, positive, refuse, xyz};
+use crate::error::Result;
 use crate::md::V3;
+use crate::run::Equilibrium;
+use crate::scene::md::{CylinderSpec, DiscSpec, MdContact, MdSection, ServoSpec, SymmetrySpec, WallSpec};
+use crate::scene::{CyclesSpec, MdScene, OutputSection, Simulation};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use std::fmt::Write;
 
 /// Parameters of a Karrech sample.
 #[derive(Debug, Clone, PartialEq)]
 pub struct KarrechSpec {
     pub spheres: usize,
+    /// Mean and standard deviation (m) of the Gaussian of the radii, both > 0.
     pub radius_mean: f64,
     pub radius_sd: f64,
     /// Container radius (m).
@@ -70,32 +77,115 @@ impl KarrechSpec {
             energy_ratio: 1e-6,
         }
     }
+
+    /// The largest radius a sphere can draw (m): mean + 3 sd.
+    pub fn max_radius(&self) -> f64 {
+        self.radius_mean + 3.0 * self.radius_sd
+    }
+
+    /// Checks what every Karrech scene uses: materials, law, container, step.
+    fn check_common(&self, every: u64) -> Result<()> {
+        positive("karrech: radius_mean (m)", self.radius_mean)?;
+        positive("karrech: radius_sd (m)", self.radius_sd)?;
+        positive("karrech: container_radius (m)", self.container_radius)?;
+        positive("karrech: density (kg/m³)", self.density)?;
+        positive("karrech: young (Pa)", self.young)?;
+        if !(self.poisson > -1.0 && self.poisson < 0.5) {
+            return refuse(format!("karrech: poisson must be in (-1, 0.5), got {}", self.poisson));
+        }
+        non_negative("karrech: friction", self.friction)?;
+        non_negative("karrech: alpha", self.alpha)?;
+        positive("karrech: dt (s)", self.dt)?;
+        if every == 0 {
+            return refuse("karrech: every (steps between rows of series.csv) must be at least 1, got 0".into());
+        }
+        Ok(())
+    }
+
+    /// Checks the parameters of the deposit.
+    fn check_deposit(&self, every: u64) -> Result<()> {
+        if self.spheres == 0 {
+            return refuse("karrech: spheres must be at least 1, got 0".into());
+        }
+        self.check_common(every)?;
+        // The largest sphere must fit off both symmetry planes inside the cylinder:
+        // at 45°, its centre at (r, r) is r √2 from the axis, at most R − r.
+        let r = self.max_radius();
+        let need = (1.0 + std::f64::consts::SQRT_2) * r;
+        if self.container_radius < need {
+            return refuse(format!(
+                "karrech: container_radius {} m is too small for the largest sphere (radius_mean + 3 radius_sd = {r} m \
+                 needs at least (1 + √2) × {r} = {need} m)",
+                self.container_radius
+            ));
+        }
+        if !(self.loose_fraction > 0.0 && self.loose_fraction < 1.0) {
+            return refuse(format!("karrech: loose_fraction must be in (0, 1), got {}", self.loose_fraction));
+        }
+        positive("karrech: duration (s)", self.duration)?;
+        positive("karrech: energy_ratio", self.energy_ratio)?;
+        Ok(())
+    }
 }
 
 /// The paper's number of spheres in the quarter sample.
 pub const PAPER_SPHERES: usize = 850;
 
+/// Draws of a position per sphere before [`loose_spheres`] gives up.
+pub const MAX_DRAWS: usize = 100_000;
+
 /// Radii and loose positions, drawn from the seed: random sequential placement
 /// without overlap in the quarter cylinder, up to the height that gives the
 /// loose packing fraction.
-pub fn loose_spheres(spec: &KarrechSpec) -> Vec<(f64, V3)> {
+///
+/// # Errors
+/// [`Error::Scene`](crate::Error::Scene) naming the parameter: one out of range
+/// (see [`deposit_scene`]), a loose layer lower than the largest sphere's
+/// diameter (too few spheres for `loose_fraction`), or a sphere with no free
+/// place after [`MAX_DRAWS`] draws (`loose_fraction` too high to place at random).
+pub fn loose_spheres(spec: &KarrechSpec) -> Result<Vec<(f64, V3)>> {
+    spec.check_deposit(1)?;
     let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
-    let normal = Normal::new(spec.radius_mean, spec.radius_sd).expect("finite sd");
+    let normal = Normal::new(spec.radius_mean, spec.radius_sd)
+        .map_err(|e| crate::Error::Scene(format!("karrech: radius_mean, radius_sd: {e}")))?;
     let (lo, hi) = (spec.radius_mean - 3.0 * spec.radius_sd, spec.radius_mean + 3.0 * spec.radius_sd);
-    let radii: Vec<f64> = (0..spec.spheres)
-        .map(|_| loop {
-            let r: f64 = normal.sample(&mut rng);
-            if r > lo.max(0.1 * spec.radius_mean) && r < hi {
-                break r;
-            }
-        })
-        .collect();
+    let mut radii = Vec::with_capacity(spec.spheres);
+    for _ in 0..spec.spheres {
+        // Accepted with probability > 0.49 (at least the half above the mean, to
+        // mean + 3 sd): the bound is never reached in practice.
+        let r = (0..MAX_DRAWS)
+            .map(|_| normal.sample(&mut rng))
+            .find(|&r: &f64| r > lo.max(0.1 * spec.radius_mean) && r < hi);
+        match r {
+            Some(r) => radii.push(r),
+            None => return refuse(format!("karrech: radius_sd: no radius in range after {MAX_DRAWS} draws")),
+        }
+    }
     let volume: f64 = radii.iter().map(|r| 4.0 / 3.0 * std::f64::consts::PI * r * r * r).sum();
     let section = std::f64::consts::PI * spec.container_radius.powi(2) / 4.0;
     let height = volume / (spec.loose_fraction * section);
+    let r_max = radii.iter().copied().fold(0.0, f64::max);
+    if height < 2.0 * r_max {
+        return refuse(format!(
+            "karrech: spheres: the loose layer of {} spheres at loose_fraction {} is {height} m high, lower than the \
+             largest sphere's diameter {} m; use more spheres or a lower loose_fraction",
+            spec.spheres,
+            spec.loose_fraction,
+            2.0 * r_max
+        ));
+    }
     let mut placed: Vec<(f64, V3)> = Vec::with_capacity(radii.len());
-    for &r in &radii {
+    for (k, &r) in radii.iter().enumerate() {
+        let mut draws = 0;
         loop {
+            if draws == MAX_DRAWS {
+                return refuse(format!(
+                    "karrech: loose_fraction {}: no free place for sphere {k} of {} after {MAX_DRAWS} draws; lower \
+                     loose_fraction",
+                    spec.loose_fraction, spec.spheres
+                ));
+            }
+            draws += 1;
             let rho = (spec.container_radius - r) * rng.random::<f64>().sqrt();
             let phi = 0.5 * std::f64::consts::PI * rng.random::<f64>();
             let z = r + (height - 2.0 * r) * rng.random::<f64>();
@@ -110,52 +200,97 @@ pub fn loose_spheres(spec: &KarrechSpec) -> Vec<(f64, V3)> {
             }
         }
     }
-    placed
+    Ok(placed)
 }
 
 /// The common part of the Karrech scenes: simulation header, materials, law,
-/// symmetry planes, base and cylinder.
-fn header(out: &mut String, spec: &KarrechSpec, duration: f64, equilibrium: bool, every: u64) {
-    let _ = writeln!(
-        out,
-        "[simulation]\nengine = \"md\"\ndimension = 3\ndt = {:?}\nduration = {duration:?}\ngravity = [0.0, 0.0, -9.81]\nseed = {}",
-        spec.dt, spec.seed
-    );
-    if equilibrium {
-        let _ = writeln!(out, "equilibrium = {{ energy_ratio = {:?}, steps = 1000 }}", spec.energy_ratio);
+/// symmetry planes, base and cylinder; no sphere.
+fn common(spec: &KarrechSpec, duration: f64, equilibrium: bool, every: u64) -> MdScene {
+    let contact = |other: &str| MdContact {
+        between: ["diorite".into(), other.into()],
+        model: "hertz".into(),
+        friction: Some(spec.friction),
+        static_friction: None,
+        dynamic_friction: None,
+        restitution: None,
+        normal_damping_ratio: Some(spec.alpha),
+        tangential_damping_ratio: Some(spec.alpha),
+        normal_stiffness: None,
+        tangential_stiffness: None,
+        normal_damping: None,
+        tangential_damping: None,
+    };
+    MdScene {
+        simulation: Simulation {
+            engine: "md".into(),
+            dimension: Some(3),
+            dt: spec.dt,
+            duration,
+            gravity: Some(vec![0.0, 0.0, -9.81]),
+            thickness: None,
+            seed: Some(spec.seed),
+            equilibrium: equilibrium.then_some(Equilibrium {
+                kinetic_energy: None,
+                energy_ratio: Some(spec.energy_ratio),
+                steps: Some(1000),
+            }),
+        },
+        md: Some(MdSection {
+            integrator: Some("gear".into()),
+            gear: Some("karrech".into()),
+            skin: Some(0.2 * spec.radius_mean),
+            ..MdSection::default()
+        }),
+        output: Some(OutputSection { every: Some(every), cycles: None }),
+        symmetry: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+            .into_iter()
+            .map(|normal| SymmetrySpec { point: [0.0; 3], normal })
+            .collect(),
+        materials: vec![
+            md_material("diorite", spec.density, spec.young, spec.poisson),
+            md_material("steel", 7850.0, 210e9, 0.3),
+        ],
+        contacts: vec![contact("diorite"), contact("steel")],
+        walls: vec![
+            md_plane("base".into(), "steel", V3::zeros(), V3::new(0.0, 0.0, 1.0), None),
+            WallSpec {
+                name: "cylinder".into(),
+                material: "steel".into(),
+                plane: None,
+                disc: None,
+                cylinder: Some(CylinderSpec {
+                    axis_point: [0.0; 3],
+                    axis: [0.0, 0.0, 1.0],
+                    radius: spec.container_radius,
+                }),
+                servo: None,
+            },
+        ],
+        bodies: Vec::new(),
     }
-    let _ = writeln!(out, "\n[md]\nintegrator = \"gear\"\ngear = \"karrech\"\nskin = {:?}\n", 0.2 * spec.radius_mean);
-    let _ = writeln!(out, "[output]\nevery = {every}\n");
-    for normal in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
-        let _ = writeln!(out, "[[symmetry]]\npoint = [0.0, 0.0, 0.0]\nnormal = {}\n", v3(V3::from(normal)));
-    }
-    material(out, "diorite", spec.density, spec.young, spec.poisson);
-    material(out, "steel", 7850.0, 210e9, 0.3);
-    for other in ["diorite", "steel"] {
-        let _ = writeln!(
-            out,
-            "[[contact]]\nbetween = [\"diorite\", \"{other}\"]\nmodel = \"hertz\"\nfriction = {:?}\nnormal_damping_ratio = {:?}\ntangential_damping_ratio = {:?}\n",
-            spec.friction, spec.alpha, spec.alpha
-        );
-    }
-    plane(out, "base", "steel", V3::zeros(), V3::new(0.0, 0.0, 1.0), None);
-    let _ = writeln!(
-        out,
-        "[[wall]]\nname = \"cylinder\"\nmaterial = \"steel\"\ncylinder = {{ axis_point = [0.0, 0.0, 0.0], axis = [0.0, 0.0, 1.0], radius = {:?} }}\n",
-        spec.container_radius
-    );
 }
 
 /// The deposit scene: loose spheres falling in the quarter cylinder, run until
-/// `E_c/E_p ≤ energy_ratio` (or `duration`); a row of `series.csv` every `every` steps.
-pub fn deposit_scene(spec: &KarrechSpec, every: u64) -> String {
-    let mut out =
-        String::from("# Karrech et al. (2007) sample, Table 1: deposit under gravity (ballast karrech deposit).\n\n");
-    header(&mut out, spec, spec.duration, true, every);
-    for (k, (r, x)) in loose_spheres(spec).into_iter().enumerate() {
-        sphere(&mut out, &format!("g{k}"), "diorite", r, x, None);
-    }
-    out
+/// `E_c/E_p ≤ energy_ratio` (or `duration`); a row of `series.csv` every `every`
+/// steps. Validated like a scene file.
+///
+/// # Errors
+/// [`Error::Scene`](crate::Error::Scene) naming the parameter: no sphere, a
+/// radius mean or spread, container radius, material constant, time step,
+/// duration or energy ratio that is not positive and finite (Poisson's ratio
+/// outside (−1, 0.5), a negative friction or damping ratio), a container too
+/// small for the largest sphere (mean + 3 sd), `every` = 0, and the placement
+/// errors of [`loose_spheres`].
+pub fn deposit_scene(spec: &KarrechSpec, every: u64) -> Result<MdScene> {
+    spec.check_deposit(every)?;
+    let mut scene = common(spec, spec.duration, true, every);
+    scene.bodies = loose_spheres(spec)?
+        .into_iter()
+        .enumerate()
+        .map(|(k, (r, x))| md_sphere(format!("g{k}"), "diorite", r, x))
+        .collect();
+    scene.validate()?;
+    Ok(scene)
 }
 
 /// Loading modes of §4.
@@ -178,29 +313,57 @@ impl Loading {
 
 /// The loading scene: the deposited spheres `(radius, position)` under a plate
 /// resting on the highest sphere top, pressed by `σ(t)` for `cycles` cycles.
-pub fn loading_scene(spec: &KarrechSpec, spheres: &[(f64, V3)], loading: Loading, cycles: u32, every: u64) -> String {
-    let mut out = format!(
-        "# Karrech et al. (2007) sample under a cyclic plate load: coverage {}, Δσ = {} Pa, f = {} Hz \
-         (ballast karrech load).\n\n",
-        loading.coverage, loading.amplitude, loading.frequency
-    );
+/// Validated like a scene file.
+///
+/// # Errors
+/// [`Error::Scene`](crate::Error::Scene) naming the parameter: no sphere, a
+/// coverage outside (0, 1], an amplitude that is not finite, a frequency that is
+/// not positive, no cycle, `every` = 0, the material, law and step parameters of
+/// `spec` as in [`deposit_scene`], and a sphere the scene validation refuses.
+pub fn loading_scene(
+    spec: &KarrechSpec,
+    spheres: &[(f64, V3)],
+    loading: Loading,
+    cycles: u32,
+    every: u64,
+) -> Result<MdScene> {
+    spec.check_common(every)?;
+    if spheres.is_empty() {
+        return refuse("karrech: loading_scene: the sample has no sphere".into());
+    }
+    if !(loading.coverage > 0.0 && loading.coverage <= 1.0) {
+        return refuse(format!("karrech: loading coverage must be in (0, 1], got {}", loading.coverage));
+    }
+    super::finite("karrech: loading amplitude (Pa)", loading.amplitude)?;
+    positive("karrech: loading frequency (Hz)", loading.frequency)?;
+    if cycles == 0 {
+        return refuse("karrech: cycles must be at least 1, got 0".into());
+    }
     let duration = cycles as f64 / loading.frequency;
-    header(&mut out, spec, duration, false, every);
+    let mut scene = common(spec, duration, false, every);
     let top = spheres.iter().map(|(r, x)| x[2] + r).fold(0.0, f64::max);
     let radius = spec.container_radius * loading.coverage.sqrt();
     let area = std::f64::consts::PI * radius * radius / 4.0;
     let mass = 7850.0 * 0.01 * area;
-    let _ = writeln!(
-        out,
-        "[[wall]]\nname = \"plate\"\nmaterial = \"steel\"\ndisc = {{ point = {}, normal = [0.0, 0.0, -1.0], radius = {radius:?} }}\n\
-         servo = {{ mass = {mass:?}, viscosity = 0.0, stress = 0.0, amplitude = {:?}, period = {:?}, area = {area:?} }}\n",
-        v3(V3::new(0.0, 0.0, top)),
-        loading.amplitude,
-        1.0 / loading.frequency
-    );
-    let _ = writeln!(out, "[output.cycles]\nfrequency = {:?}\n", loading.frequency);
-    for (k, (r, x)) in spheres.iter().enumerate() {
-        sphere(&mut out, &format!("g{k}"), "diorite", *r, *x, None);
-    }
-    out
+    scene.walls.push(WallSpec {
+        name: "plate".into(),
+        material: "steel".into(),
+        plane: None,
+        disc: Some(DiscSpec { point: xyz(V3::new(0.0, 0.0, top)), normal: [0.0, 0.0, -1.0], radius }),
+        cylinder: None,
+        servo: Some(ServoSpec {
+            mass,
+            viscosity: 0.0,
+            stress: Some(0.0),
+            force: None,
+            amplitude: Some(loading.amplitude),
+            period: Some(1.0 / loading.frequency),
+            area: Some(area),
+        }),
+    });
+    scene.output.get_or_insert_with(OutputSection::default).cycles =
+        Some(CyclesSpec { frequency: loading.frequency, body: None, positions: None });
+    scene.bodies = spheres.iter().enumerate().map(|(k, &(r, x))| md_sphere(format!("g{k}"), "diorite", r, x)).collect();
+    scene.validate()?;
+    Ok(scene)
 }

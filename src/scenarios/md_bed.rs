@@ -7,7 +7,13 @@
 //! horizontal velocities in ±2.5 cm/s, settling under gravity with velocity
 //! Verlet at Δt = 5 µs and a 1 mm skin. The random numbers are ours (ChaCha8
 //! from `seed`), the distributions the peers'.
+//!
+//! The bed is built directly as an [`MdSystem`] (it is a benchmark of the
+//! engine, with no scene file); a spec with no sphere or a box too narrow for
+//! one lattice site is an [`Error::Scene`](crate::Error::Scene).
 
+use super::refuse;
+use crate::error::Result;
 use crate::md::{self, Ghosts, LawTable, Material, MdSettings, MdSystem, Particles, Shape, Wall, V3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -51,10 +57,27 @@ pub const DT: f64 = 5e-6;
 /// Neighbour skin (m).
 pub const SKIN: f64 = 1e-3;
 
+/// Distance (m) of the first lattice site from the walls `x = 0`, `y = 0`.
+const ORIGIN: f64 = 0.4959 * SPACING;
+
+/// The narrowest box (m) that holds one lattice site 6 mm (the largest radius)
+/// inside its walls, as the peers' region.
+pub const MIN_SIDE: f64 = ORIGIN + 0.006;
+
 /// The spheres of the bed on their lattice.
-pub fn bed_spheres(spec: &BedSpec) -> Vec<SphereSpec> {
+///
+/// # Errors
+/// [`Error::Scene`](crate::Error::Scene): no sphere, or a side that is not finite
+/// or below [`MIN_SIDE`].
+pub fn bed_spheres(spec: &BedSpec) -> Result<Vec<SphereSpec>> {
+    if spec.n == 0 {
+        return refuse("md_bed: n (spheres) must be at least 1, got 0".into());
+    }
+    if !(spec.side.is_finite() && spec.side >= MIN_SIDE) {
+        return refuse(format!("md_bed: side must be at least {MIN_SIDE} m (one lattice site), got {} m", spec.side));
+    }
     let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
-    let origin = 0.4959 * SPACING;
+    let origin = ORIGIN;
     let per_row = ((spec.side - 0.006 - origin) / SPACING).floor() as usize + 1;
     let mut out = Vec::with_capacity(spec.n);
     'fill: for k in 0.. {
@@ -75,7 +98,7 @@ pub fn bed_spheres(spec: &BedSpec) -> Vec<SphereSpec> {
             }
         }
     }
-    out
+    Ok(out)
 }
 
 /// The five walls of the bed: `(name, shape)`.
@@ -91,9 +114,12 @@ pub fn bed_walls(side: f64) -> Vec<(&'static str, Shape)> {
 }
 
 /// The bed as a system ready to settle.
-pub fn bed_system(spec: &BedSpec) -> MdSystem {
+///
+/// # Errors
+/// Those of [`bed_spheres`].
+pub fn bed_system(spec: &BedSpec) -> Result<MdSystem> {
     let mut p = Particles::default();
-    for (k, s) in bed_spheres(spec).iter().enumerate() {
+    for (k, s) in bed_spheres(spec)?.iter().enumerate() {
         p.push(&format!("s{k}"), 0, MATERIAL.density, s.radius, s.position, s.velocity, V3::zeros());
     }
     let mut laws = LawTable::new(1);
@@ -109,7 +135,7 @@ pub fn bed_system(spec: &BedSpec) -> MdSystem {
         background_damping: 0.0,
         background_rotational_damping: 0.0,
     };
-    MdSystem::new(settings, p, walls, laws, Ghosts::new(Vec::new()))
+    Ok(MdSystem::new(settings, p, walls, laws, Ghosts::new(Vec::new())))
 }
 
 /// Height of the highest sphere centre (m): the peers' settled-bed figure.

@@ -2,7 +2,8 @@
 //! deposited under gravity on a viscoelastic sublayer, then a rigid sleeper with
 //! bars under its lower face, loaded by `F = A + B cos(2π f t − φ)`.
 //!
-//! Two stages, each a plain scene (TOML text) run by `ballast run`, so that every
+//! Two stages, each a plain [`Scene`] value, validated like a scene file and
+//! saved with [`Scene::to_toml_string`] to be run by `ballast run`, so that every
 //! stage is saved, validated and rerun like a hand-written scene:
 //! 1. [`sample_scene`]: the loose sample above the sublayer, between two side
 //!    walls, to deposit until equilibrium. With [`SampleSpec::bank`] the side walls
@@ -19,12 +20,17 @@
 //! is a 20 × 10 mm rigid block on one spring of law (17) of rest length 10 mm
 //! with `k_N` = 4100 N per unit strain and `ν` = 80 N·s, moving vertically only.
 
+use super::{body, finite, non_negative, positive, rect, refuse, validated};
 use crate::error::{Error, Result};
-use crate::scene::{BodySpec, Scene};
+use crate::nscd::Policy;
+use crate::run::Equilibrium;
+use crate::scene::{
+    BodySpec, ContactEntry, Drive, ImposedSpec, LoadSpec, Material, NscdSection, OutputSection, RegularSpec, Scene,
+    Simulation, SpringSpec,
+};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::PI;
-use std::fmt::Write;
 
 /// Names of the bodies the stages look for.
 pub const SLEEPER: &str = "sleeper";
@@ -34,6 +40,14 @@ pub const PAD_PREFIX: &str = "pad";
 pub const GRAIN_PREFIX: &str = "g";
 /// Names of the mould walls removed by [`open_bank`].
 pub const MOULD: [&str; 2] = ["mould_left", "mould_right"];
+
+/// The fewest grains the paper's sample can be [scaled](SampleSpec::scaled) to:
+/// the scaled width `n / 724` m must hold the largest grain (2 × 10 mm + 2 × 1 mm
+/// of clearance = 22 mm, `n ≥ 15.9`), and [`sample_scene`] refuses a narrower
+/// one. Fewer grains gave a box narrower than a grain (the grains started inside
+/// the walls and the deposit diverged at its first step) and, for a width below
+/// two pad gaps (2 mm, one grain), pads of negative width (a clockwise polygon).
+pub const MIN_SCALED_GRAINS: usize = 16;
 
 /// The sample of stage 1.
 #[derive(Debug, Clone, PartialEq)]
@@ -88,8 +102,12 @@ impl SampleSpec {
         }
     }
 
-    /// The same grading scaled to about `n` grains in the proportions 361 : 242 : 121,
-    /// and the width scaled to keep the layer's thickness (for quick tests).
+    /// The same grading scaled to about `n` grains in the proportions 361 : 242 : 121
+    /// (at least one of each size), and the width scaled by `n` over the grading's
+    /// number of grains (724 for the paper's) to keep the layer's thickness (for
+    /// quick tests). The width must still hold the largest grain
+    /// ([`SampleSpec::min_width`], 22 mm for the paper's grading): below
+    /// [`MIN_SCALED_GRAINS`] grains it does not, and [`sample_scene`] refuses the spec.
     pub fn scaled(mut self, n: usize) -> Self {
         let total: usize = self.grading.iter().map(|g| g.1).sum();
         let f = n as f64 / total as f64;
@@ -98,58 +116,99 @@ impl SampleSpec {
         self
     }
 
+    /// The narrowest `width` (m) that holds the largest grain between the walls:
+    /// its circumscribed diameter and [`CLEARANCE`] on each side.
+    pub fn min_width(&self) -> f64 {
+        let r_max = self.grading.iter().filter(|g| g.1 > 0).map(|g| g.0).fold(0.0, f64::max);
+        2.0 * r_max + 2.0 * CLEARANCE
+    }
+
+    /// Width of the frame and of the sublayer (m): `width`, plus `bank_margin` on
+    /// each side with `bank`.
+    pub fn frame_width(&self) -> f64 {
+        if self.bank {
+            self.width + 2.0 * self.bank_margin
+        } else {
+            self.width
+        }
+    }
+
     /// Total solid area of the grains (m²): a regular pentagon of circumradius r has area (5/2) r² sin 72°.
     pub fn solid_area(&self) -> f64 {
         self.grading.iter().map(|&(r, n)| n as f64 * 2.5 * r * r * (0.4 * PI).sin()).sum()
     }
 }
 
-/// One rectangle `[x0, x1] × [y0, y1]` as a counter-clockwise polygon literal.
-fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> String {
-    format!("[[{x0:?}, {y0:?}], [{x1:?}, {y0:?}], [{x1:?}, {y1:?}], [{x0:?}, {y1:?}]]")
+/// Gap (m) between neighbouring grains of a row, and between rows, at the start
+/// of the deposit (and between a row's ends and the walls).
+pub const CLEARANCE: f64 = 0.001;
+
+/// Checks the sample `spec`; returns the number of grains.
+fn check_sample(spec: &SampleSpec) -> Result<usize> {
+    let (n, r_min, r_max) = super::grading("sample", &spec.grading)?;
+    let width = positive("sample: width (m)", spec.width)?;
+    let min_width = spec.min_width();
+    if width < min_width {
+        return refuse(format!(
+            "sample: width {width} m cannot hold the largest grain (at least 2 × {r_max} m + 2 × {CLEARANCE} m =              {min_width} m; a grading scaled to fewer than {MIN_SCALED_GRAINS} grains is too narrow)"
+        ));
+    }
+    let pad_width = positive("sample: pad_width (m)", spec.pad_width)?;
+    positive("sample: pad_height (m)", spec.pad_height)?;
+    let gap = non_negative("sample: pad_gap (m)", spec.pad_gap)?;
+    if 2.0 * gap >= pad_width {
+        return refuse(format!("sample: pad_gap {gap} m must be less than half the pad_width {pad_width} m"));
+    }
+    if spec.bank {
+        non_negative("sample: bank_margin (m)", spec.bank_margin)?;
+        // The mould stands 1 mm above the pads: the grains must not pass under it.
+        let inradius = r_min * (PI / 5.0).cos();
+        if inradius <= MOULD_GAP {
+            return refuse(format!(
+                "sample: grading: with a bank, the smallest grain (inradius {inradius} m) would pass under the mould                  ({MOULD_GAP} m above the pads)"
+            ));
+        }
+    }
+    // The frame holds at least one pad with its gaps (the sample's width does:
+    // it holds a grain of 2 r_max ≥ pad_width + 2 pad_gap for the paper's values).
+    let frame = spec.frame_width();
+    if frame < pad_width + 2.0 * gap {
+        return refuse(format!(
+            "sample: width {frame} m of the frame cannot hold one pad (pad_width {pad_width} m + 2 × pad_gap {gap} m)"
+        ));
+    }
+    positive("sample: spring_length (m)", spec.spring_length)?;
+    non_negative("sample: k_n (N)", spec.k_n)?;
+    non_negative("sample: nu (N·s)", spec.nu)?;
+    positive("sample: density (kg/m³)", spec.density)?;
+    non_negative("sample: friction", spec.friction)?;
+    positive("sample: dt (s)", spec.dt)?;
+    positive("sample: max_duration (s)", spec.max_duration)?;
+    Ok(n)
 }
 
+/// Height (m) of the mould's lower edge above the pads' top faces.
+const MOULD_GAP: f64 = 0.001;
+
 /// The stage-1 scene: loose grains above the sublayer, to deposit until
-/// equilibrium (kinetic energy below 1e-11 J per grain for 500 steps).
-pub fn sample_scene(spec: &SampleSpec) -> String {
+/// equilibrium (kinetic energy below 1e-11 J per grain for 500 steps),
+/// validated like a scene file.
+///
+/// # Errors
+/// [`Error::Scene`] naming the parameter: a grading without grains or with a
+/// radius that is not positive, a `width` narrower than [`SampleSpec::min_width`]
+/// (a grading [scaled](SampleSpec::scaled) to fewer than [`MIN_SCALED_GRAINS`]
+/// grains), pads that do not fit, with `bank` a smallest grain that would pass
+/// under the mould (1 mm above the pads), a size, stiffness, density, time step or
+/// duration that is not positive (or, for `pad_gap`, `bank_margin`, `k_n`, `nu`
+/// and `friction`, non-negative) and finite.
+pub fn sample_scene(spec: &SampleSpec) -> Result<Scene> {
+    let n = check_sample(spec)?;
     let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
     let radii = super::deposit::shuffled_radii(&spec.grading, &mut rng);
-    let n = radii.len();
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "# Saussine et al. (2006) ballast sample, stage 1 (deposit): {n} pentagons, seed {}, {}.\n\
-         # Geometry and reasoning: data/saussine2006/README.md.\n",
-        spec.seed,
-        if spec.bank { "mould for a free bank" } else { "between side walls" }
-    );
-    let _ = writeln!(
-        s,
-        "[simulation]\nengine = \"nscd\"\ndt = {:?}\nduration = {:?}\ngravity = [0.0, -9.81]\nthickness = 1.0\n\
-         seed = {}\nequilibrium = {{ kinetic_energy = {:?}, steps = 500 }}\n",
-        spec.dt,
-        spec.max_duration,
-        spec.seed,
-        1e-11 * n as f64
-    );
-    let _ = writeln!(
-        s,
-        "[nscd]\ntheta = 0.5\ncriterion = \"quad_max\"\ntolerance = 1.0e-4\nmax_iterations = 2000\n\n\
-         [output]\nevery = 50\n"
-    );
-    for (name, rho) in [("ballast", spec.density), ("elastomer", 1100.0), ("frame", 2400.0)] {
-        let _ = writeln!(s, "[[material]]\nname = \"{name}\"\ndensity = {rho:?}\n");
-    }
-    // Grain–grain and grain–sublayer contacts have the paper's μ; the frame's side
-    // walls are smooth (μ = 0), so that the sublayer alone carries the weight (no
-    // Janssen share on the walls; measured with μ = 0.5 walls: −1.3 % of the weight,
-    // held down by the walls after the sublayer's rebound).
-    for (other, mu) in [("ballast", spec.friction), ("elastomer", spec.friction), ("frame", 0.0)] {
-        let _ = writeln!(s, "[[contact]]\nbetween = [\"ballast\", \"{other}\"]\nfriction = {mu:?}\n");
-    }
 
     // Sublayer: pads side by side over the frame's width, top faces at y = 0.
-    let frame = if spec.bank { spec.width + 2.0 * spec.bank_margin } else { spec.width };
+    let frame = spec.frame_width();
     let pitch = spec.pad_width + spec.pad_gap;
     let pads = ((frame + spec.pad_gap) / pitch).floor().max(1.0) as usize;
     let pad_w = (frame - spec.pad_gap * (pads as f64 + 1.0)) / pads as f64;
@@ -159,8 +218,9 @@ pub fn sample_scene(spec: &SampleSpec) -> String {
 
     // Grains: rows filled left to right inside the deposit walls, each grain
     // 1 mm from its neighbours, rows one largest diameter + 1 mm apart: a loose
-    // but compact start, so the layer falls only a few centimetres.
-    let clearance = 0.001;
+    // but compact start, so the layer falls only a few centimetres. The width
+    // holds the largest grain (checked), so every row has at least one grain.
+    let clearance = CLEARANCE;
     let (left, right) = (-spec.width / 2.0, spec.width / 2.0);
     let mut placed = Vec::with_capacity(n);
     let (mut x, mut y_row, mut row_r) = (left, ph.max(0.0) + clearance, 0.0f64);
@@ -193,42 +253,90 @@ pub fn sample_scene(spec: &SampleSpec) -> String {
     let mut walls =
         vec![("left_wall", rect(fl - t, bottom, fl, wall_top)), ("right_wall", rect(fr, bottom, fr + t, wall_top))];
     if spec.bank {
-        // The mould stands 1 mm above the pads (grains, inradius ≥ 4 mm, cannot pass).
-        walls.push((MOULD[0], rect(left - t, 0.001, left, wall_top)));
-        walls.push((MOULD[1], rect(right, 0.001, right + t, wall_top)));
+        // The mould stands 1 mm above the pads (checked: the grains cannot pass).
+        walls.push((MOULD[0], rect(left - t, MOULD_GAP, left, wall_top)));
+        walls.push((MOULD[1], rect(right, MOULD_GAP, right + t, wall_top)));
     }
+    let mut bodies = Vec::with_capacity(walls.len() + pads + n);
     for (name, poly) in walls {
-        let _ = writeln!(s, "[[body]]\nname = \"{name}\"\nmaterial = \"frame\"\npolygon = {poly}\nposition = [0.0, 0.0]\nfixed = true\n");
+        bodies.push(BodySpec { polygon: Some(poly), fixed: Some(true), ..body(name, "frame", [0.0, 0.0]) });
     }
+    let zero = Some(Drive::Constant(0.0));
     for k in 0..pads {
-        let xc = pad_x(k);
-        let poly = rect(-pad_w / 2.0, -ph / 2.0, pad_w / 2.0, ph / 2.0);
-        let _ = writeln!(
-            s,
-            "[[body]]\nname = \"{PAD_PREFIX}{k}\"\nmaterial = \"elastomer\"\npolygon = {poly}\nposition = [{xc:?}, {:?}]\n\
-             imposed = {{ vx = 0.0, spin = 0.0 }}\n",
-            -ph / 2.0
-        );
+        bodies.push(BodySpec {
+            polygon: Some(rect(-pad_w / 2.0, -ph / 2.0, pad_w / 2.0, ph / 2.0)),
+            imposed: Some(ImposedSpec { vx: zero, vy: None, spin: zero }),
+            ..body(format!("{PAD_PREFIX}{k}"), "elastomer", [pad_x(k), -ph / 2.0])
+        });
     }
     for (k, &(xc, yc, r)) in placed.iter().enumerate() {
         let angle = 2.0 * PI * rng.random::<f64>();
         let v = [0.02 * rng.random_range(-1.0..1.0), 0.02 * rng.random_range(-1.0..1.0)];
-        let _ = writeln!(
-            s,
-            "[[body]]\nname = \"{GRAIN_PREFIX}{k}\"\nmaterial = \"ballast\"\nregular = {{ sides = 5, radius = {r:?} }}\n\
-             position = [{xc:?}, {yc:?}]\nangle = {angle:?}\nvelocity = [{:?}, {:?}]\n",
-            v[0], v[1]
-        );
+        bodies.push(BodySpec {
+            regular: Some(RegularSpec { sides: 5, radius: r }),
+            angle: Some(angle),
+            velocity: Some(v),
+            ..body(format!("{GRAIN_PREFIX}{k}"), "ballast", [xc, yc])
+        });
     }
-    for k in 0..pads {
-        let xc = pad_x(k);
-        let _ = writeln!(
-            s,
-            "[[spring]]\nbody = \"{PAD_PREFIX}{k}\"\nanchor = [{xc:?}, {y_anchor:?}]\nk_n = {:?}\nnu = {:?}\nrest_length = {l0:?}\n",
-            spec.k_n, spec.nu
-        );
-    }
-    s
+    let springs = (0..pads)
+        .map(|k| SpringSpec {
+            body: format!("{PAD_PREFIX}{k}"),
+            point: None,
+            anchor: Some([pad_x(k), y_anchor]),
+            other: None,
+            other_point: None,
+            k_n: spec.k_n,
+            nu: Some(spec.nu),
+            rest_length: Some(l0),
+            prestrain: None,
+            compression_only: None,
+        })
+        .collect();
+    // Grain–grain and grain–sublayer contacts have the paper's μ; the frame's side
+    // walls are smooth (μ = 0), so that the sublayer alone carries the weight (no
+    // Janssen share on the walls; measured with μ = 0.5 walls: −1.3 % of the weight,
+    // held down by the walls after the sublayer's rebound).
+    let contacts = [("ballast", spec.friction), ("elastomer", spec.friction), ("frame", 0.0)]
+        .into_iter()
+        .map(|(other, friction)| ContactEntry {
+            between: ["ballast".into(), other.into()],
+            friction,
+            restitution: None,
+            tangential_restitution: None,
+        })
+        .collect();
+    validated(Scene {
+        simulation: Simulation {
+            engine: "nscd".into(),
+            dt: spec.dt,
+            duration: spec.max_duration,
+            gravity: Some(vec![0.0, -9.81]),
+            dimension: None,
+            thickness: Some(1.0),
+            seed: Some(spec.seed),
+            equilibrium: Some(Equilibrium {
+                kinetic_energy: Some(1e-11 * n as f64),
+                energy_ratio: None,
+                steps: Some(500),
+            }),
+        },
+        nscd: Some(NscdSection {
+            theta: Some(0.5),
+            criterion: Some("quad_max".into()),
+            tolerance: Some(1.0e-4),
+            max_iterations: Some(2000),
+            ..NscdSection::default()
+        }),
+        output: Some(OutputSection { every: Some(50), cycles: None }),
+        materials: [("ballast", spec.density), ("elastomer", 1100.0), ("frame", 2400.0)]
+            .into_iter()
+            .map(|(name, density)| Material { name: name.into(), density })
+            .collect(),
+        contacts,
+        bodies,
+        springs,
+    })
 }
 
 /// Stage 1b of a free-bank sample: the deposited sample without its mould, to be
@@ -320,12 +428,84 @@ impl LoadingSpec {
     }
 
     /// For a sample scaled by `f` in width ([`SampleSpec::scaled`]): the sleeper's
-    /// width and the load scaled by `f`, so the pressure under the sleeper is the same.
+    /// width and the load scaled by `f`, so the pressure under the sleeper is the
+    /// same. The bars keep their size (that of the smallest grains) while the
+    /// scaled sleeper holds them ([`LoadingSpec::min_sleeper_width`]: a sample of
+    /// at least 116 grains for the paper's sleeper); on a narrower sleeper they
+    /// are narrowed with it to `sleeper_width / (2 bars + 1)`, one bar width from
+    /// the ends and from each other (before, [`loaded_scene`] refused the sleeper
+    /// of any sample of fewer than 116 grains).
     pub fn scaled(mut self, f: f64) -> Self {
         self.sleeper_width *= f;
         self.mean *= f;
         self.amplitude *= f;
+        if self.bars > 0 && self.sleeper_width < self.min_sleeper_width() {
+            self.bar_size = self.sleeper_width / (2 * self.bars + 1) as f64;
+        }
         self
+    }
+
+    /// The narrowest sleeper (m) that holds its bars, `(bars + 2) × bar_size`: the
+    /// outer bars one bar width in from the ends, the bars side by side at the
+    /// closest (0 without bars).
+    pub fn min_sleeper_width(&self) -> f64 {
+        if self.bars == 0 {
+            0.0
+        } else {
+            (self.bars + 2) as f64 * self.bar_size
+        }
+    }
+
+    /// Checks every parameter (one-line errors naming it).
+    fn check(&self) -> Result<()> {
+        let w = positive("loaded_scene: sleeper_width (m)", self.sleeper_width)?;
+        positive("loaded_scene: sleeper_height (m)", self.sleeper_height)?;
+        positive("loaded_scene: sleeper_density (kg/m³)", self.sleeper_density)?;
+        if self.bars > 0 {
+            let b = positive("loaded_scene: bar_size (m)", self.bar_size)?;
+            if w < self.min_sleeper_width() {
+                return refuse(format!(
+                    "loaded_scene: a sleeper {w} m wide is too narrow for {} bars of {b} m (at least {} m); use fewer bars",
+                    self.bars,
+                    self.min_sleeper_width()
+                ));
+            }
+        }
+        finite("loaded_scene: mean (N)", self.mean)?;
+        finite("loaded_scene: amplitude (N)", self.amplitude)?;
+        positive("loaded_scene: frequency (Hz)", self.frequency)?;
+        finite("loaded_scene: phase (rad)", self.phase)?;
+        if !(self.inclination_deg.is_finite() && self.inclination_deg.abs() < 90.0) {
+            return refuse(format!(
+                "loaded_scene: inclination_deg must be in (-90, 90) degrees, got {}",
+                self.inclination_deg
+            ));
+        }
+        positive("loaded_scene: stiffness_factor", self.stiffness_factor)?;
+        if self.cycles == 0 {
+            return refuse("loaded_scene: cycles must be at least 1, got 0".into());
+        }
+        positive("loaded_scene: dt (s)", self.dt)?;
+        if ![Policy::Strict, Policy::Quad, Policy::QuadMax, Policy::Energy].iter().any(|p| p.name() == self.criterion) {
+            return refuse(format!(
+                "loaded_scene: criterion '{}' is not one of 'strict', 'quad', 'quad_max', 'energy'",
+                self.criterion
+            ));
+        }
+        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
+            return refuse(format!("loaded_scene: tolerance must be in (0, 1), got {}", self.tolerance));
+        }
+        if self.min_iterations == 0 || self.max_iterations < self.min_iterations {
+            return refuse(format!(
+                "loaded_scene: min_iterations must be at least 1 and max_iterations at least min_iterations, got {} \
+                 and {}",
+                self.min_iterations, self.max_iterations
+            ));
+        }
+        if self.output_every == 0 {
+            return refuse("loaded_scene: output_every must be at least 1, got 0".into());
+        }
+        Ok(())
     }
 }
 
@@ -352,7 +532,12 @@ fn surface_under(sample: &Scene, sys: &crate::nscd::System, x0: f64, x1: f64) ->
 
 /// The stage-2 scene: `sample` (a deposited sample, e.g. the `final_scene.toml`
 /// of stage 1) with the sleeper on top at x = 0, its bars resting on the highest
-/// grain under it, loaded for `spec.cycles` cycles.
+/// grain under it, loaded for `spec.cycles` cycles; validated like a scene file.
+///
+/// # Errors
+/// [`Error::Scene`]: a sample that already has a sleeper or still has its mould,
+/// an invalid sample, no grain under the sleeper, or a parameter of `spec` out
+/// of range (named in the message; e.g. a sleeper too narrow for its bars).
 pub fn loaded_scene(sample: &Scene, spec: &LoadingSpec) -> Result<Scene> {
     if sample.bodies.iter().any(|b| b.name == SLEEPER) {
         return Err(Error::Scene("loaded_scene: the sample already has a sleeper".into()));
@@ -360,15 +545,8 @@ pub fn loaded_scene(sample: &Scene, spec: &LoadingSpec) -> Result<Scene> {
     if sample.bodies.iter().any(|b| MOULD.contains(&b.name.as_str())) {
         return Err(Error::Scene("loaded_scene: the sample still has its mould; run open_bank first".into()));
     }
+    spec.check()?;
     let (w, h, b) = (spec.sleeper_width, spec.sleeper_height, spec.bar_size);
-    if spec.bars > 0 && w < (spec.bars + 2) as f64 * b {
-        // Bars one bar width in from the ends and at least one bar width apart.
-        return Err(Error::Scene(format!(
-            "loaded_scene: a sleeper {w} m wide is too narrow for {} bars of {b} m (at least {} m); use fewer bars",
-            spec.bars,
-            (spec.bars + 2) as f64 * b
-        )));
-    }
     let sys = sample.build()?;
     let top = surface_under(sample, &sys, -w / 2.0, w / 2.0)?;
     let mut out = sample.clone();
@@ -395,14 +573,14 @@ pub fn loaded_scene(sample: &Scene, spec: &LoadingSpec) -> Result<Scene> {
         s.prestrain = Some(stretch - eps / spec.stiffness_factor);
     }
     if !out.materials.iter().any(|m| m.name == "aluminium") {
-        out.materials.push(crate::scene::Material { name: "aluminium".into(), density: spec.sleeper_density });
+        out.materials.push(Material { name: "aluminium".into(), density: spec.sleeper_density });
     }
     let friction = out
         .contacts
         .iter()
         .find(|c| c.between == ["ballast".to_string(), "ballast".to_string()])
         .map_or(0.5, |c| c.friction);
-    out.contacts.push(crate::scene::ContactEntry {
+    out.contacts.push(ContactEntry {
         between: ["ballast".into(), "aluminium".into()],
         friction,
         restitution: None,
@@ -416,29 +594,30 @@ pub fn loaded_scene(sample: &Scene, spec: &LoadingSpec) -> Result<Scene> {
             if spec.bars == 1 { -b / 2.0 } else { -w / 2.0 + b + k as f64 * (w - 3.0 * b) / (spec.bars - 1) as f64 };
         parts.push(rect(x0, 0.0, x0 + b, b));
     }
+    let zero = Some(Drive::Constant(0.0));
     let imposed = match spec.guide {
-        Guide::Vertical => "imposed = { vx = 0.0, spin = 0.0 }\n",
-        Guide::Level => "imposed = { spin = 0.0 }\n",
-        Guide::Free => "",
+        Guide::Vertical => Some(ImposedSpec { vx: zero, vy: None, spin: zero }),
+        Guide::Level => Some(ImposedSpec { vx: None, vy: None, spin: zero }),
+        Guide::Free => None,
     };
+    let (polygon, parts) = if spec.bars == 0 { (parts.pop(), None) } else { (None, Some(parts)) };
     let a = spec.inclination_deg.to_radians();
-    // F (negative: downwards) along (−sin a, cos a): the lateral part points to +x.
-    let shape =
-        if spec.bars == 0 { format!("polygon = {}", parts[0]) } else { format!("parts = [{}]", parts.join(", ")) };
-    let text = format!(
-        "name = \"{SLEEPER}\"\nmaterial = \"aluminium\"\n{shape}\nposition = [0.0, {top:?}]\n{imposed}\
-         load = {{ direction = [{:?}, {:?}], mean = {:?}, amplitude = {:?}, frequency = {:?}, phase = {:?} }}\n",
-        -a.sin(),
-        a.cos(),
-        spec.mean,
-        spec.amplitude,
-        spec.frequency,
-        spec.phase
-    );
-    let body: BodySpec = toml::from_str(&text).map_err(|e| Error::Scene(format!("loaded_scene: sleeper: {e}")))?;
-    out.bodies.push(body);
+    out.bodies.push(BodySpec {
+        polygon,
+        parts,
+        imposed,
+        // F (negative: downwards) along (−sin a, cos a): the lateral part points to +x.
+        load: Some(LoadSpec {
+            direction: [-a.sin(), a.cos()],
+            mean: spec.mean,
+            amplitude: spec.amplitude,
+            frequency: spec.frequency,
+            phase: spec.phase,
+        }),
+        ..body(SLEEPER, "aluminium", [0.0, top])
+    });
     // The whole scene goes through the usual validation.
-    Scene::from_toml_str(&out.to_toml_string()?)
+    validated(out)
 }
 
 /// What `sample.json` records about a deposited sample.

@@ -108,6 +108,13 @@ impl Scene {
             .map_err(|e| Error::Scene(format!("cannot read scene file '{}': {e}", path.display())))
     }
 
+    /// Validates a scene built as a value (e.g. by a generator of
+    /// [`crate::scenarios`]) exactly as [`Scene::from_toml_str`] validates a file:
+    /// the same one-line [`Error::Scene`] messages.
+    pub fn validate(&self) -> Result<()> {
+        validate::check(self).map(|_| ())
+    }
+
     /// The scene as TOML text, laid out like a hand-written scene (only the keys
     /// the scene has, inline tables for `regular`, `imposed` and `load`), which
     /// [`Scene::from_toml_str`] reads back to an equal scene: floats are written

@@ -69,6 +69,13 @@ impl MdScene {
         Self::from_toml_str_named(&Scene::read_text(path)?, &path.display().to_string())
     }
 
+    /// Validates a scene built as a value (e.g. by a generator of
+    /// [`crate::scenarios`]) exactly as [`MdScene::from_toml_str`] validates a
+    /// file: the same one-line [`Error::Scene`] messages.
+    pub fn validate(&self) -> Result<()> {
+        validate::check(self).map(|_| ())
+    }
+
     /// The scene as TOML text that [`MdScene::from_toml_str`] reads back to an
     /// equal scene (only the keys the scene has; floats in their shortest exact
     /// form). It does not fail at present; the `Result` leaves room for formats
