@@ -101,7 +101,7 @@ fn generated_scenes_are_those_of_the_former_text_generators_bit_for_bit() {
     let spheres: Vec<(f64, V3)> = luding::radii(&spec)
         .iter()
         .enumerate()
-        .map(|(i, &r)| (r, V3::new(0.01 * i as f64 + 0.001, 0.02, 0.03)))
+        .map(|(i, &r)| (r, V3::new(0.012 * i as f64 + 0.008, 0.02, 0.03)))
         .collect();
     let (lo, hi) = (V3::new(-0.001, 0.0, 0.0005), V3::new(0.3, 0.05, 0.06));
     same_md("luding_10_3_cycle", &luding::cyclic_scene(&spec, &spheres, lo, hi, 3, 100).unwrap());

@@ -12,6 +12,10 @@
 //!   in powders and grains*, §2: `f_n = k δ + γ₀ δ̇` (eq. 1), tangential spring and
 //!   dashpot (eq. 3) with static/dynamic friction and the sliding spring reset (eq. 4).
 //!
+//! Contact times (the time scale a time step must resolve): [`linear_contact_time`]
+//! (David et al. §2) and [`hertz_contact_time`] (the classical duration of an
+//! elastic Hertz impact), both through [`PairLaw::contact_time`].
+//!
 //! A damping given as a restitution coefficient `e` is turned into the ratio `α`:
 //! for `linear` exactly, `α = −ln e / √(π² + ln² e)` (then `r = exp(−η₀ t_c)` of
 //! David et al. holds with `t_c = π/ω`); for `hertz` by [`hertz_alpha_for_restitution`].
@@ -133,6 +137,95 @@ impl PairLaw {
             kt_kn_sqrt: (kt / kn).sqrt(),
         }
     }
+}
+
+impl PairLaw {
+    /// Normal stiffness (N/m) at overlap `delta` (m) with effective radius
+    /// `r_star` (m): `k` for `linear`, the tangent stiffness `2 E* √(R* δ)` for `hertz`.
+    pub fn normal_stiffness(&self, r_star: f64, delta: f64) -> f64 {
+        match self.model {
+            Model::Linear => self.kn,
+            Model::Hertz => 2.0 * self.e_star * (r_star * delta).sqrt(),
+        }
+    }
+
+    /// Normal dashpot γ_n (kg/s) at overlap `delta` (m) for reduced mass `m_star`
+    /// (kg) and effective radius `r_star` (m).
+    pub fn normal_dashpot(&self, m_star: f64, r_star: f64, delta: f64) -> f64 {
+        self.damping_n.gamma(m_star, self.normal_stiffness(r_star, delta))
+    }
+
+    /// Elastic energy (J) of the normal spring at overlap `delta` (m): `k δ² / 2`
+    /// for `linear`, `(8/15) E* √R* δ^{5/2}` for `hertz` (the work of
+    /// `F_n = 4/3 E* √R* δ^{3/2}`).
+    pub fn normal_energy(&self, r_star: f64, delta: f64) -> f64 {
+        match self.model {
+            Model::Linear => 0.5 * self.kn * delta * delta,
+            Model::Hertz => 8.0 / 15.0 * self.e_star * r_star.sqrt() * delta.powf(2.5),
+        }
+    }
+
+    /// Largest overlap (m) of an elastic central impact at approach speed `v`
+    /// (m/s) for reduced mass `m_star` (kg) and effective radius `r_star` (m),
+    /// where `m* v² / 2` has become elastic energy: `v √(m*/k)` for `linear`,
+    /// [`hertz_max_overlap`] for `hertz` (a dashpot only makes it smaller).
+    pub fn impact_overlap(&self, m_star: f64, r_star: f64, v: f64) -> f64 {
+        match self.model {
+            Model::Linear => v * (m_star / self.kn).sqrt(),
+            Model::Hertz => hertz_max_overlap(m_star, r_star, self.e_star, v),
+        }
+    }
+
+    /// Contact time (s) of a central impact at approach speed `v` (m/s) for
+    /// reduced mass `m_star` (kg) and effective radius `r_star` (m): for `linear`
+    /// [`linear_contact_time`] with the normal dashpot (independent of `v`); for
+    /// `hertz` the elastic duration [`hertz_contact_time`].
+    pub fn contact_time(&self, m_star: f64, r_star: f64, v: f64) -> f64 {
+        match self.model {
+            Model::Linear => linear_contact_time(self.kn, m_star, self.damping_n.gamma(m_star, self.kn)),
+            Model::Hertz => hertz_contact_time(m_star, r_star, self.e_star, v),
+        }
+    }
+}
+
+/// Contact time (s) of the linear spring–dashpot, David et al. §2: the half
+/// period `t_c = π / ω` of the damped oscillation, `ω = √(k/m* − η₀²)`,
+/// `η₀ = γ₀ / (2 m*)`, for normal stiffness `k` (N/m), reduced mass `m_star`
+/// (kg) and normal dashpot `gamma` (kg/s). Undamped, `t_c = π √(m*/k)`.
+/// Infinite when the dashpot is critical or stronger (`η₀² ≥ k/m*`: no rebound).
+pub fn linear_contact_time(k: f64, m_star: f64, gamma: f64) -> f64 {
+    let eta = gamma / (2.0 * m_star);
+    let omega2 = k / m_star - eta * eta;
+    if omega2 > 0.0 {
+        std::f64::consts::PI / omega2.sqrt()
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The coefficient of [`hertz_contact_time`]: `(4/5) B(2/5, 1/2) (15/16)^{2/5}`
+/// = 2.8683, with B the Beta function. The duration of an elastic impact is
+/// `2 ∫₀^{δ_max} dδ / δ̇ = 2.9433 δ_max / v` (`(4/5) B(2/5, 1/2) = 2.9433`; Johnson,
+/// *Contact Mechanics*, 1985, §11.4: `2.94 δ_max / v`), and
+/// [`hertz_max_overlap`] turns `δ_max / v` into `(m*² / (R* E*² v))^{1/5}` times
+/// `(15/16)^{2/5}`.
+pub const HERTZ_DURATION: f64 = 2.868_265_699_195_331_5;
+
+/// Duration (s) of an elastic central impact between Hertz bodies (Hertz 1882;
+/// Johnson 1985 §11.4): `t_H = 2.868 (m*² / (R* E*² v))^{1/5}`
+/// ([`HERTZ_DURATION`]) for reduced mass `m_star` (kg), effective radius
+/// `r_star` (m), effective modulus `e_star` (Pa, as in `F_n = 4/3 E* √R* δ^{3/2}`)
+/// and approach speed `v` (m/s). The stiffness grows with the overlap, so the
+/// duration shrinks, slowly, with the speed: `t_H ∝ v^{-1/5}`.
+pub fn hertz_contact_time(m_star: f64, r_star: f64, e_star: f64, v: f64) -> f64 {
+    HERTZ_DURATION * (m_star * m_star / (r_star * e_star * e_star * v)).powf(0.2)
+}
+
+/// Largest overlap (m) of an elastic central Hertz impact at approach speed `v`
+/// (m/s): `δ_max = (15 m* v² / (16 E* √R*))^{2/5}`, where the kinetic energy
+/// `m* v² / 2` has become elastic energy `(8/15) E* √R* δ^{5/2}`.
+pub fn hertz_max_overlap(m_star: f64, r_star: f64, e_star: f64, v: f64) -> f64 {
+    (15.0 * m_star * v * v / (16.0 * e_star * r_star.sqrt())).powf(0.4)
 }
 
 /// The pair laws of all material pairs, `n × n`, symmetric.

@@ -13,6 +13,34 @@ use super::contact::History;
 use super::particles::V3;
 use serde::{Deserialize, Serialize};
 
+/// The grid has at most this many cells per sphere (plus [`MIN_CELLS`]): a
+/// spread-out system (a sphere far away) gets larger cells, not more of them.
+pub const MAX_CELLS_PER_SPHERE: usize = 8;
+/// Cells the grid may always have (a 3 × 3 × 3 block).
+pub const MIN_CELLS: usize = 27;
+
+/// Cell size (m) and cells per axis of a grid over a box of extents `extent`
+/// (m, each ≥ 0): cells of side `cell` (m) or larger, at most `max_cells` in
+/// all (at least 1). The side grows by 1.5× until the count fits, counted in `f64` so that
+/// no extent (up to infinite) overflows; an infinite extent gives one cell of
+/// infinite side.
+pub fn grid(extent: &V3, cell: f64, max_cells: usize) -> (f64, [usize; 3]) {
+    let max_cells = max_cells.max(1);
+    let span = extent.max();
+    if !span.is_finite() {
+        return (f64::INFINITY, [1; 3]);
+    }
+    let per_axis = |size: f64| extent.map(|e| (e / size).floor() + 1.0);
+    // Start where one axis alone fits, then grow.
+    let mut size = cell.max(span / max_cells as f64).max(f64::MIN_POSITIVE);
+    let mut n = per_axis(size);
+    while n.product() > max_cells as f64 {
+        size *= 1.5;
+        n = per_axis(size);
+    }
+    (size, [n[0] as usize, n[1] as usize, n[2] as usize])
+}
+
 /// The neighbour list and its per-pair contact memory.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct Neighbours {
@@ -68,28 +96,19 @@ impl Neighbours {
         let s = &mut self.scratch;
         let r_max = r.iter().cloned().fold(0.0, f64::max);
         let cell = (2.0 * r_max + self.skin).max(1e-12);
-        // Grid over the bounding box.
+        // Grid over the bounding box of the finite centres (a non-finite one, which
+        // the step then reports, falls in a corner cell).
         let mut lo = V3::repeat(f64::INFINITY);
         let mut hi = V3::repeat(f64::NEG_INFINITY);
-        for p in x {
+        for p in x.iter().filter(|p| p.iter().all(|c| c.is_finite())) {
             lo = lo.inf(p);
             hi = hi.sup(p);
         }
-        if n_all == 0 {
+        if lo[0] > hi[0] {
             lo = V3::zeros();
             hi = V3::zeros();
         }
-        let mut dims = [1usize; 3];
-        let mut size = cell;
-        loop {
-            for a in 0..3 {
-                dims[a] = (((hi[a] - lo[a]) / size).floor() as usize + 1).max(1);
-            }
-            if dims[0] * dims[1] * dims[2] <= 8 * n_all.max(1) + 27 {
-                break;
-            }
-            size *= 1.5;
-        }
+        let (size, dims) = grid(&(hi - lo), cell, MAX_CELLS_PER_SPHERE * n_all + MIN_CELLS);
         let n_cells = dims[0] * dims[1] * dims[2];
         let cell_index = |p: &V3| -> [usize; 3] {
             let mut c = [0usize; 3];

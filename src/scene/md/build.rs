@@ -2,15 +2,13 @@
 //! system's current state back into the scene.
 //!
 //! Sphere `i` of the system is `bodies[i]` of the scene, wall `k` is `walls[k]`,
-//! material `m` is `materials[m]`. A law given by a restitution coefficient gets
-//! its damping ratio from [`md::law::hertz_alpha_for_restitution`] or
-//! [`md::law::linear_alpha_for_restitution`].
+//! material `m` is `materials[m]`. The laws come resolved from validation
+//! (which needs them for the initial overlaps and the time step).
 
 use super::format::MdScene;
-use super::validate::{check, CheckedLaw, CheckedModel};
+use super::validate::check;
 use crate::error::Result;
-use crate::md::{self, Damping, Ghosts, LawTable, MdSystem, PairLaw, Particles, Shape, V3};
-use std::sync::Mutex;
+use crate::md::{Ghosts, MdSystem, Particles, Shape, V3};
 
 impl MdScene {
     /// Validates the scene and builds the MD system at time 0 (forces evaluated
@@ -18,10 +16,6 @@ impl MdScene {
     /// `ballast run` sets its own, see [`MdSystem::set_threads`]).
     pub fn build(&self) -> Result<MdSystem> {
         let c = check(self)?;
-        let mut laws = LawTable::new(c.materials.len());
-        for l in &c.laws {
-            laws.set(l.a, l.b, pair_law(l, &c.materials));
-        }
         let mut particles = Particles::default();
         for (b, &m) in self.bodies.iter().zip(&c.sphere_materials) {
             particles.push(
@@ -34,7 +28,7 @@ impl MdScene {
                 V3::from(b.spin()),
             );
         }
-        let mut sys = MdSystem::new(c.settings, particles, c.walls, laws, Ghosts::new(c.planes));
+        let mut sys = MdSystem::new(c.settings, particles, c.walls, c.laws, Ghosts::new(c.planes));
         if let Some(t) = c.threads {
             sys.set_threads(t);
         }
@@ -74,37 +68,5 @@ impl MdScene {
             }
         }
         out
-    }
-}
-
-/// [`md::law::hertz_alpha_for_restitution`], remembered: each call integrates
-/// impacts for some milliseconds, and scenes repeat their coefficients.
-fn hertz_alpha(e: f64) -> f64 {
-    static KNOWN: Mutex<Vec<(u64, f64)>> = Mutex::new(Vec::new());
-    let mut known = KNOWN.lock().unwrap_or_else(|p| p.into_inner());
-    if let Some(&(_, alpha)) = known.iter().find(|(bits, _)| *bits == e.to_bits()) {
-        return alpha;
-    }
-    let alpha = md::law::hertz_alpha_for_restitution(e);
-    if known.len() < 64 {
-        known.push((e.to_bits(), alpha));
-    }
-    alpha
-}
-
-/// The engine's law of a validated `[[contact]]`.
-fn pair_law(l: &CheckedLaw, materials: &[md::Material]) -> PairLaw {
-    match l.model {
-        CheckedModel::Hertz { restitution, alpha_n, alpha_t } => {
-            let alpha_n = restitution.map_or(alpha_n, hertz_alpha);
-            PairLaw::hertz(&materials[l.a], &materials[l.b], alpha_n, alpha_t.unwrap_or(alpha_n), l.mu_s)
-        }
-        CheckedModel::Linear { kn, kt, restitution, gamma_n, gamma_t } => {
-            let normal = match restitution {
-                Some(e) => Damping::Ratio(md::law::linear_alpha_for_restitution(e)),
-                None => Damping::Coefficient(gamma_n),
-            };
-            PairLaw::linear(kn, kt, normal, Damping::Coefficient(gamma_t), l.mu_s, l.mu_d)
-        }
     }
 }

@@ -15,6 +15,20 @@ use serde::{Deserialize, Serialize};
 pub const DEFAULT_MD_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
 /// Default skin, as a fraction of the mean sphere diameter (m/m).
 pub const DEFAULT_SKIN_FRACTION: f64 = 0.1;
+/// Deepest initial overlap a scene may have, as a fraction of the smaller radius
+/// of the pair (sphere–sphere, sphere–wall, sphere and its symmetry image). A
+/// deposited sample written back by `final_scene.toml` overlaps by about 1e-3 of
+/// a radius (1e-6 m on the 1.5–5 mm spheres of Karrech et al.), a soft one by a
+/// few 1e-2; at 0.1 of the radius Hertz's contact radius `√(R* δ)` is already a
+/// third of `R*` (the theory wants it small), a 1 mm diorite sphere stores
+/// enough energy to leave at ~100 m/s, and deeper overlaps are typos (a sphere
+/// placed inside another or in a wall). The engine stops at 0.5 (a runaway overlap).
+pub const MAX_INITIAL_OVERLAP: f64 = 0.1;
+/// Slowest impact speed (m/s) at which Hertz contact times are taken for the
+/// time-step check (a fall of 5 cm; faster if the initial state can produce
+/// faster impacts). The Hertz contact time varies as `v^{-1/5}`: an estimate off
+/// by 10× in speed is off by 1.6× in time.
+pub const REFERENCE_SPEED: f64 = 1.0;
 
 /// A whole MD scene file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

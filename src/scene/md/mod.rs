@@ -10,8 +10,8 @@
 //! let scene = ballast::scene::MdScene::from_toml_str(r#"
 //!     [simulation]
 //!     engine = "md"
-//!     dt = 1e-5
-//!     duration = 1e-3
+//!     dt = 1e-6
+//!     duration = 1e-4
 //!     [[material]]
 //!     name = "glass"
 //!     density = 2500.0
@@ -37,6 +37,7 @@
 
 mod build;
 mod format;
+mod safety;
 mod validate;
 mod write;
 

@@ -5,20 +5,26 @@
 //! section or the entry and the field, as for NSCD scenes, e.g.
 //! `body[3] 's3': sphere: must be positive and finite, got -0.001` or
 //! `contact[1].normal_stiffness: not a key of model 'hertz' (only of 'linear')`.
-//! Overlapping initial spheres are allowed.
+//! The resolved scene is then checked against its own dynamics
+//! ([`super::safety`]): initial overlaps, background damping, time step.
 
 use super::format::{MdContact, MdScene, ServoSpec, WallSpec, DEFAULT_MD_GRAVITY, DEFAULT_SKIN_FRACTION};
+use super::safety::{self, Resolved};
 use crate::error::Result;
-use crate::md::{self, Drive, GearSet, History1, Integrator, MdSettings, Motion, Shape, SymmetryPlane, Wall, V3};
+use crate::md::{
+    self, Damping, Drive, GearSet, History1, Integrator, LawTable, MdSettings, Motion, PairLaw, Shape, SymmetryPlane,
+    Wall, V3,
+};
 use crate::scene::validate::{err, finite, label, non_negative, num, positive, MAX_LENGTH, MIN_SIZE};
 use std::collections::HashMap;
+use std::sync::Mutex;
 
 /// Two unit vectors are perpendicular (symmetry planes) or along an axis (box
 /// walls) within this tolerance.
 const ANGLE_TOLERANCE: f64 = 1e-9;
 
-/// The model of a contact law and its parameters, as given (the restitution
-/// mapping, which takes some milliseconds for `hertz`, is left to the build).
+/// The model of a contact law and its parameters, as given ([`pair_law`] then
+/// maps a restitution to a damping ratio, remembered: some milliseconds for `hertz`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum CheckedModel {
     /// Hertz–Mindlin: `α_n` from `restitution` if given, else `alpha_n`;
@@ -49,7 +55,8 @@ pub(crate) struct CheckedMd {
     pub materials: Vec<md::Material>,
     /// Material index of each sphere.
     pub sphere_materials: Vec<usize>,
-    pub laws: Vec<CheckedLaw>,
+    /// The laws, restitution coefficients turned into damping ratios.
+    pub laws: LawTable,
     pub walls: Vec<Wall>,
     pub planes: Vec<SymmetryPlane>,
     pub threads: Option<usize>,
@@ -319,7 +326,54 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
     let skin = ms.skin.unwrap_or(DEFAULT_SKIN_FRACTION * diameters / scene.bodies.len() as f64);
     let settings =
         MdSettings { dt: sim.dt, gravity, integrator, skin, background_damping, background_rotational_damping };
-    Ok(CheckedMd { settings, materials, sphere_materials, laws, walls, planes, threads: ms.threads, cycles })
+    let mut table = LawTable::new(n);
+    for l in &laws {
+        table.set(l.a, l.b, pair_law(l, &materials));
+    }
+    safety::check(&Resolved {
+        scene,
+        settings: &settings,
+        densities: materials.iter().map(|m| m.density).collect(),
+        sphere_materials: &sphere_materials,
+        laws: &table,
+        walls: &walls,
+        planes: &planes,
+    })?;
+    Ok(CheckedMd { settings, materials, sphere_materials, laws: table, walls, planes, threads: ms.threads, cycles })
+}
+
+/// [`md::law::hertz_alpha_for_restitution`], remembered: each call integrates
+/// impacts for some milliseconds, and scenes repeat their coefficients.
+fn hertz_alpha(e: f64) -> f64 {
+    static KNOWN: Mutex<Vec<(u64, f64)>> = Mutex::new(Vec::new());
+    let mut known = KNOWN.lock().unwrap_or_else(|p| p.into_inner());
+    if let Some(&(_, alpha)) = known.iter().find(|(bits, _)| *bits == e.to_bits()) {
+        return alpha;
+    }
+    let alpha = md::law::hertz_alpha_for_restitution(e);
+    if known.len() < 64 {
+        known.push((e.to_bits(), alpha));
+    }
+    alpha
+}
+
+/// The engine's law of a validated `[[contact]]`: a restitution coefficient
+/// becomes the damping ratio of [`md::law::hertz_alpha_for_restitution`] or
+/// [`md::law::linear_alpha_for_restitution`].
+fn pair_law(l: &CheckedLaw, materials: &[md::Material]) -> PairLaw {
+    match l.model {
+        CheckedModel::Hertz { restitution, alpha_n, alpha_t } => {
+            let alpha_n = restitution.map_or(alpha_n, hertz_alpha);
+            PairLaw::hertz(&materials[l.a], &materials[l.b], alpha_n, alpha_t.unwrap_or(alpha_n), l.mu_s)
+        }
+        CheckedModel::Linear { kn, kt, restitution, gamma_n, gamma_t } => {
+            let normal = match restitution {
+                Some(e) => Damping::Ratio(md::law::linear_alpha_for_restitution(e)),
+                None => Damping::Coefficient(gamma_n),
+            };
+            PairLaw::linear(kn, kt, normal, Damping::Coefficient(gamma_t), l.mu_s, l.mu_d)
+        }
+    }
 }
 
 /// Checks one `[[contact]]` between materials `a` and `b`.
