@@ -1,23 +1,55 @@
 //! `ballast`: granular mechanics under cyclic loading, for railway ballast settlement.
 //!
-//! - [`nscd`]: non-smooth contact dynamics of rigid 2D polygons (Moreau–Jean θ-method,
-//!   nonlinear Gauss–Seidel with exact Coulomb friction, shadow-overlap detection,
-//!   viscoelastic sublayer);
-//! - [`scene`]: TOML scene files, their validation, and building a system from them;
-//! - [`io`]: output files (`series.csv`, `final.json`).
+//! Two engines behind one interface ([`run::Engine`]):
+//! - [`nscd`]: non-smooth contact dynamics of rigid 2D polygons and discs
+//!   (Moreau–Jean θ-method, nonlinear Gauss–Seidel with exact Coulomb friction,
+//!   shadow-overlap detection, viscoelastic sublayer; Saussine et al. 2006);
+//! - [`md`]: soft-contact molecular dynamics of 3D spheres (Hertz–Mindlin and
+//!   linear spring–dashpot laws, Verlet and Gear integrators, walls, servo walls,
+//!   symmetry planes; Karrech et al. 2007, David et al.).
+//!
+//! Around them:
+//! - [`run`]: the run loop shared by both engines (equilibrium stop, outputs,
+//!   checkpoints and resume, divergence handling, progress callback) and the
+//!   write-back of generalised positions that a cyclic driver needs;
+//! - [`scene`]: TOML scene files of either engine, their validation (one-line
+//!   errors naming the field), building a system, saving a state as a scene;
+//! - [`io`]: the output files (CSV through serde row types, JSON, VTK for
+//!   ParaView, figures);
+//! - [`scenarios`]: ready-made scenes (the Saussine pentagon sample and its
+//!   loading, the Karrech sphere sample, the Luding triaxial box, the peers' bed);
+//! - [`geometry`]: convex polygons, discs and compounds; [`clock`]: the exact
+//!   simulation and cycle clocks; [`team`]: the two-thread team of a step;
+//!   [`error`]: the crate's error type.
 //!
 //! All quantities are SI and `f64`.
 //!
-//! ```
-//! let scene = ballast::scene::Scene::load("examples/block_on_floor.toml")?;
-//! let mut sys = scene.build()?; // nscd::System: plain serde data
-//! for _ in 0..scene.steps() {
-//!     let stats = sys.step()?; // contacts, iterations, criterion, overlaps, kinetic energy
-//!     assert!(stats.max_overlap < 1e-6);
-//! }
-//! println!("{:?}", sys.bodies.q); // (x, y, θ) of every centre of mass
+//! A scene file, run into an output folder (as `ballast run` does):
+//! ```no_run
+//! use ballast::run::{run_file, RunOptions};
+//! let out = run_file("examples/sleeper_load.toml".as_ref(), "out/sleeper".as_ref(), &RunOptions::default(), &mut |_| {})?;
+//! println!("{} steps, t = {} s, max overlap {:e} m", out.step, out.time, out.report.max_overlap_m);
 //! # Ok::<(), ballast::Error>(())
 //! ```
+//! A system built in code (here from a scene, then changed), stepped through the
+//! same loop, with its generalised positions read and written back:
+//! ```
+//! use ballast::run::{Engine, RunOptions, RunPlan, Runner};
+//! let scene = ballast::scene::Scene::load("examples/block_on_floor.toml")?;
+//! let mut sys = scene.build()?; // nscd::System: plain serde data
+//! let mut c = sys.configuration(); // (x, y, θ) of every mobile body
+//! c.q[1] += 1e-3; // the first one 1 mm higher
+//! sys.set_configuration(&c)?; // velocities zeroed, warm start forgotten
+//! let out = std::env::temp_dir().join(format!("ballast-doc-{}", std::process::id()));
+//! let plan = RunPlan::new(200, 10); // 200 steps, a row of series.csv every 10
+//! let run = Runner::from_system(sys, plan)?.run(&out, &RunOptions::default(), &mut |_| {})?;
+//! assert_eq!(run.step, 200);
+//! assert!(run.report.max_overlap_m < 1e-6);
+//! # std::fs::remove_dir_all(&out).ok();
+//! # Ok::<(), ballast::Error>(())
+//! ```
+//! Steps can also be made one at a time ([`nscd::System::step`],
+//! [`md::MdSystem::step`]); `examples/library_run.rs` shows both engines.
 
 pub mod clock;
 pub mod error;

@@ -12,7 +12,7 @@
 //! disc. A body never contacts itself, so parts of one body never meet. A plain
 //! polygon is a single part, so pairs without a compound are detected exactly as
 //! before, with the same feature ids. A pair involving a compound gets the
-//! feature id of [`compound_feature`], which names both parts, so keys stay
+//! feature id of `compound_feature`, which names both parts, so keys stay
 //! unique and stable from step to step and the warm start finds them.
 
 use super::bodies::Bodies;

@@ -1,6 +1,6 @@
 //! Domain-split NLGS: the two halves of the sample swept side by side, the
 //! rows that join them after (in the spirit of the parallel NSCD of Renouf,
-//! Dubois & Alart 2004, ref. [25] of Saussine et al. 2006).
+//! Dubois & Alart 2004, ref. \[25\] of Saussine et al. 2006).
 //!
 //! The mobile bodies are split at the median abscissa of their centres (at
 //! `q_m`) into a left and a right set. A row (contact or spring) whose mobile

@@ -320,7 +320,7 @@ impl System {
     /// built there would. The clock goes on.
     ///
     /// # Errors
-    /// [`Error::Scene`] if `c` has not 3 coordinates per body, names an unknown
+    /// [`crate::Error::Scene`] if `c` has not 3 coordinates per body, names an unknown
     /// or fixed body or holds a non-finite value; the system is then unchanged.
     pub fn set_configuration(&mut self, c: &crate::run::Configuration) -> crate::Result<()> {
         c.check(3, self.bodies.len())?;

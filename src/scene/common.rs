@@ -2,8 +2,8 @@
 //! dimension, time step, duration, gravity, seed, equilibrium stop) and
 //! `[output]` (rows of `series.csv`, per-cycle output). They are parsed by the
 //! same serde types for NSCD and MD scenes, checked by the same functions
-//! ([`check_simulation`], [`check_output`]) and written back by the same code;
-//! [`run_plan`] turns them into the run loop's [`RunPlan`].
+//! (`check_simulation`, `check_output`) and written back by the same code;
+//! `run_plan` turns them into the run loop's [`RunPlan`].
 
 use super::validate::{check_time, err, finite, positive, steps_of};
 use super::write::{float, opt, string};
@@ -61,7 +61,7 @@ impl Simulation {
     }
 
     /// The gravity of a scene of dimension `N` (m/s²): the scene's, or `default`
-    /// if it has none or not `N` components (refused by [`check_simulation`]).
+    /// if it has none or not `N` components (refused by the validation).
     pub fn gravity_or<const N: usize>(&self, default: [f64; N]) -> [f64; N] {
         self.gravity.as_deref().and_then(|g| g.try_into().ok()).unwrap_or(default)
     }

@@ -67,7 +67,7 @@ pub struct NscdSection {
     /// Alternate forward and backward NLGS sweeps (symmetric Gauss–Seidel); default false.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub symmetric: Option<bool>,
-    /// Alert distance (m), ≥ 0; default: [`DEFAULT_ALERT_FRACTION`] times the
+    /// Alert distance (m), ≥ 0; default: [`crate::nscd::system::DEFAULT_ALERT_FRACTION`] times the
     /// smallest inner radius of the non-fixed bodies (of all bodies if none moves).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub alert_distance: Option<f64>,
