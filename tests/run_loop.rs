@@ -111,6 +111,10 @@ fn resume_is_bit_identical<E: Engine>(runner: &Runner<E>, other: &Runner<E>, sto
     let dir = temp_dir(test);
     let (whole, parts) = (dir.join("whole"), dir.join("parts"));
     let opts = RunOptions { vtk_every: vtk, ..quiet() };
+    // Nothing to resume yet: an input error, nothing written.
+    let err = runner.run(&parts, &RunOptions { resume: true, ..opts.clone() }, &mut |_| {}).unwrap_err();
+    assert!(matches!(err, Error::Scene(_)) && err.to_string().contains("--resume: no checkpoint.json"), "{err}");
+    assert!(!parts.join("series.csv").exists());
     let done = runner.run(&whole, &opts, &mut |_| {}).unwrap();
     assert_eq!(done.status, Status::Ended(RunEnd::Finished));
     let first = runner.run(&parts, &RunOptions { stop_after: Some(stop), ..opts.clone() }, &mut |_| {}).unwrap();

@@ -462,8 +462,14 @@ impl<E: Engine> Runner<E> {
     /// The run continued from the checkpoint in `out`, checked against the plan,
     /// the initial system and the files.
     fn resume(&self, out: &Path) -> Result<Live<E>> {
-        let cp = Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source_crc32())?;
         let path = out.join(CHECKPOINT_FILE);
+        if !path.is_file() {
+            return Err(Error::Scene(format!(
+                "--resume: no {CHECKPOINT_FILE} in '{}' (nothing to continue: run without --resume)",
+                out.display()
+            )));
+        }
+        let cp = Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source_crc32())?;
         let bad = |msg: String| Error::Scene(format!("{}: not a valid checkpoint: {msg}", path.display()));
         cp.system.check_state().map_err(|e| bad(e.to_string()))?;
         cp.system.check_same_model(&self.system).map_err(|e| bad(e.to_string()))?;
