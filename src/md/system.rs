@@ -29,22 +29,46 @@ use crate::team::Team;
 use nalgebra::{Matrix3, UnitQuaternion};
 use serde::{Deserialize, Serialize};
 
-/// Run settings of the MD engine (SI).
+/// Default neighbour skin of a scene, as a fraction of the mean sphere diameter (m/m).
+pub const DEFAULT_SKIN_FRACTION: f64 = 0.1;
+
+/// Run settings of the MD engine (SI). [`MdSettings::default`] gives the
+/// defaults of scenes (`[simulation]` and `[md]` of the MD scene format), but
+/// for the time step, which a scene must give, and the skin, whose scene
+/// default follows the spheres.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MdSettings {
-    /// Time step (s).
+    /// Time step (s), > 0 and below the contacts' stability limit; default 1e-6
+    /// (scenes must give it).
     pub dt: f64,
-    /// Gravity (m/s²).
+    /// Gravity (m/s²); default `[0, 0, −9.81]`.
     pub gravity: V3,
+    /// Integrator; default velocity Verlet (a scene's `gear` default is
+    /// Karrech's set, [`super::GearSet::Karrech`]).
     pub integrator: Integrator,
-    /// Neighbour skin (m).
+    /// Neighbour skin (m), > 0; default 1e-3 here; a scene's default is
+    /// [`DEFAULT_SKIN_FRACTION`] × the mean sphere diameter.
     pub skin: f64,
-    /// Translational background damping `γ_b` (kg/s): `f = −γ_b v`.
+    /// Translational background damping `γ_b` (kg/s): `f = −γ_b v`; default 0.
     pub background_damping: f64,
     /// Rotational background damping `γ_br` (kg/s): `τ = −γ_br r² ω` on a sphere of
     /// radius `r` (Luding's form, so that `γ_br` has the unit of `γ_b`; the paper's
-    /// 0.05 kg/s then relaxes spins in `2/5 m/γ_br`, 8 ms for its 1 g spheres).
+    /// 0.05 kg/s then relaxes spins in `2/5 m/γ_br`, 8 ms for its 1 g spheres);
+    /// default 0.
     pub background_rotational_damping: f64,
+}
+
+impl Default for MdSettings {
+    fn default() -> Self {
+        MdSettings {
+            dt: 1e-6,
+            gravity: V3::new(0.0, 0.0, -9.81),
+            integrator: Integrator::Verlet,
+            skin: 1e-3,
+            background_damping: 0.0,
+            background_rotational_damping: 0.0,
+        }
+    }
 }
 
 /// What one step measured (forces at its evaluation, state at its end).

@@ -20,7 +20,7 @@ impl Scene {
         let params = NscdParams {
             dt: self.simulation.dt,
             theta: checked.theta,
-            gravity: self.simulation.gravity_or(super::format::DEFAULT_GRAVITY),
+            gravity: self.simulation.gravity_or(NscdParams::default().gravity),
             alert_distance: checked.alert_distance,
             nlgs: checked.nlgs,
         };

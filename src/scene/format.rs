@@ -2,16 +2,16 @@
 //!
 //! Every table refuses unknown keys. Optional keys are `Option`s (or empty
 //! vectors) so that a scene written back with [`Scene::to_toml_string`] keeps
-//! exactly the keys the user gave; the defaults live in the accessor methods and
-//! the `DEFAULT_*` constants. All quantities are SI.
+//! exactly the keys the user gave; the engine's defaults are those of
+//! [`crate::nscd::NscdParams::default`] (θ, gravity, NLGS settings), the others
+//! live in the accessor methods and the `DEFAULT_*` constants. All quantities
+//! are SI.
 
 pub use super::common::{CyclesSpec, OutputSection, Simulation, DEFAULT_OUTPUT_EVERY};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
 use std::marker::PhantomData;
 
-/// Default gravity of a 2D scene (m/s²).
-pub const DEFAULT_GRAVITY: [f64; 2] = [0.0, -9.81];
 /// Default out-of-plane thickness (m).
 pub const DEFAULT_THICKNESS: f64 = 1.0;
 

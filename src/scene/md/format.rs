@@ -4,17 +4,14 @@
 //!
 //! As for NSCD scenes, every table refuses unknown keys and optional keys are
 //! `Option`s, so that [`MdScene::to_toml_string`] writes back exactly the keys the
-//! user gave; the defaults live in the accessor methods and the `DEFAULT_*`
-//! constants. Vectors are arrays of exactly 3 numbers. All quantities are SI.
+//! user gave; the defaults are those of [`crate::md::MdSettings::default`]
+//! (and of the shared sections, [`crate::scene::common`]). Vectors are arrays of exactly 3 numbers. All quantities are SI.
 
 use crate::scene::common::{OutputSection, Simulation};
 use crate::scene::format::{array, opt_array};
 use serde::{Deserialize, Serialize};
 
-/// Default gravity (m/s²).
-pub const DEFAULT_MD_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
-/// Default skin, as a fraction of the mean sphere diameter (m/m).
-pub const DEFAULT_SKIN_FRACTION: f64 = 0.1;
+pub use crate::md::system::DEFAULT_SKIN_FRACTION;
 /// Deepest initial overlap a scene may have, as a fraction of the smaller radius
 /// of the pair (sphere–sphere, sphere–wall, sphere and its symmetry image). A
 /// deposited sample written back by `final_scene.toml` overlaps by about 1e-3 of

@@ -8,9 +8,10 @@
 //! The resolved scene is then checked against its own dynamics
 //! ([`super::safety`]): initial overlaps, background damping, time step.
 
-use super::format::{MdContact, MdScene, ServoSpec, WallSpec, DEFAULT_MD_GRAVITY, DEFAULT_SKIN_FRACTION};
+use super::format::{MdContact, MdScene, ServoSpec, WallSpec};
 use super::safety::{self, Resolved};
 use crate::error::Result;
+use crate::md::system::DEFAULT_SKIN_FRACTION;
 use crate::md::{
     self, Damping, Drive, GearSet, History1, Integrator, LawTable, MdSettings, Motion, PairLaw, Shape, SymmetryPlane,
     Wall, V3,
@@ -120,7 +121,8 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
     // [simulation]
     let sim = &scene.simulation;
     crate::scene::common::check_simulation(sim, "md", 3)?;
-    let gravity = V3::from(sim.gravity_or(DEFAULT_MD_GRAVITY));
+    let defaults = MdSettings::default();
+    let gravity = V3::from(sim.gravity_or(defaults.gravity.into()));
 
     // [md]
     let ms = scene.md.clone().unwrap_or_default();
@@ -147,9 +149,12 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
     if let Some(s) = ms.skin {
         length("md.skin", s)?;
     }
-    let background_damping = non_negative("md.background_damping", ms.background_damping.unwrap_or(0.0))?;
-    let background_rotational_damping =
-        non_negative("md.background_rotational_damping", ms.background_rotational_damping.unwrap_or(0.0))?;
+    let background_damping =
+        non_negative("md.background_damping", ms.background_damping.unwrap_or(defaults.background_damping))?;
+    let background_rotational_damping = non_negative(
+        "md.background_rotational_damping",
+        ms.background_rotational_damping.unwrap_or(defaults.background_rotational_damping),
+    )?;
     if ms.threads == Some(0) {
         return err("md.threads: must be at least 1, got 0".into());
     }
