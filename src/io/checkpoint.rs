@@ -45,12 +45,15 @@ pub struct Checkpoint<S, C> {
     pub first_step: u64,
     /// Steps made by the engine when the checkpoint was written.
     pub step: u64,
-    /// Length of `series.csv` (bytes) and rows in it.
+    /// Length of `series.csv` (bytes), rows in it and the CRC-32 of these bytes.
     pub series_bytes: u64,
     pub series_rows: u64,
-    /// Length of `cycles.csv` (bytes) and rows in it (0 and 0 without cycles).
+    pub series_crc32: u32,
+    /// Length of `cycles.csv` (bytes), rows in it and the CRC-32 of these bytes
+    /// (0, 0 and 0 without cycles).
     pub cycles_bytes: u64,
     pub cycles_rows: u64,
+    pub cycles_crc32: u32,
     /// Running summary of the run so far.
     pub summary: RunSummary,
     /// The engine state.
@@ -64,6 +67,8 @@ pub struct Checkpoint<S, C> {
     /// The followed bodies and their coordinates at the start (with
     /// `output.cycles.positions`).
     pub positions: Option<crate::run::Configuration>,
+    /// CRC-32 of the records of `cycle_displacements.npy` (0 without positions).
+    pub positions_crc32: u32,
 }
 
 /// CRC-32 (IEEE) of `bytes`.
@@ -71,8 +76,17 @@ pub fn crc32(bytes: &[u8]) -> u32 {
     crc32fast::hash(bytes)
 }
 
+/// `PATH: not a valid checkpoint: MSG`, on one line: `msg` may quote the
+/// file (a serde error quotes an unknown variant as it is), so its control
+/// characters become `?` and it is cut to 200 characters.
 fn invalid(path: &Path, msg: impl std::fmt::Display) -> Error {
-    Error::Scene(format!("{}: not a valid checkpoint: {msg}", path.display()))
+    const MAX: usize = 200;
+    let msg = msg.to_string();
+    let mut short: String = msg.chars().take(MAX).map(|c| if c.is_control() { '?' } else { c }).collect();
+    if msg.chars().count() > MAX {
+        short.push('…');
+    }
+    Error::Scene(format!("{}: not a valid checkpoint: {short}", path.display()))
 }
 
 impl<S: Serialize + DeserializeOwned, C: Serialize + DeserializeOwned> Checkpoint<S, C> {
@@ -92,23 +106,31 @@ impl<S: Serialize + DeserializeOwned, C: Serialize + DeserializeOwned> Checkpoin
         let bytes = std::fs::read(&path).map_err(|e| io_error(&path, "read checkpoint", e))?;
         let text = String::from_utf8(bytes).map_err(|_| invalid(&path, "not UTF-8 text"))?;
         let (first, json) = text.split_once('\n').ok_or_else(|| invalid(&path, "no header line"))?;
+        // The header exactly as written: 8 lower-case hex digits, nothing else.
         let crc = first
             .strip_prefix(MAGIC)
-            .and_then(|s| s.trim().strip_prefix("crc32="))
-            .and_then(|s| u32::from_str_radix(s.trim(), 16).ok())
-            .ok_or_else(|| invalid(&path, format!("the first line is not '{MAGIC} crc32=…'")))?;
+            .and_then(|s| s.strip_prefix(" crc32="))
+            .filter(|s| s.len() == 8 && s.bytes().all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)))
+            .and_then(|s| u32::from_str_radix(s, 16).ok())
+            .ok_or_else(|| invalid(&path, format!("the first line is not '{MAGIC} crc32=XXXXXXXX'")))?;
         if crc32(json.as_bytes()) != crc {
             return Err(invalid(&path, "checksum mismatch (the file was edited or cut short)"));
         }
         let cp: Self = serde_json::from_str(json).map_err(|e| invalid(&path, e))?;
         if cp.engine != engine {
-            return Err(invalid(&path, format!("written by the {} engine, the scene is for {engine}", cp.engine)));
+            return Err(invalid(
+                &path,
+                format!("written by the {} engine, the scene is for {engine}", crate::scene::clip(&cp.engine)),
+            ));
         }
         let version = env!("CARGO_PKG_VERSION");
         if cp.version != version {
             return Err(invalid(
                 &path,
-                format!("written by ballast {}, this is {version}; run without --resume to start again", cp.version),
+                format!(
+                    "written by ballast {}, this is {version}; run without --resume to start again",
+                    crate::scene::clip(&cp.version)
+                ),
             ));
         }
         if cp.source_crc32 != source_crc32 {

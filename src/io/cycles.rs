@@ -37,6 +37,9 @@ pub struct NscdCycleState {
     /// Steps of the cycle under way, and the sums over them.
     pub steps: u64,
     pub sum_y: f64,
+    /// Smallest load magnitude of the cycle (N); infinite before its first
+    /// step, which JSON writes as `null` (a checkpoint at a cycle end).
+    #[serde(deserialize_with = "null_is_infinite")]
     pub min_load: f64,
     pub y_at_min_load: f64,
     pub sum_speed: f64,
@@ -46,6 +49,11 @@ pub struct NscdCycleState {
     /// Positions `(x, y, θ)` of every body at the end of the first cycle (for the
     /// displacement field from cycle 1 to the end of the run).
     pub first_cycle_q: Option<Vec<[f64; 3]>>,
+}
+
+/// An `f64` that reads `null` (serde_json's form of a non-finite number) as +∞.
+fn null_is_infinite<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
 }
 
 impl NscdCycleState {
@@ -71,6 +79,47 @@ impl NscdCycleState {
     pub fn restart(&mut self) {
         let first = self.first_cycle_q.take();
         *self = Self { first_cycle_q: first, ..Self::new(self.body, self.y0) };
+    }
+}
+
+/// The check of a per-cycle state read from a checkpoint.
+pub trait CycleCheck {
+    /// Checks `self`, read from a checkpoint written after `cycles` completed
+    /// cycles of a system of `bodies` bodies, against `start`, the state the
+    /// run started with ([`crate::run::Engine::cycle_start`]): what the
+    /// per-cycle output follows and starts from, and the shape of what it
+    /// keeps. The message says what differs.
+    fn check(&self, start: &Self, bodies: usize, cycles: u64) -> std::result::Result<(), String>;
+}
+
+impl CycleCheck for NscdCycleState {
+    fn check(&self, start: &Self, bodies: usize, cycles: u64) -> std::result::Result<(), String> {
+        if self.body != start.body || self.y0.to_bits() != start.y0.to_bits() {
+            return Err(format!(
+                "it follows body {} from y0 = {} m, the scene body {} from {} m",
+                self.body, self.y0, start.body, start.y0
+            ));
+        }
+        match (&self.first_cycle_q, cycles) {
+            (None, 0) => Ok(()),
+            (Some(q), 1..) if q.len() == bodies => Ok(()),
+            (q, _) => Err(format!(
+                "positions of {} bodies at the end of the first cycle, after {cycles} cycles of {bodies} bodies",
+                q.as_ref().map_or(0, Vec::len)
+            )),
+        }
+    }
+}
+
+impl CycleCheck for MdCycleState {
+    fn check(&self, start: &Self, _bodies: usize, _cycles: u64) -> std::result::Result<(), String> {
+        let same = self.x0.len() == start.x0.len()
+            && self.x0.iter().flatten().zip(start.x0.iter().flatten()).all(|(a, b)| a.to_bits() == b.to_bits());
+        if same {
+            Ok(())
+        } else {
+            Err(format!("{} sphere centres at the start, not those of the scene's {}", self.x0.len(), start.x0.len()))
+        }
     }
 }
 

@@ -59,6 +59,18 @@ fn header(cycles: u64, bodies: usize, dof: usize) -> Vec<u8> {
     h
 }
 
+/// The columns of `cycle_bodies.csv` for `dof` coordinates per body (3 or 6).
+fn columns(dof: usize) -> Vec<&'static str> {
+    let q0: &[&str] = if dof == 3 {
+        &["x0_m", "y0_m", "theta0_rad"]
+    } else {
+        &["x0_m", "y0_m", "z0_m", "rx0_rad", "ry0_rad", "rz0_rad"]
+    };
+    let mut head = vec!["body", "name"];
+    head.extend_from_slice(q0);
+    head
+}
+
 /// Writes the positions of a fixed set of bodies at each cycle end.
 #[derive(Debug)]
 pub struct PositionsWriter {
@@ -67,6 +79,8 @@ pub struct PositionsWriter {
     reference: Configuration,
     cycles: u64,
     record: Vec<u8>,
+    /// CRC-32 of the records written (the data after the header).
+    crc: crc32fast::Hasher,
 }
 
 impl PositionsWriter {
@@ -83,14 +97,7 @@ impl PositionsWriter {
                 q0: reference.body(k).to_vec(),
             })
             .collect();
-        let names: &[&str] = if reference.dof == 3 {
-            &["x0_m", "y0_m", "theta0_rad"]
-        } else {
-            &["x0_m", "y0_m", "z0_m", "rx0_rad", "ry0_rad", "rz0_rad"]
-        };
-        let mut head = vec!["body", "name"];
-        head.extend_from_slice(names);
-        let mut w = super::table::TableWriter::create(&dir.join(BODIES_FILE), &head)?;
+        let mut w = super::table::TableWriter::create(&dir.join(BODIES_FILE), &columns(reference.dof))?;
         for r in &rows {
             w.write(r)?;
         }
@@ -98,25 +105,57 @@ impl PositionsWriter {
         let path = dir.join(DISPLACEMENTS_FILE);
         let mut file = File::create(&path).map_err(|e| io_error(&path, "create", e))?;
         file.write_all(&header(0, reference.len(), reference.dof)).map_err(|e| io_error(&path, "write", e))?;
-        Ok(Self { path, file, reference, cycles: 0, record: Vec::new() })
+        Ok(Self { path, file, reference, cycles: 0, record: Vec::new(), crc: crc32fast::Hasher::new() })
     }
 
     /// Reopens the files in `dir` of a run resumed after `cycles` cycles: the
     /// displacements of later cycles are cut off.
-    pub fn resume(dir: &Path, reference: Configuration, cycles: u64) -> Result<Self> {
+    ///
+    /// # Errors
+    /// `not a valid checkpoint: …` if `cycle_bodies.csv` does not hold the
+    /// bodies, `names` and coordinates of `reference`, or the displacements file is
+    /// shorter than `cycles` records or their CRC-32 is not `crc` (edited).
+    pub fn resume(dir: &Path, reference: Configuration, names: &[String], cycles: u64, crc: u32) -> Result<Self> {
+        let invalid =
+            |path: &Path, msg: &str| Error::Scene(format!("not a valid checkpoint: '{}' {msg}", path.display()));
+        let bodies = dir.join(BODIES_FILE);
+        let (header, rows): (Vec<String>, Vec<BodyRow>) = match super::table::read(&bodies) {
+            Ok(table) => table,
+            Err(_) if !bodies.is_file() => return Err(invalid(&bodies, "is missing")),
+            Err(e) => return Err(Error::Scene(format!("not a valid checkpoint: {e}"))),
+        };
+        let same = header == columns(reference.dof)
+            && rows.len() == reference.len()
+            && rows.iter().enumerate().all(|(k, r)| {
+                r.body == reference.bodies[k]
+                    && names.get(k) == Some(&r.name)
+                    && r.q0.len() == reference.dof
+                    && r.q0.iter().zip(reference.body(k)).all(|(a, b)| a.to_bits() == b.to_bits())
+            });
+        if !same {
+            return Err(invalid(
+                &bodies,
+                "does not hold the columns, followed bodies, names and start of the checkpoint",
+            ));
+        }
         let path = dir.join(DISPLACEMENTS_FILE);
         let bytes = HEADER_LEN as u64 + cycles * (reference.q.len() as u64 * 4);
-        let file =
+        let mut file =
             std::fs::OpenOptions::new().read(true).write(true).open(&path).map_err(|e| io_error(&path, "open", e))?;
         let len = file.metadata().map_err(|e| io_error(&path, "read", e))?.len();
         if len < bytes {
-            return Err(Error::Scene(format!(
-                "not a valid checkpoint: '{}' is shorter ({len} bytes) than {cycles} cycles need ({bytes} bytes)",
-                path.display()
-            )));
+            return Err(invalid(&path, &format!("is shorter ({len} bytes) than {cycles} cycles need ({bytes} bytes)")));
+        }
+        let mut data = vec![0; (bytes - HEADER_LEN as u64) as usize];
+        file.seek(SeekFrom::Start(HEADER_LEN as u64))
+            .and_then(|_| file.read_exact(&mut data))
+            .map_err(|e| io_error(&path, "read", e))?;
+        if crc32fast::hash(&data) != crc {
+            return Err(invalid(&path, "was edited since the checkpoint (its records have another checksum)"));
         }
         file.set_len(bytes).map_err(|e| io_error(&path, "truncate", e))?;
-        let mut w = Self { path, file, reference, cycles, record: Vec::new() };
+        let crc = crc32fast::Hasher::new_with_initial_len(crc, data.len() as u64);
+        let mut w = Self { path, file, reference, cycles, record: Vec::new(), crc };
         w.write_header()?;
         Ok(w)
     }
@@ -140,8 +179,14 @@ impl PositionsWriter {
         }
         self.file.seek(SeekFrom::End(0)).map_err(|e| io_error(&self.path, "seek", e))?;
         self.file.write_all(&self.record).map_err(|e| io_error(&self.path, "write", e))?;
+        self.crc.update(&self.record);
         self.cycles += 1;
         self.write_header()
+    }
+
+    /// CRC-32 of the records written (the data after the header), for a checkpoint.
+    pub fn crc32(&self) -> u32 {
+        self.crc.clone().finalize()
     }
 
     /// Cycles written.

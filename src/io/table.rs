@@ -9,22 +9,43 @@
 //! `Vec` that takes the extra columns.
 //!
 //! For `--resume` a table is cut back to its length at the checkpoint
-//! ([`TableWriter::resume`]): rows a killed run wrote after it disappear.
+//! ([`TableWriter::resume`]): rows a killed run wrote after it disappear. The
+//! writer keeps the CRC-32 of what it wrote ([`TableWriter::crc32`]), which the
+//! checkpoint records, so that a table edited since is refused.
 
 use super::io_error;
 use crate::error::{Error, Result};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::fs::File;
-use std::io::Seek;
+use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
 /// A CSV table being written.
 #[derive(Debug)]
 pub struct TableWriter {
     path: PathBuf,
-    out: csv::Writer<File>,
+    out: csv::Writer<Hashed>,
     rows: u64,
+}
+
+/// A file that keeps the CRC-32 of the bytes written to it.
+#[derive(Debug)]
+struct Hashed {
+    file: File,
+    crc: crc32fast::Hasher,
+}
+
+impl Write for Hashed {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.file.write(buf)?;
+        self.crc.update(&buf[..n]);
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.file.flush()
+    }
 }
 
 fn csv_error(path: &Path, what: &str, e: csv::Error) -> Error {
@@ -32,15 +53,15 @@ fn csv_error(path: &Path, what: &str, e: csv::Error) -> Error {
     io_error(path, &format!("{what}{line}"), std::io::Error::other(e.to_string()))
 }
 
-fn writer(file: File) -> csv::Writer<File> {
-    csv::WriterBuilder::new().has_headers(false).from_writer(file)
+fn writer(file: File, crc: crc32fast::Hasher) -> csv::Writer<Hashed> {
+    csv::WriterBuilder::new().has_headers(false).from_writer(Hashed { file, crc })
 }
 
 impl TableWriter {
     /// Creates (truncates) the file at `path` and writes the header.
     pub fn create<S: AsRef<str>>(path: &Path, header: &[S]) -> Result<Self> {
         let file = File::create(path).map_err(|e| io_error(path, "create", e))?;
-        let mut out = writer(file);
+        let mut out = writer(file, crc32fast::Hasher::new());
         out.write_record(header.iter().map(|s| s.as_ref())).map_err(|e| csv_error(path, "write", e))?;
         Ok(Self { path: path.to_path_buf(), out, rows: 0 })
     }
@@ -51,14 +72,16 @@ impl TableWriter {
     ///
     /// # Errors
     /// If the file is missing, or shorter than `bytes`, or does not hold a header
-    /// and exactly `rows` complete lines in its first `bytes` bytes.
-    pub fn resume(path: &Path, bytes: u64, rows: u64) -> Result<Self> {
-        check_length(path, bytes, rows)?;
+    /// and exactly `rows` complete lines in its first `bytes` bytes, or these
+    /// bytes do not have the CRC-32 `crc` (the file was edited).
+    pub fn resume(path: &Path, bytes: u64, rows: u64, crc: u32) -> Result<Self> {
+        check_length(path, bytes, rows, crc)?;
         let file = std::fs::OpenOptions::new().write(true).open(path).map_err(|e| io_error(path, "open", e))?;
         file.set_len(bytes).map_err(|e| io_error(path, "truncate", e))?;
         let mut file = file;
         file.seek(std::io::SeekFrom::End(0)).map_err(|e| io_error(path, "seek", e))?;
-        Ok(Self { path: path.to_path_buf(), out: writer(file), rows })
+        let hasher = crc32fast::Hasher::new_with_initial_len(crc, bytes);
+        Ok(Self { path: path.to_path_buf(), out: writer(file, hasher), rows })
     }
 
     /// Appends one row.
@@ -72,9 +95,15 @@ impl TableWriter {
     /// a checkpoint.
     pub fn sync(&mut self) -> Result<u64> {
         self.out.flush().map_err(|e| io_error(&self.path, "write", e))?;
-        let f = self.out.get_ref();
+        let f = &self.out.get_ref().file;
         f.sync_data().map_err(|e| io_error(&self.path, "sync", e))?;
         Ok(f.metadata().map_err(|e| io_error(&self.path, "read", e))?.len())
+    }
+
+    /// CRC-32 of the bytes written so far, header included (after
+    /// [`TableWriter::sync`]: of the whole file), for a checkpoint.
+    pub fn crc32(&self) -> u32 {
+        self.out.get_ref().crc.clone().finalize()
     }
 
     /// Number of rows written (header excluded).
@@ -94,8 +123,8 @@ impl TableWriter {
 }
 
 /// Checks that the first `bytes` bytes of the table at `path` are its header and
-/// `rows` complete lines.
-pub fn check_length(path: &Path, bytes: u64, rows: u64) -> Result<()> {
+/// `rows` complete lines, with the CRC-32 `crc`.
+pub fn check_length(path: &Path, bytes: u64, rows: u64, crc: u32) -> Result<()> {
     let bad = |msg: String| Err(Error::Scene(format!("not a valid checkpoint: '{}' {msg}", path.display())));
     let text = match std::fs::read(path) {
         Ok(t) => t,
@@ -109,6 +138,9 @@ pub fn check_length(path: &Path, bytes: u64, rows: u64) -> Result<()> {
     let lines = head.iter().filter(|&&b| b == b'\n').count() as u64;
     if head.last() != Some(&b'\n') || lines != rows + 1 {
         return bad(format!("does not hold a header and {rows} rows in its first {bytes} bytes"));
+    }
+    if crc32fast::hash(head) != crc {
+        return bad(format!("was edited since the checkpoint (its first {bytes} bytes have another checksum)"));
     }
     Ok(())
 }
@@ -195,14 +227,20 @@ mod tests {
         let mut w = TableWriter::create(&path, &["time_s", "n", "fraction", "a, \"b\"_force_N", "c_force_N"]).unwrap();
         w.write(&rows[0]).unwrap();
         let bytes = w.sync().unwrap();
+        let crc = w.crc32();
+        assert_eq!(crc, crc32fast::hash(&std::fs::read(&path).unwrap()));
         w.write(&rows[1]).unwrap();
         w.finish().unwrap();
         let (header, back): (_, Vec<Row>) = read(&path).unwrap();
         assert_eq!(header[3], "a, \"b\"_force_N");
         assert_eq!(back, rows);
-        let mut w = TableWriter::resume(&path, bytes, 1).unwrap();
-        assert!(TableWriter::resume(&path, bytes, 2).is_err(), "wrong row count");
+        assert!(TableWriter::resume(&path, bytes, 1, crc ^ 1).is_err(), "wrong checksum");
+        let mut w = TableWriter::resume(&path, bytes, 1, crc).unwrap();
+        assert!(TableWriter::resume(&path, bytes, 2, crc).is_err(), "wrong row count");
         w.write(&rows[1]).unwrap();
+        w.sync().unwrap();
+        // The checksum goes on from the resumed part: that of the whole file.
+        assert_eq!(w.crc32(), crc32fast::hash(&std::fs::read(&path).unwrap()));
         w.finish().unwrap();
         assert_eq!(read::<Row>(&path).unwrap().1, rows);
         let _ = std::fs::remove_dir_all(&dir);

@@ -197,6 +197,11 @@ fn one() -> u64 {
     1
 }
 
+/// Whether two vectors are the same bit for bit.
+fn same_bits(a: &V3, b: &V3) -> bool {
+    a.iter().zip(b.iter()).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
 /// Spheres per chunk below which a step stays on one thread (a phase must
 /// outlast the hand-over to the helper by far).
 const PAR_MIN: usize = 256;
@@ -558,7 +563,11 @@ impl MdSystem {
 
     /// Checks that the state holds together (a state read from a checkpoint):
     /// array lengths, material and partner indices, the neighbour rows, finite
-    /// positions and velocities, the clock. The message names what is wrong.
+    /// positions and velocities, the clock, the Gear positions, and the state
+    /// derived from the positions at the last neighbour build (images, neighbour
+    /// list, wall candidates, their contact memory: built again from
+    /// `neighbours.x_build` and the walls at `s_build`, they must come out the
+    /// same). The message names what is wrong.
     pub fn check_state(&self) -> Result<()> {
         let bad = |msg: String| Err(Error::Scene(msg));
         let p = &self.particles;
@@ -586,25 +595,31 @@ impl MdSystem {
         if self.gear_x.len() != expected || self.gear_w.len() != expected {
             return bad(format!("Gear derivatives of {} spheres for {n}", self.gear_x.len()));
         }
+        // The corrector leaves the position in the first Gear row.
+        if let Some(i) = (0..self.gear_x.len()).find(|&i| !same_bits(&self.gear_x[i][0], &p.x[i])) {
+            return bad(format!("sphere {i}: the Gear position is not the sphere's"));
+        }
         let nw = self.walls.len();
-        if !self.wall_hist.is_empty() && self.wall_hist.len() != n * nw {
+        if self.wall_hist.len() != n * nw {
             return bad(format!(
                 "wall contact memory of {} entries for {n} spheres and {nw} walls",
                 self.wall_hist.len()
             ));
         }
         let nb = &self.neighbours;
-        let rows_ok = nb.start.is_empty()
-            || (nb.start.len() == n + 1
-                && nb.start[0] == 0
-                && nb.start.windows(2).all(|w| w[0] <= w[1])
-                && nb.start[n] as usize == nb.j.len());
+        let rows_ok = nb.start.len() == n + 1
+            && nb.start[0] == 0
+            && nb.start.windows(2).all(|w| w[0] <= w[1])
+            && nb.start[n] as usize == nb.j.len();
         if !rows_ok || nb.key.len() != nb.j.len() || nb.hist.len() != nb.j.len() {
             return bad("neighbour list: rows, partners, keys and memory do not match".into());
         }
         let n_all = n + self.ghosts.len();
-        if nb.j.iter().any(|&j| j as usize >= n_all) || !(nb.x_build.is_empty() || nb.x_build.len() == n) {
+        if nb.j.iter().any(|&j| j as usize >= n_all) || nb.x_build.len() != n {
             return bad("neighbour list: a partner or build position out of range".into());
+        }
+        if nb.skin.to_bits() != self.settings.skin.to_bits() {
+            return bad(format!("neighbour list: skin {} m, the settings' is {} m", nb.skin, self.settings.skin));
         }
         let g = &self.ghosts;
         if g.mask.len() != g.len() || g.key.len() != g.len() || g.origin.iter().any(|&i| i as usize >= n) {
@@ -616,6 +631,27 @@ impl MdSystem {
         if !(self.settings.dt.is_finite() && self.settings.dt > 0.0) {
             return bad(format!("time step {} s", self.settings.dt));
         }
+        // The derived state, built again where it was built.
+        let mut again = self.clone();
+        again.particles.x.clone_from(&nb.x_build);
+        for w in &mut again.walls {
+            w.s = w.s_build;
+        }
+        again.rebuild();
+        let (a, b) = (&again.neighbours, &again.ghosts);
+        if a.start != nb.start || a.j != nb.j || a.key != nb.key || a.hist != nb.hist {
+            return bad("neighbour list: not the list of the spheres at its build".into());
+        }
+        if b.origin != g.origin || b.mask != g.mask || b.key != g.key {
+            return bad("symmetry images: not the images of the spheres at the last build".into());
+        }
+        if let Some((w, _)) = self.walls.iter().zip(&again.walls).find(|(w, v)| w.candidates != v.candidates) {
+            let name = crate::scene::clip(&w.name);
+            return bad(format!("wall '{name}': not the candidate spheres of the last build"));
+        }
+        if again.wall_hist != self.wall_hist {
+            return bad("wall contact memory: held for spheres that are not candidates".into());
+        }
         let t = crate::clock::time_at(self.time_origin, self.step_origin, self.step, self.settings.dt);
         if self.step < self.step_origin || t.to_bits() != self.time.to_bits() {
             return bad(format!("clock: time {} s at step {} does not follow from its origin", self.time, self.step));
@@ -625,7 +661,9 @@ impl MdSystem {
 
     /// Checks that `self` is a state of the model `fresh` (the system built from
     /// the same scene): the same spheres (names, radii, masses, materials),
-    /// walls (names, shapes, motions), laws, symmetry planes and settings.
+    /// walls (names, shapes, motions), laws, symmetry planes, settings,
+    /// measurement period, clock origin, zero of the gravitational energy and
+    /// energy at the start.
     pub fn check_same_model(&self, fresh: &MdSystem) -> Result<()> {
         let bad = |what: String| Err(Error::Scene(format!("{what} differs from the scene's")));
         let (a, b) = (&self.particles, &fresh.particles);
@@ -658,8 +696,20 @@ impl MdSystem {
         if !same(&|s| serde_json::to_value(&s.ghosts.planes).unwrap_or_default()) {
             return bad("the symmetry planes".into());
         }
-        if self.settings != fresh.settings {
-            return bad("the [md] settings or time step".into());
+        if self.settings != fresh.settings || self.measure_every != fresh.measure_every {
+            return bad("the [md] settings, time step or measurement period".into());
+        }
+        // The run loop never changes the time step: the clock keeps its origin.
+        if self.time_origin.to_bits() != fresh.time_origin.to_bits() || self.step_origin != fresh.step_origin {
+            return bad("the clock's origin".into());
+        }
+        // Set when the system is built: the zero of the gravitational energy and
+        // the energy budget of the divergence check.
+        if self.gravity_reference.to_bits() != fresh.gravity_reference.to_bits() {
+            return bad("the zero of the gravitational energy".into());
+        }
+        if self.energy_start.to_bits() != fresh.energy_start.to_bits() {
+            return bad("the energy at the start (the budget of the energy-growth check)".into());
         }
         Ok(())
     }

@@ -165,6 +165,13 @@ impl System {
         if let Some(i) = (0..n).find(|&i| self.bodies.q[i].iter().chain(&self.bodies.u[i]).any(|x| !x.is_finite())) {
             failure = Some((i, "non-finite position or velocity".to_string()));
         }
+        // Scenes place bodies within ±MAX_LENGTH (the detection grid and the
+        // restart scene, `final_scene.toml`, rely on it): a body carried beyond
+        // has run away.
+        let far = crate::scene::MAX_LENGTH;
+        if let Some(i) = (0..n).find(|&i| failure.is_none() && self.bodies.q[i][..2].iter().any(|x| x.abs() > far)) {
+            failure = Some((i, format!("runaway position: its centre of mass is beyond ±{far:e} m")));
+        }
         stats.kinetic_energy = self.bodies.kinetic_energy();
         if failure.is_none() && !stats.kinetic_energy.is_finite() {
             let speed = |i: usize| self.bodies.u[i][0].hypot(self.bodies.u[i][1]);

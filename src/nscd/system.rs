@@ -400,8 +400,9 @@ impl System {
 
     /// Checks that `self` is a state of the model `fresh` (the system built from
     /// the same scene): the same bodies (names, shapes, materials, masses,
-    /// fixed, imposed, loads), springs (but their impulses), contact laws and
-    /// parameters.
+    /// inverse masses, fixed, imposed, loads), springs (but their impulses),
+    /// contact laws, parameters, clock origin and zero of the gravitational
+    /// energy.
     pub fn check_same_model(&self, fresh: &System) -> crate::Result<()> {
         let bad = |what: String| Err(crate::Error::Scene(format!("{what} differs from the scene's")));
         if self.bodies.len() != fresh.bodies.len() {
@@ -425,8 +426,27 @@ impl System {
         if self.materials != fresh.materials || !same(&self.laws, &fresh.laws) {
             return bad("the contact laws".into());
         }
+        if let Some(i) = (0..self.bodies.len()).find(|&i| !same(&self.bodies.inv_m[i], &fresh.bodies.inv_m[i])) {
+            return bad(format!(
+                "the inverse masses of body {i} ('{}')",
+                crate::scene::clip(&fresh.bodies.info[i].name)
+            ));
+        }
         if self.params != fresh.params {
             return bad("the [nscd] parameters or time step".into());
+        }
+        // The run loop never changes the time step: the clock keeps its origin.
+        if self.time_origin.to_bits() != fresh.time_origin.to_bits() || self.step_origin != fresh.step_origin {
+            return bad("the clock's origin".into());
+        }
+        // The zero of the gravitational energy is set by the first step, from
+        // the state the run starts from.
+        let reference = match fresh.gravity_reference {
+            None if self.step > fresh.step => Some(fresh.lowest_point()),
+            r => r,
+        };
+        if !same(&self.gravity_reference, &reference) {
+            return bad("the zero of the gravitational energy".into());
         }
         Ok(())
     }

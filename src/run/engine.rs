@@ -13,6 +13,7 @@
 //! next step starts exactly from the written configuration.
 
 use crate::error::Result;
+use crate::io::cycles::CycleCheck;
 use crate::io::summary::StepSummary;
 use crate::io::vtk::PvdCollection;
 use crate::io::FinalState;
@@ -104,8 +105,9 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// [`crate::io::series`]; the columns carry their unit in their name).
     type Row: Serialize + DeserializeOwned + Clone + std::fmt::Debug;
     /// What the per-cycle output accumulates over the steps of a cycle (kept in
-    /// checkpoints).
-    type CycleState: Clone + std::fmt::Debug + Serialize + DeserializeOwned + Send;
+    /// checkpoints, checked on resume against the state [`Engine::cycle_start`]
+    /// gives: [`CycleCheck`]).
+    type CycleState: Clone + std::fmt::Debug + Serialize + DeserializeOwned + Send + CycleCheck;
     /// One row of `cycles.csv`.
     type CycleRow: Serialize + DeserializeOwned + Clone + std::fmt::Debug;
 

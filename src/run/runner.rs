@@ -18,6 +18,7 @@ use super::equilibrium::Equilibrium;
 use crate::clock::cycles_at;
 use crate::error::{Error, Result};
 use crate::io::checkpoint::{crc32, Checkpoint, CHECKPOINT_FILE};
+use crate::io::cycles::CycleCheck;
 use crate::io::positions::{PositionsWriter, BODIES_FILE, DISPLACEMENTS_FILE};
 use crate::io::summary::{RunEnd, RunReport, RunSummary};
 use crate::io::table::TableWriter;
@@ -411,22 +412,7 @@ impl<E: Engine> Runner<E> {
         ] {
             io::remove_stale(out, stale)?;
         }
-        match &self.origin {
-            Origin::Scene { path, .. } => {
-                io::copy_scene(path, out)?;
-            }
-            Origin::Code { json } => {
-                io::write_text(out, files::INITIAL_STATE, json)?;
-            }
-        }
-        let info = RunInfo {
-            seed: self.plan.seed,
-            engine: E::NAME.to_string(),
-            version: env!("CARGO_PKG_VERSION").to_string(),
-            steps: self.plan.steps,
-            dt: sys.dt(),
-        };
-        info.write(out)?;
+        self.write_records(out)?;
         let series = TableWriter::create(&out.join(files::SERIES), &sys.series_header())?;
         let mut snapshots = PvdCollection::new();
         if opts.vtk_every > 0 {
@@ -459,8 +445,31 @@ impl<E: Engine> Runner<E> {
         Ok(Live { sys, summary, series, snapshots, cycles, cycles_done: 0, positions, first_step })
     }
 
+    /// Writes the record of the run's input: the copy of the scene (or the
+    /// initial state of a system built in code) and `run.json`.
+    fn write_records(&self, out: &Path) -> Result<()> {
+        match &self.origin {
+            Origin::Scene { path, .. } => {
+                io::copy_scene(path, out)?;
+            }
+            Origin::Code { json } => {
+                io::write_text(out, files::INITIAL_STATE, json)?;
+            }
+        }
+        let info = RunInfo {
+            seed: self.plan.seed,
+            engine: E::NAME.to_string(),
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            steps: self.plan.steps,
+            dt: self.system.dt(),
+        };
+        info.write(out)?;
+        Ok(())
+    }
+
     /// The run continued from the checkpoint in `out`, checked against the plan,
-    /// the initial system and the files.
+    /// the initial system and the files. The record of the input is written
+    /// again (the checkpoint holds the CRC-32 of the scene text: it is the same).
     fn resume(&self, out: &Path) -> Result<Live<E>> {
         let path = out.join(CHECKPOINT_FILE);
         if !path.is_file() {
@@ -495,7 +504,7 @@ impl<E: Engine> Runner<E> {
         if cp.series_rows != rows {
             return Err(bad(format!("{} rows of series.csv, {rows} expected after step {step}", cp.series_rows)));
         }
-        let series = TableWriter::resume(&out.join(files::SERIES), cp.series_bytes, cp.series_rows)?;
+        let series = TableWriter::resume(&out.join(files::SERIES), cp.series_bytes, cp.series_rows, cp.series_crc32)?;
         let (cycles, positions) = match (plan.cycles, cp.cycles) {
             (Some(c), Some(state)) => {
                 let done = cycles_at(cp.system.time(), c.frequency, cp.system.dt());
@@ -507,24 +516,39 @@ impl<E: Engine> Runner<E> {
                         cp.system.time()
                     )));
                 }
-                let table = TableWriter::resume(&out.join(files::CYCLES), cp.cycles_bytes, cp.cycles_rows)?;
+                // The per-cycle state must start where this run's does.
+                let start = self.system.cycle_start(c.body)?;
+                state.check(&start, cp.system.body_count(), done).map_err(|e| bad(format!("per-cycle state: {e}")))?;
+                let table =
+                    TableWriter::resume(&out.join(files::CYCLES), cp.cycles_bytes, cp.cycles_rows, cp.cycles_crc32)?;
                 let positions = match (c.positions, cp.positions) {
                     (true, Some(reference)) => {
                         reference.check(E::DOF, cp.system.body_count()).map_err(|e| bad(e.to_string()))?;
-                        Some(PositionsWriter::resume(out, reference, done)?)
+                        if reference != self.system.configuration() {
+                            return Err(bad("the followed bodies or their start differ from the scene's".into()));
+                        }
+                        let names: Vec<String> = reference.bodies.iter().map(|&i| body_name(&self.system, i)).collect();
+                        Some(PositionsWriter::resume(out, reference, &names, done, cp.positions_crc32)?)
                     }
-                    (false, None) => None,
+                    (false, None) if cp.positions_crc32 == 0 => None,
                     _ => return Err(bad("the positions output does not match the scene's".into())),
                 };
                 (Some((state, table)), positions)
             }
-            (None, None) => (None, None),
+            (None, None) => {
+                let counts = [cp.cycles_bytes, cp.cycles_rows, cp.cycles_done, cp.cycles_crc32.into()];
+                if counts != [0; 4] || cp.positions.is_some() || cp.positions_crc32 != 0 {
+                    return Err(bad("per-cycle counters or positions in a run without per-cycle output".into()));
+                }
+                (None, None)
+            }
             _ => return Err(bad("the per-cycle output does not match the scene's".into())),
         };
         if cp.snapshots.entries().iter().any(|e| !e.parts.iter().all(|p| out.join(&p.file).is_file())) {
             return Err(bad("a snapshot it lists is missing".into()));
         }
         io::remove_stale(out, files::FINAL_SCENE)?;
+        self.write_records(out)?;
         Ok(Live {
             sys: cp.system,
             summary: cp.summary,
@@ -540,9 +564,9 @@ impl<E: Engine> Runner<E> {
     /// Writes `checkpoint.json` for the run in progress.
     fn checkpoint(&self, out: &Path, live: &mut Live<E>) -> Result<()> {
         let series_bytes = live.series.sync()?;
-        let (cycles_bytes, cycles_rows) = match live.cycles.as_mut() {
-            Some((_, t)) => (t.sync()?, t.rows()),
-            None => (0, 0),
+        let (cycles_bytes, cycles_rows, cycles_crc32) = match live.cycles.as_mut() {
+            Some((_, t)) => (t.sync()?, t.rows(), t.crc32()),
+            None => (0, 0, 0),
         };
         if let Some(p) = live.positions.as_mut() {
             p.sync()?;
@@ -555,14 +579,17 @@ impl<E: Engine> Runner<E> {
             step: live.sys.steps_done(),
             series_bytes,
             series_rows: live.series.rows(),
+            series_crc32: live.series.crc32(),
             cycles_bytes,
             cycles_rows,
+            cycles_crc32,
             summary: live.summary,
             system: live.sys.clone(),
             snapshots: live.snapshots.clone(),
             cycles: live.cycles.as_ref().map(|(s, _)| s.clone()),
             cycles_done: live.cycles_done,
             positions: live.positions.as_ref().map(|p| p.reference().clone()),
+            positions_crc32: live.positions.as_ref().map_or(0, |p| p.crc32()),
         }
         .write(out)?;
         Ok(())

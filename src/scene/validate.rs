@@ -70,8 +70,23 @@ pub(crate) fn num(v: f64) -> String {
     }
 }
 
+/// A scene error. Its message is made one line of bounded length whatever the
+/// scene holds: control characters become `?` and every quoted span (`'…'`,
+/// where the messages quote the user's strings) is cut to 64 characters
+/// ([`super::clip`]); a safety net under the `clip` of names in the messages of
+/// both engines' validation.
 pub(crate) fn err<T>(msg: String) -> Result<T> {
-    Err(Error::Scene(msg))
+    Err(Error::Scene(tidy(&msg)))
+}
+
+/// `msg` as [`err`] writes it.
+fn tidy(msg: &str) -> String {
+    let plain = |s: &str| s.chars().map(|c| if c.is_control() { '?' } else { c }).collect::<String>();
+    msg.split('\'')
+        .enumerate()
+        .map(|(k, s)| if k % 2 == 1 { super::clip(s) } else { plain(s) })
+        .collect::<Vec<_>>()
+        .join("'")
 }
 
 /// `ctx: must be finite, got …` unless `v` is finite.
@@ -130,12 +145,13 @@ pub(crate) fn body_label(i: usize, b: &BodySpec) -> String {
     label("body", i, &b.name)
 }
 
-/// `section[i] 'name'`, or `section[i]` when `name` is empty.
+/// `section[i] 'name'`, or `section[i]` when `name` is empty (the name
+/// clipped, [`super::clip`]).
 pub(crate) fn label(section: &str, i: usize, name: &str) -> String {
     if name.is_empty() {
         format!("{section}[{i}]")
     } else {
-        format!("{section}[{i}] '{name}'")
+        format!("{section}[{i}] '{}'", super::clip(name))
     }
 }
 
@@ -235,7 +251,8 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
     let criterion = ns.criterion.as_deref().unwrap_or(defaults.nlgs.policy.name());
     let Some(policy) = policy(criterion) else {
         return err(format!(
-            "nscd.criterion: unknown criterion '{criterion}', expected one of 'strict', 'quad', 'quad_max', 'energy'"
+            "nscd.criterion: unknown criterion '{}', expected one of 'strict', 'quad', 'quad_max', 'energy'",
+            super::clip(criterion)
         ));
     };
     let tolerance = ns.tolerance.unwrap_or(defaults.nlgs.tolerance);
@@ -279,9 +296,12 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
             return err(format!("material[{i}].name: must not be empty"));
         }
         if let Some(j) = materials.insert(m.name.as_str(), i) {
-            return err(format!("material[{i}].name: duplicate material '{}' (also material[{j}])", m.name));
+            return err(format!(
+                "material[{i}].name: duplicate material '{}' (also material[{j}])",
+                super::clip(&m.name)
+            ));
         }
-        positive(&format!("material[{i}] '{}': density", m.name), m.density)?;
+        positive(&format!("{}: density", label("material", i, &m.name)), m.density)?;
     }
 
     // [[contact]]
@@ -291,14 +311,15 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
         for (k, name) in c.between.iter().enumerate() {
             match materials.get(name.as_str()) {
                 Some(&m) => ids[k] = m,
-                None => return err(format!("contact[{i}].between: unknown material '{name}'")),
+                None => return err(format!("contact[{i}].between: unknown material '{}'", super::clip(name))),
             }
         }
         let key = (ids[0].min(ids[1]), ids[0].max(ids[1]));
         if let Some(j) = pairs.insert(key, i) {
             return err(format!(
                 "contact[{i}].between: duplicate law for materials '{}' and '{}' (also contact[{j}])",
-                c.between[0], c.between[1]
+                super::clip(&c.between[0]),
+                super::clip(&c.between[1])
             ));
         }
         non_negative(&format!("contact[{i}].friction"), c.friction)?;
@@ -321,7 +342,7 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
             }
         }
         let Some(&material) = materials.get(b.material.as_str()) else {
-            return err(format!("{}: unknown material '{}'", ctx("material"), b.material));
+            return err(format!("{}: unknown material '{}'", ctx("material"), super::clip(&b.material)));
         };
         let (shape, centroid) = shape_of(b).map_err(|e| Error::Scene(format!("{label}: {e}")))?;
         let size = shape.bounding_radius() + centroid.norm();
@@ -388,7 +409,7 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
     for (i, s) in scene.springs.iter().enumerate() {
         let ctx = |field: &str| format!("spring[{i}].{field}");
         let Some(&a) = names.get(s.body.as_str()) else {
-            return err(format!("{}: unknown body '{}'", ctx("body"), s.body));
+            return err(format!("{}: unknown body '{}'", ctx("body"), super::clip(&s.body)));
         };
         let point_a = coordinates(&ctx("point"), s.point.unwrap_or([0.0, 0.0]))?;
         let (b, point_b, end_b) = match (&s.anchor, &s.other) {
@@ -403,10 +424,10 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
             }
             (None, Some(other)) => {
                 let Some(&b) = names.get(other.as_str()) else {
-                    return err(format!("{}: unknown body '{other}'", ctx("other")));
+                    return err(format!("{}: unknown body '{}'", ctx("other"), super::clip(other)));
                 };
                 if b == a {
-                    return err(format!("{}: the spring joins body '{other}' to itself", ctx("other")));
+                    return err(format!("{}: the spring joins body '{}' to itself", ctx("other"), super::clip(other)));
                 }
                 let p = coordinates(&ctx("other_point"), s.other_point.unwrap_or([0.0, 0.0]))?;
                 (Some(b), p, world(b, p))
