@@ -241,6 +241,7 @@ enum Pause {
     /// Busy-wait one round (`spin_loop`).
     Spin,
     /// Give the core away for one round (`yield_now`).
+    #[cfg_attr(feature = "loom", allow(dead_code))] // the model's waits are spins (loom yields)
     Yield,
     /// (Helper only) sleep until unparked: [`sync::sleep`].
     Sleep,
@@ -256,16 +257,21 @@ enum Pause {
 ///   zero-cost inline call).
 /// - The waiting policy ([`Idle`], [`sleep`]): loom has no clock (`Instant`) and no
 ///   `park_timeout`, and time-based spinning would make its state space endless.
-///   In the model, the helper spins one round (a loom yield) and then takes the
-///   sleep path, where the real code waits for 50 µs and then 5 ms of idleness;
-///   and `sleep` is a `park` without timeout. The model thus goes through the
-///   same three places where the helper can find a job (the check before waiting,
-///   the check after a spin, the re-check after raising `sleeping`) and the
-///   same unpark by `join` and by `Drop`, with one difference that makes it
-///   stricter: the 50 ms timeout of the real sleep would hide a lost wake-up as
-///   a latency, while in the model it is a deadlock, which loom reports. The
-///   caller's wait for `done` is a loop of loom yields, as spin and yield are the
-///   same thing to loom.
+///   In the model, an idle helper goes straight to the sleep path, where the real
+///   code first spins for 50 µs and yields until 5 ms of idleness; and `sleep` is
+///   a `park` without timeout. A spin or yield round only goes back to the check
+///   of `stop` and `posted` at the top of the loop, so the model still goes
+///   through every place where the helper can find a job or the stop (that
+///   check, before and after each sleep, and the re-check after raising
+///   `sleeping`) and through the unparks by `join` and by `Drop`. It has no spin
+///   round of its own because to loom a spin is a yield, after which it lets the
+///   other threads run rather than preempt them for the spinning one: with one
+///   spin round, the models missed a `Drop` without unpark and a `join` without
+///   unpark on the first job (both caught as they are). And it is stricter than
+///   the real code where it matters: the 50 ms timeout of the real sleep would
+///   hide a lost wake-up as a latency, while in the model it is a deadlock, which
+///   loom reports. The caller's wait for `done` is a loop of loom yields (spin
+///   and yield are the same thing to loom).
 ///
 /// With the feature on, a `Team` of two threads works only inside
 /// `loom::model`: the feature is for the model test alone.
@@ -368,33 +374,24 @@ mod sync {
     mod idle {
         use super::Pause;
 
-        /// Rounds of spinning before the helper sleeps, in the model.
-        const SPINS: u32 = 1;
-
-        /// The count of one wait (loom has no clock).
-        pub(in super::super) struct Idle {
-            spins: u32,
-        }
+        /// No state: the model's waits are not timed.
+        pub(in super::super) struct Idle;
 
         impl Idle {
             pub(in super::super) fn new() -> Self {
-                Idle { spins: 0 }
+                Idle
             }
 
-            /// The helper waiting for a job: `SPINS` spins, then sleep.
+            /// The helper waiting for a job: straight to the sleep path (see the
+            /// module's documentation for why not a spin round first).
             pub(in super::super) fn helper_pause(&mut self) -> Pause {
-                self.spins = self.spins.saturating_add(1);
-                if self.spins <= SPINS {
-                    Pause::Spin
-                } else {
-                    Pause::Sleep
-                }
+                Pause::Sleep
             }
 
             /// The caller waiting for the helper's half: a loom yield each round
             /// (to loom, `spin_loop` is `yield_now`).
             pub(in super::super) fn caller_pause(&mut self) -> Pause {
-                Pause::Yield
+                Pause::Spin
             }
         }
 

@@ -7,7 +7,7 @@
 //!
 //! Each model runs `Team::join` as the crate compiles it, under every
 //! interleaving of its threads (caller, helper, and in one model a second caller)
-//! up to `LOOM_MAX_PREEMPTIONS` preemptions (2 unless set), and fails on a data
+//! up to `LOOM_MAX_PREEMPTIONS` preemptions (3 unless set), and fails on a data
 //! race on a loom `UnsafeCell` (the erased job slot inside the team, and the
 //! `Probe`s written by the halves here), on a deadlock (among them a lost
 //! wake-up of the sleeping helper: the model's sleep has no timeout), on a
@@ -25,13 +25,13 @@ use std::time::Instant;
 use ballast::team::Team;
 use loom::cell::UnsafeCell;
 
-/// Runs `f` under loom with at most 2 preemptions (unless `LOOM_MAX_PREEMPTIONS`
+/// Runs `f` under loom with at most 3 preemptions (unless `LOOM_MAX_PREEMPTIONS`
 /// says otherwise), and prints how many interleavings it went through
 /// (`-- --nocapture` shows them).
 fn model(name: &str, f: impl Fn() + Sync + Send + 'static) {
     let mut builder = loom::model::Builder::new();
     if builder.preemption_bound.is_none() {
-        builder.preemption_bound = Some(2);
+        builder.preemption_bound = Some(3);
     }
     let runs = Arc::new(AtomicUsize::new(0));
     let counter = Arc::clone(&runs);
