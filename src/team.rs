@@ -374,12 +374,17 @@ mod sync {
     mod idle {
         use super::Pause;
 
-        /// No state: the model's waits are not timed.
-        pub(in super::super) struct Idle;
+        /// Rounds after which the caller's wait gives up in the model.
+        const ROUNDS: u32 = 10_000;
+
+        /// The count of one wait (the model's waits are not timed).
+        pub(in super::super) struct Idle {
+            rounds: u32,
+        }
 
         impl Idle {
             pub(in super::super) fn new() -> Self {
-                Idle
+                Idle { rounds: 0 }
             }
 
             /// The helper waiting for a job: straight to the sleep path (see the
@@ -389,8 +394,25 @@ mod sync {
             }
 
             /// The caller waiting for the helper's half: a loom yield each round
-            /// (to loom, `spin_loop` is `yield_now`).
+            /// (to loom, `spin_loop` is `yield_now`), and an abort after `ROUNDS`.
+            /// Loom stops an endless wait at its branch limit (1000 by default,
+            /// reached long before), but not while the thread unwinds, as the
+            /// guard's wait does when `a` panicked: a helper that never finished
+            /// (e.g. a lost wake-up) then made a failing model grow until the
+            /// machine ran out of memory. An abort, since the guard must not
+            /// panic.
             pub(in super::super) fn caller_pause(&mut self) -> Pause {
+                self.rounds += 1;
+                if self.rounds > ROUNDS {
+                    // Straight to stderr: the test harness's capture would be
+                    // lost with the process.
+                    use std::io::Write;
+                    let _ = writeln!(
+                        std::io::stderr(),
+                        "team model: the helper did not finish its job ({ROUNDS} rounds of waiting); aborting"
+                    );
+                    std::process::abort();
+                }
                 Pause::Spin
             }
         }

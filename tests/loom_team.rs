@@ -2,7 +2,7 @@
 //! feature, on loom's primitives: see `mod sync` in `src/team.rs`):
 //!
 //! ```sh
-//! cargo test --release --features loom --test loom_team
+//! cargo test --features loom --test loom_team   # or with --release
 //! ```
 //!
 //! Each model runs `Team::join` as the crate compiles it, under every
