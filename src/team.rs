@@ -14,6 +14,9 @@
 //! The split NLGS (`nscd::split`) uses the same team for its two half-sweeps.
 //!
 //! A team without a helper (one thread) runs both halves in order on the caller.
+//!
+//! The hand-over is checked by a loom model of this very code (`mod sync` below,
+//! `tests/loom_team.rs`): `cargo test --features loom --test loom_team`.
 
 use sync::{
     fence, spin_loop, thread, yield_now, Arc, AtomicBool, AtomicU64, Idle, JoinHandle, Mutex, Ordering, UnsafeCell,
