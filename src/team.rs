@@ -14,17 +14,13 @@
 //! The split NLGS (`nscd::split`) uses the same team for its two half-sweeps.
 //!
 //! A team without a helper (one thread) runs both halves in order on the caller.
+//!
+//! The hand-over is checked by a loom model of this very code (`mod sync` below,
+//! `tests/loom_team.rs`): `cargo test --features loom --test loom_team`.
 
-use std::cell::UnsafeCell;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
-use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
-
-/// How long an idle helper spins before it starts yielding its core.
-const SPIN: Duration = Duration::from_micros(50);
-/// How long an idle helper yields before it sleeps until the next job.
-const YIELD: Duration = Duration::from_millis(5);
+use sync::{
+    fence, spin_loop, thread, yield_now, Arc, AtomicBool, AtomicU64, Idle, JoinHandle, Mutex, Ordering, UnsafeCell,
+};
 
 /// The job handed to the helper: a borrowed closure whose lifetime has been
 /// erased; [`Team::join`] does not return before the helper is done with it.
@@ -92,7 +88,7 @@ impl Team {
             job: UnsafeCell::new(None),
         });
         let s = Arc::clone(&shared);
-        let thread = std::thread::Builder::new().name("ballast-helper".into()).spawn(move || helper(&s));
+        let thread = thread::Builder::new().name("ballast-helper".into()).spawn(move || helper(&s));
         match thread {
             Ok(t) => Team { helper: Some(Helper { shared, thread: Some(t) }) },
             // No thread to be had: run on the caller alone.
@@ -144,9 +140,15 @@ impl Team {
         let number = s.posted.load(Ordering::Relaxed) + 1;
         // SAFETY: the helper finished the previous job (`done == posted`), so it
         // does not read `job` until `posted` is raised below.
-        unsafe { *s.job.get() = Some(job) };
-        s.posted.store(number, Ordering::SeqCst);
-        if s.sleeping.load(Ordering::SeqCst) {
+        s.job.with_mut(|slot| unsafe { *slot = Some(job) });
+        s.posted.store(number, Ordering::Release);
+        // With the fence of the helper's sleep path, a store-buffering (Dekker)
+        // hand-shake: either this load sees `sleeping` raised and unparks the
+        // helper, or the helper's re-check after raising it sees this job. (SeqCst
+        // fences rather than SeqCst accesses: the same guarantee, and the form
+        // loom checks; it treats SeqCst accesses as AcqRel.)
+        fence(Ordering::SeqCst);
+        if s.sleeping.load(Ordering::Relaxed) {
             if let Some(t) = &h.thread {
                 t.thread().unpark();
             }
@@ -171,14 +173,13 @@ struct Wait<'a> {
 
 impl Drop for Wait<'_> {
     fn drop(&mut self) {
-        let start = Instant::now();
-        let mut spins = 0u32;
+        // Nothing here may panic: this guard is what keeps `join` from returning
+        // (or unwinding) while the helper may still use the job.
+        let mut idle = Idle::new();
         while self.shared.done.load(Ordering::Acquire) < self.number {
-            spins += 1;
-            if spins < 4096 || start.elapsed() < SPIN {
-                std::hint::spin_loop();
-            } else {
-                std::thread::yield_now();
+            match idle.caller_pause() {
+                Pause::Spin => spin_loop(),
+                Pause::Yield | Pause::Sleep => yield_now(),
             }
         }
         self.shared.busy.store(false, Ordering::Release);
@@ -189,8 +190,7 @@ impl Drop for Wait<'_> {
 fn helper(s: &Shared) {
     let mut seen = 0u64;
     loop {
-        let start = Instant::now();
-        let mut spins = 0u32;
+        let mut idle = Idle::new();
         loop {
             if s.stop.load(Ordering::Acquire) {
                 return;
@@ -198,28 +198,28 @@ fn helper(s: &Shared) {
             if s.posted.load(Ordering::Acquire) > seen {
                 break;
             }
-            spins = spins.wrapping_add(1);
-            if !spins.is_multiple_of(64) {
-                std::hint::spin_loop();
-                continue;
-            }
-            let idle = start.elapsed();
-            if idle < SPIN {
-                std::hint::spin_loop();
-            } else if idle < YIELD {
-                std::thread::yield_now();
-            } else {
-                s.sleeping.store(true, Ordering::SeqCst);
-                if s.posted.load(Ordering::SeqCst) == seen && !s.stop.load(Ordering::SeqCst) {
-                    std::thread::park_timeout(Duration::from_millis(50));
+            match idle.helper_pause() {
+                Pause::Spin => spin_loop(),
+                Pause::Yield => yield_now(),
+                Pause::Sleep => {
+                    // Either the caller sees `sleeping` after raising `posted` and
+                    // unparks, or this sees the raise (the fences pair with the
+                    // one in `join`); `Drop` unparks unconditionally after raising
+                    // `stop`. An unpark that comes after this has woken up only
+                    // leaves a token: the next sleep returns at once and re-checks.
+                    s.sleeping.store(true, Ordering::Relaxed);
+                    fence(Ordering::SeqCst);
+                    if s.posted.load(Ordering::Relaxed) == seen && !s.stop.load(Ordering::SeqCst) {
+                        sync::sleep();
+                    }
+                    s.sleeping.store(false, Ordering::Relaxed);
                 }
-                s.sleeping.store(false, Ordering::SeqCst);
             }
         }
         seen = s.posted.load(Ordering::Acquire);
         // SAFETY: `posted` was raised after `job` was written, and the caller
         // does not write it again before `done` reaches `seen`.
-        let job = unsafe { (*s.job.get()).take() };
+        let job = s.job.with_mut(|slot| unsafe { (*slot).take() });
         if let Some(job) = job {
             job();
         }
@@ -239,7 +239,198 @@ impl Drop for Team {
     }
 }
 
-#[cfg(test)]
+/// What a waiting thread does next.
+enum Pause {
+    /// Busy-wait one round (`spin_loop`).
+    Spin,
+    /// Give the core away for one round (`yield_now`).
+    #[cfg_attr(feature = "loom", allow(dead_code))] // the model's waits are spins (loom yields)
+    Yield,
+    /// (Helper only) sleep until unparked: [`sync::sleep`].
+    Sleep,
+}
+
+/// The primitives the team synchronises with: std's in normal builds, and loom's
+/// under the `loom` feature, so that the model (`tests/loom_team.rs`) checks this
+/// very code, not a copy. Everything above is the same code in both builds; the
+/// only differences are here:
+///
+/// - `UnsafeCell`: loom's tracks every access and reports two that are not
+///   ordered by happens-before; std's is wrapped with the same `with_mut` (a
+///   zero-cost inline call).
+/// - The waiting policy ([`Idle`], [`sleep`]): loom has no clock (`Instant`) and no
+///   `park_timeout`, and time-based spinning would make its state space endless.
+///   In the model, an idle helper goes straight to the sleep path, where the real
+///   code first spins for 50 µs and yields until 5 ms of idleness; and `sleep` is
+///   a `park` without timeout. A spin or yield round only goes back to the check
+///   of `stop` and `posted` at the top of the loop, so the model still goes
+///   through every place where the helper can find a job or the stop (that
+///   check, before and after each sleep, and the re-check after raising
+///   `sleeping`) and through the unparks by `join` and by `Drop`. It has no spin
+///   round of its own because to loom a spin is a yield, after which it lets the
+///   other threads run rather than preempt them for the spinning one: with one
+///   spin round, the models missed a `Drop` without unpark and a `join` without
+///   unpark on the first job (both caught as they are). And it is stricter than
+///   the real code where it matters: the 50 ms timeout of the real sleep would
+///   hide a lost wake-up as a latency, while in the model it is a deadlock, which
+///   loom reports. The caller's wait for `done` is a loop of loom yields (spin
+///   and yield are the same thing to loom).
+///
+/// With the feature on, a `Team` of two threads works only inside
+/// `loom::model`: the feature is for the model test alone.
+mod sync {
+    #[cfg(not(feature = "loom"))]
+    pub(super) use std::{
+        hint::spin_loop,
+        sync::atomic::{fence, AtomicBool, AtomicU64, Ordering},
+        sync::{Arc, Mutex},
+        thread::{self, yield_now, JoinHandle},
+    };
+
+    #[cfg(feature = "loom")]
+    pub(super) use loom::{
+        cell::UnsafeCell,
+        hint::spin_loop,
+        sync::atomic::{fence, AtomicBool, AtomicU64, Ordering},
+        sync::{Arc, Mutex},
+        thread::{self, yield_now, JoinHandle},
+    };
+
+    use super::Pause;
+
+    /// `std::cell::UnsafeCell` with loom's access API.
+    #[cfg(not(feature = "loom"))]
+    pub(super) struct UnsafeCell<T>(std::cell::UnsafeCell<T>);
+
+    #[cfg(not(feature = "loom"))]
+    impl<T> UnsafeCell<T> {
+        pub(super) const fn new(value: T) -> Self {
+            UnsafeCell(std::cell::UnsafeCell::new(value))
+        }
+
+        #[inline(always)]
+        pub(super) fn with_mut<R>(&self, f: impl FnOnce(*mut T) -> R) -> R {
+            f(self.0.get())
+        }
+    }
+
+    #[cfg(not(feature = "loom"))]
+    mod idle {
+        use super::Pause;
+        use std::time::{Duration, Instant};
+
+        /// How long an idle helper spins before it starts yielding its core.
+        const SPIN: Duration = Duration::from_micros(50);
+        /// How long an idle helper yields before it sleeps until the next job.
+        const YIELD: Duration = Duration::from_millis(5);
+
+        /// The clock of one wait.
+        pub(in super::super) struct Idle {
+            start: Instant,
+            spins: u32,
+        }
+
+        impl Idle {
+            #[inline]
+            pub(in super::super) fn new() -> Self {
+                Idle { start: Instant::now(), spins: 0 }
+            }
+
+            /// The helper waiting for a job: spins for 50 µs (reading the clock
+            /// every 64 rounds), then yields until 5 ms, then sleeps.
+            #[inline]
+            pub(in super::super) fn helper_pause(&mut self) -> Pause {
+                self.spins = self.spins.wrapping_add(1);
+                if !self.spins.is_multiple_of(64) {
+                    return Pause::Spin;
+                }
+                let idle = self.start.elapsed();
+                if idle < SPIN {
+                    Pause::Spin
+                } else if idle < YIELD {
+                    Pause::Yield
+                } else {
+                    Pause::Sleep
+                }
+            }
+
+            /// The caller waiting for the helper's half: spins at least 4096
+            /// rounds and 50 µs, then yields; never sleeps (nothing would wake it).
+            #[inline]
+            pub(in super::super) fn caller_pause(&mut self) -> Pause {
+                self.spins = self.spins.saturating_add(1);
+                if self.spins < 4096 || self.start.elapsed() < SPIN {
+                    Pause::Spin
+                } else {
+                    Pause::Yield
+                }
+            }
+        }
+
+        /// The helper's sleep: until unparked, or 50 ms at most.
+        pub(in super::super) fn sleep() {
+            std::thread::park_timeout(Duration::from_millis(50));
+        }
+    }
+
+    #[cfg(feature = "loom")]
+    mod idle {
+        use super::Pause;
+
+        /// Rounds after which the caller's wait gives up in the model.
+        const ROUNDS: u32 = 10_000;
+
+        /// The count of one wait (the model's waits are not timed).
+        pub(in super::super) struct Idle {
+            rounds: u32,
+        }
+
+        impl Idle {
+            pub(in super::super) fn new() -> Self {
+                Idle { rounds: 0 }
+            }
+
+            /// The helper waiting for a job: straight to the sleep path (see the
+            /// module's documentation for why not a spin round first).
+            pub(in super::super) fn helper_pause(&mut self) -> Pause {
+                Pause::Sleep
+            }
+
+            /// The caller waiting for the helper's half: a loom yield each round
+            /// (to loom, `spin_loop` is `yield_now`), and an abort after `ROUNDS`.
+            /// Loom stops an endless wait at its branch limit (1000 by default,
+            /// reached long before), but not while the thread unwinds, as the
+            /// guard's wait does when `a` panicked: a helper that never finished
+            /// (e.g. a lost wake-up) then made a failing model grow until the
+            /// machine ran out of memory. An abort, since the guard must not
+            /// panic.
+            pub(in super::super) fn caller_pause(&mut self) -> Pause {
+                self.rounds += 1;
+                if self.rounds > ROUNDS {
+                    // Straight to stderr: the test harness's capture would be
+                    // lost with the process.
+                    use std::io::Write;
+                    let _ = writeln!(
+                        std::io::stderr(),
+                        "team model: the helper did not finish its job ({ROUNDS} rounds of waiting); aborting"
+                    );
+                    std::process::abort();
+                }
+                Pause::Spin
+            }
+        }
+
+        /// The helper's sleep: until unparked, without the real code's timeout,
+        /// so that a lost wake-up is a deadlock loom reports.
+        pub(in super::super) fn sleep() {
+            loom::thread::park();
+        }
+    }
+
+    pub(super) use idle::{sleep, Idle};
+}
+
+#[cfg(all(test, not(feature = "loom")))]
 mod tests {
     use super::Team;
 
