@@ -522,3 +522,19 @@ fn a_failed_step_leaves_the_last_good_state() {
     assert_eq!(sys.step().unwrap_err().to_string(), last_good.step().unwrap_err().to_string());
     assert_eq!(serde_json::to_value(&sys).unwrap(), serde_json::to_value(&last_good).unwrap());
 }
+
+/// A sphere carried beyond the bounds of a scene (±1e9 m, `MAX_LENGTH`) ends the
+/// run with a divergence naming it, so that the state can always be written back
+/// as a valid scene: 0.5 mm inside the bound at 1 m/s, Δt = 1 ms, it crosses it
+/// in the first step (x = 1e9 + 0.5 mm), and the system holds the start.
+#[test]
+fn a_sphere_beyond_the_scene_bounds_diverges() {
+    let x0 = ballast::scene::MAX_LENGTH - 5e-4;
+    let mut p = Particles::default();
+    p.push("runaway", 0, 2000.0, 0.01, V3::new(x0, 0.0, 0.0), V3::new(1.0, 0.0, 0.0), V3::zeros());
+    let law = PairLaw::hertz(&material(1e8), &material(1e8), 0.3, 0.3, 0.5);
+    let mut sys = system(settings(1e-3, V3::zeros(), Integrator::Verlet, 0.001), p, vec![], laws(law, law));
+    let err = sys.step().unwrap_err().to_string();
+    assert!(err.starts_with("step 1: body 0 ('runaway')") && err.contains("beyond"), "{err}");
+    assert_eq!((sys.step, sys.particles.x[0][0]), (0, x0), "held at the start");
+}

@@ -215,6 +215,11 @@ pub const CHUNKS: usize = 2;
 /// Steps between two copies of the last good state.
 const BACKUP_EVERY: u64 = 100;
 
+/// A sphere whose centre leaves `±POSITION_BOUND` (m) on an axis ends the step
+/// with a divergence: the bounds of a scene ([`crate::scene::MAX_LENGTH`]), so
+/// that the state of a run can always be written back as a valid scene.
+pub const POSITION_BOUND: f64 = crate::scene::MAX_LENGTH;
+
 /// The energy-growth check stops a run whose spheres hold more than
 /// `E_0 + W + ENERGY_GROWTH (|E_0| + W)`, with `E_0` the mechanical energy at the
 /// start and `W` the work of the servo drives since: without numerical
@@ -481,10 +486,14 @@ impl MdSystem {
         let (stats, kinetic, height) = self.forces(dt, measure, true)?;
         if !kinetic.is_finite() {
             let p = &self.particles;
-            let i = (0..p.len())
-                .find(|&i| !(p.x[i].iter().all(|c| c.is_finite()) && p.v[i].iter().all(|c| c.is_finite())))
-                .unwrap_or(0);
-            return Err(self.diverged(i, "position or velocity is not finite".into()));
+            let inside = |x: &V3| x.iter().all(|c| c.abs() <= POSITION_BOUND);
+            let i = (0..p.len()).find(|&i| !(inside(&p.x[i]) && p.v[i].iter().all(|c| c.is_finite()))).unwrap_or(0);
+            let what = if p.x[i].iter().all(|c| c.is_finite()) && p.v[i].iter().all(|c| c.is_finite()) {
+                format!("carried beyond ±{POSITION_BOUND:e} m (the bounds of a scene)")
+            } else {
+                "position or velocity is not finite".to_string()
+            };
+            return Err(self.diverged(i, what));
         }
         let t_next = crate::clock::time_at(self.time_origin, self.step_origin, self.step + 1, dt);
         self.drive_work += walls::advance(&mut self.walls, t_next, dt);
@@ -1284,7 +1293,7 @@ fn first_half(c: View, integrator: Integrator, g: V3, dt: f64) -> f64 {
 
 /// After the force evaluation: second half kick (Verlet) or corrector (Gear),
 /// orientations; returns the kinetic energy of the chunk (J), non-finite if a
-/// position or velocity is, and `Σ m (x · up)` (kg·m).
+/// velocity is or a position is not within [`POSITION_BOUND`], and `Σ m (x · up)` (kg·m).
 fn second_half(c: View, integrator: Integrator, g: V3, up: V3, dt: f64) -> (f64, f64) {
     let mut kinetic = 0.0;
     let mut height = 0.0;
@@ -1298,7 +1307,7 @@ fn second_half(c: View, integrator: Integrator, g: V3, up: V3, dt: f64) -> (f64,
                 // Solid sphere: I = 2/5 m r².
                 kinetic += 0.5 * c.m[i] * (c.v[i].norm_squared() + 0.4 * c.r[i] * c.r[i] * c.w[i].norm_squared());
                 height += c.m[i] * c.x[i].dot(&up);
-                finite &= c.x[i].iter().all(|a| a.is_finite());
+                finite &= c.x[i].iter().all(|a| a.abs() <= POSITION_BOUND);
             }
         }
         Integrator::Gear(set) => {
@@ -1320,7 +1329,7 @@ fn second_half(c: View, integrator: Integrator, g: V3, up: V3, dt: f64) -> (f64,
                 // Solid sphere: I = 2/5 m r².
                 kinetic += 0.5 * c.m[i] * (c.v[i].norm_squared() + 0.4 * c.r[i] * c.r[i] * c.w[i].norm_squared());
                 height += c.m[i] * c.x[i].dot(&up);
-                finite &= c.x[i].iter().all(|a| a.is_finite());
+                finite &= c.x[i].iter().all(|a| a.abs() <= POSITION_BOUND);
             }
         }
     }

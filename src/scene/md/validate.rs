@@ -139,12 +139,18 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
                 Some(set) => Integrator::Gear(set),
                 None => {
                     return err(format!(
-                        "md.gear: unknown set '{name}', expected one of 'karrech', 'gear3', 'gear4', 'gear5', 'gear6'"
+                        "md.gear: unknown set '{}', expected one of 'karrech', 'gear3', 'gear4', 'gear5', 'gear6'",
+                        crate::scene::clip(name)
                     ))
                 }
             }
         }
-        other => return err(format!("md.integrator: unknown integrator '{other}', expected 'verlet' or 'gear'")),
+        other => {
+            return err(format!(
+                "md.integrator: unknown integrator '{}', expected 'verlet' or 'gear'",
+                crate::scene::clip(other)
+            ))
+        }
     };
     if let Some(s) = ms.skin {
         length("md.skin", s)?;
@@ -190,7 +196,10 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
             return err(format!("material[{i}].name: must not be empty"));
         }
         if let Some(j) = names.insert(m.name.as_str(), i) {
-            return err(format!("material[{i}].name: duplicate material '{}' (also material[{j}])", m.name));
+            return err(format!(
+                "material[{i}].name: duplicate material '{}' (also material[{j}])",
+                crate::scene::clip(&m.name)
+            ));
         }
         let ctx = |field: &str| format!("{}: {field}", label("material", i, &m.name));
         positive(&ctx("density"), m.density)?;
@@ -203,7 +212,7 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
     let material = |ctx: &str, name: &str| -> Result<usize> {
         match names.get(name) {
             Some(&m) => Ok(m),
-            None => err(format!("{ctx}: unknown material '{name}'")),
+            None => err(format!("{ctx}: unknown material '{}'", crate::scene::clip(name))),
         }
     };
 
@@ -261,7 +270,7 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
             return err(format!("wall[{i}].name: must not be empty"));
         }
         if let Some(j) = wall_names.insert(w.name.as_str(), i) {
-            return err(format!("wall[{i}].name: duplicate wall '{}' (also wall[{j}])", w.name));
+            return err(format!("wall[{i}].name: duplicate wall '{}' (also wall[{j}])", crate::scene::clip(&w.name)));
         }
         let name = label("wall", i, &w.name);
         let m = material(&format!("{name}: material"), &w.material)?;
@@ -387,7 +396,13 @@ fn check_contact(i: usize, c: &MdContact, a: usize, b: usize) -> Result<CheckedL
     let model = match c.model.as_str() {
         "hertz" => md::Model::Hertz,
         "linear" => md::Model::Linear,
-        other => return err(format!("{}: unknown model '{other}', expected 'hertz' or 'linear'", ctx("model"))),
+        other => {
+            return err(format!(
+                "{}: unknown model '{}', expected 'hertz' or 'linear'",
+                ctx("model"),
+                crate::scene::clip(other)
+            ))
+        }
     };
     // Keys of the other model.
     let (foreign, other): (&[(&str, bool)], &str) = match model {
@@ -412,7 +427,11 @@ fn check_contact(i: usize, c: &MdContact, a: usize, b: usize) -> Result<CheckedL
     };
     if let Some((key, _)) = foreign.iter().find(|(_, given)| *given) {
         let hint = if key.ends_with("_friction") { ": give friction" } else { "" };
-        return err(format!("{}: not a key of model '{}' (only of '{other}'){hint}", ctx(key), c.model));
+        return err(format!(
+            "{}: not a key of model '{}' (only of '{other}'){hint}",
+            ctx(key),
+            crate::scene::clip(&c.model)
+        ));
     }
     // Friction: one coefficient, or static and dynamic.
     let (mu_s, mu_d) = match (c.friction, c.static_friction, c.dynamic_friction) {
