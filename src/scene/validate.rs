@@ -4,7 +4,7 @@
 //! `body[3] 'block': polygon: non-convex polygon: the turn at vertex 2 is clockwise`
 //! or, for a compound body, `body[3] 'sleeper': parts[1]: non-convex polygon: …`.
 
-use super::format::{BodySpec, Drive, Scene};
+use super::format::{BodySpec, Drive, NscdSection, Scene};
 use crate::error::{Error, Result};
 use crate::geometry::{rotate, Compound, ConvexPolygon, GeometryError, Shape, Vec2};
 use crate::nscd::system::DEFAULT_ALERT_FRACTION;
@@ -235,14 +235,23 @@ fn check_drive(ctx: &str, d: Drive) -> Result<()> {
     }
 }
 
-/// Checks the whole scene and resolves names, shapes and defaults.
+/// Checks the whole scene, one section after the other, and resolves names,
+/// shapes and defaults.
 pub(crate) fn check(scene: &Scene) -> Result<Checked> {
-    // [simulation]
     super::common::check_simulation(&scene.simulation, "nscd", 2)?;
-    let thickness = scene.simulation.thickness();
-
-    // [nscd]
     let ns = scene.nscd.clone().unwrap_or_default();
+    let (theta, nlgs) = check_nscd(&ns)?;
+    let materials = check_materials(scene)?;
+    check_contacts(scene, &materials)?;
+    let (bodies, names) = check_bodies(scene, &materials, scene.simulation.thickness())?;
+    let springs = check_springs(scene, &names)?;
+    let alert_distance = alert_distance(scene, &ns, &bodies);
+    let cycles = super::common::check_output(scene.output.as_ref(), true, |name| names.get(name).copied())?;
+    Ok(Checked { nlgs, theta, alert_distance, bodies, springs, cycles })
+}
+
+/// Checks `[nscd]`: θ and the NLGS settings, defaults from [`NscdParams::default`].
+fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
     let defaults = NscdParams::default();
     let theta = ns.theta.unwrap_or(defaults.theta);
     if !(0.5..=1.0).contains(&theta) {
@@ -289,7 +298,11 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
         split_min_rows: defaults.nlgs.split_min_rows,
     };
 
-    // [[material]]
+    Ok((theta, nlgs))
+}
+
+/// Checks `[[material]]`: unique non-empty names, positive densities; the index of each name.
+fn check_materials(scene: &Scene) -> Result<HashMap<&str, usize>> {
     let mut materials: HashMap<&str, usize> = HashMap::new();
     for (i, m) in scene.materials.iter().enumerate() {
         if m.name.is_empty() {
@@ -304,7 +317,11 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
         positive(&format!("{}: density", label("material", i, &m.name)), m.density)?;
     }
 
-    // [[contact]]
+    Ok(materials)
+}
+
+/// Checks `[[contact]]`: known materials, one law per pair, friction and restitutions in range.
+fn check_contacts(scene: &Scene, materials: &HashMap<&str, usize>) -> Result<()> {
     let mut pairs: HashMap<(usize, usize), usize> = HashMap::new();
     for (i, c) in scene.contacts.iter().enumerate() {
         let mut ids = [0; 2];
@@ -327,7 +344,16 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
         in_unit(&format!("contact[{i}].tangential_restitution"), c.tangential_restitution.unwrap_or(0.0))?;
     }
 
-    // [[body]]
+    Ok(())
+}
+
+/// Checks `[[body]]`: names, materials, shapes, sizes, state, imposed velocities, loads, mass;
+/// the resolved bodies and the index of each name.
+fn check_bodies<'a>(
+    scene: &'a Scene,
+    materials: &HashMap<&str, usize>,
+    thickness: f64,
+) -> Result<(Vec<CheckedBody>, HashMap<&'a str, usize>)> {
     if scene.bodies.is_empty() {
         return err("body: the scene has no [[body]]".into());
     }
@@ -399,7 +425,11 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
         bodies.push(CheckedBody { shape, centroid, material, mass, inertia });
     }
 
-    // [[spring]]
+    Ok((bodies, names))
+}
+
+/// Checks `[[spring]]`: bodies, attachments, law coefficients, rest length.
+fn check_springs(scene: &Scene, names: &HashMap<&str, usize>) -> Result<Vec<CheckedSpring>> {
     let world = |i: usize, p: [f64; 2]| -> Vec2 {
         let b = &scene.bodies[i];
         let (s, c) = b.angle().sin_cos();
@@ -451,15 +481,20 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
         springs.push(CheckedSpring { a, point_a, b, point_b, rest_length });
     }
 
-    // Alert distance.
-    let alert_distance = match ns.alert_distance {
+    Ok(springs)
+}
+
+/// The alert distance (m): `nscd.alert_distance`, else [`DEFAULT_ALERT_FRACTION`]
+/// × the smallest inner radius of the non-fixed bodies (of all bodies if none moves).
+fn alert_distance(scene: &Scene, ns: &NscdSection, bodies: &[CheckedBody]) -> f64 {
+    match ns.alert_distance {
         Some(a) => a,
         None => {
             let inner = |mobile_only: bool| {
                 scene
                     .bodies
                     .iter()
-                    .zip(&bodies)
+                    .zip(bodies)
                     .filter(|(s, _)| !mobile_only || !s.is_fixed())
                     .map(|(_, b)| b.shape.inner_radius())
                     .fold(f64::INFINITY, f64::min)
@@ -467,10 +502,5 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
             let r = if scene.bodies.iter().any(|b| !b.is_fixed()) { inner(true) } else { inner(false) };
             DEFAULT_ALERT_FRACTION * r
         }
-    };
-
-    // [output]
-    let cycles = super::common::check_output(scene.output.as_ref(), true, |name| names.get(name).copied())?;
-
-    Ok(Checked { nlgs, theta, alert_distance, bodies, springs, cycles })
+    }
 }

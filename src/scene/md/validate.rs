@@ -116,16 +116,46 @@ fn axis_of(n: &V3) -> Option<usize> {
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
-/// Checks the whole scene and resolves names, shapes, laws and defaults.
+/// Checks the whole scene, one section after the other, and resolves names,
+/// shapes, laws and defaults; then the scene as a whole against its dynamics
+/// ([`super::safety`]).
 pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
-    // [simulation]
     let sim = &scene.simulation;
     crate::scene::common::check_simulation(sim, "md", 3)?;
     let defaults = MdSettings::default();
     let gravity = V3::from(sim.gravity_or(defaults.gravity.into()));
-
-    // [md]
     let ms = scene.md.clone().unwrap_or_default();
+    let (integrator, background_damping, background_rotational_damping) = check_md(&ms, &defaults)?;
+    let cycles = crate::scene::common::check_output(scene.output.as_ref(), false, |_| None)?;
+    let planes = check_symmetry(scene)?;
+    let (names, materials) = check_materials(scene)?;
+    let (pairs, laws) = check_contacts(scene, &names)?;
+    let (sphere_materials, diameters) = check_bodies(scene, &names, &materials)?;
+    let walls = check_walls(scene, &names)?;
+    check_laws_cover(scene, &sphere_materials, &walls, &planes, &pairs)?;
+    let n = materials.len();
+    let skin = ms.skin.unwrap_or(DEFAULT_SKIN_FRACTION * diameters / scene.bodies.len() as f64);
+    let settings =
+        MdSettings { dt: sim.dt, gravity, integrator, skin, background_damping, background_rotational_damping };
+    let mut table = LawTable::new(n);
+    for l in &laws {
+        table.set(l.a, l.b, pair_law(l, &materials));
+    }
+    safety::check(&Resolved {
+        scene,
+        settings: &settings,
+        densities: materials.iter().map(|m| m.density).collect(),
+        sphere_materials: &sphere_materials,
+        laws: &table,
+        walls: &walls,
+        planes: &planes,
+    })?;
+    Ok(CheckedMd { settings, materials, sphere_materials, laws: table, walls, planes, threads: ms.threads, cycles })
+}
+
+/// Checks `[md]`: the integrator, the skin, the background damping (kg/s) and
+/// the threads; defaults from [`MdSettings::default`].
+fn check_md(ms: &super::format::MdSection, defaults: &MdSettings) -> Result<(Integrator, f64, f64)> {
     let integrator = match ms.integrator.as_deref().unwrap_or("verlet") {
         "verlet" => {
             if ms.gear.is_some() {
@@ -165,10 +195,11 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
         return err("md.threads: must be at least 1, got 0".into());
     }
 
-    // [output]
-    let cycles = crate::scene::common::check_output(scene.output.as_ref(), false, |_| None)?;
+    Ok((integrator, background_damping, background_rotational_damping))
+}
 
-    // [[symmetry]]
+/// Checks `[[symmetry]]`: at most two planes, perpendicular.
+fn check_symmetry(scene: &MdScene) -> Result<Vec<SymmetryPlane>> {
     if scene.symmetry.len() > 2 {
         return err(format!("symmetry: at most 2 symmetry planes, got {}", scene.symmetry.len()));
     }
@@ -188,7 +219,11 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
         }
     }
 
-    // [[material]]
+    Ok(planes)
+}
+
+/// Checks `[[material]]`: unique non-empty names, moduli in range; the index of each name.
+fn check_materials(scene: &MdScene) -> Result<(HashMap<&str, usize>, Vec<md::Material>)> {
     let mut names: HashMap<&str, usize> = HashMap::new();
     let mut materials = Vec::with_capacity(scene.materials.len());
     for (i, m) in scene.materials.iter().enumerate() {
@@ -209,19 +244,28 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
         }
         materials.push(md::Material { density: m.density, young: m.young, poisson: m.poisson });
     }
-    let material = |ctx: &str, name: &str| -> Result<usize> {
-        match names.get(name) {
-            Some(&m) => Ok(m),
-            None => err(format!("{ctx}: unknown material '{}'", crate::scene::clip(name))),
-        }
-    };
+    Ok((names, materials))
+}
 
-    // [[contact]]
+/// The index of the material named `name`, or an error in `ctx`.
+fn material_index(names: &HashMap<&str, usize>, ctx: &str, name: &str) -> Result<usize> {
+    match names.get(name) {
+        Some(&m) => Ok(m),
+        None => err(format!("{ctx}: unknown material '{}'", crate::scene::clip(name))),
+    }
+}
+
+/// Checks `[[contact]]`: known materials, one law per pair; the pairs and their laws.
+#[allow(clippy::type_complexity)]
+fn check_contacts(
+    scene: &MdScene,
+    names: &HashMap<&str, usize>,
+) -> Result<(HashMap<(usize, usize), usize>, Vec<CheckedLaw>)> {
     let mut pairs: HashMap<(usize, usize), usize> = HashMap::new();
     let mut laws = Vec::with_capacity(scene.contacts.len());
     for (i, c) in scene.contacts.iter().enumerate() {
-        let a = material(&format!("contact[{i}].between"), &c.between[0])?;
-        let b = material(&format!("contact[{i}].between"), &c.between[1])?;
+        let a = material_index(names, &format!("contact[{i}].between"), &c.between[0])?;
+        let b = material_index(names, &format!("contact[{i}].between"), &c.between[1])?;
         if let Some(j) = pairs.insert((a.min(b), a.max(b)), i) {
             return err(format!(
                 "contact[{i}].between: duplicate law for materials '{}' and '{}' (also contact[{j}])",
@@ -231,7 +275,16 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
         laws.push(check_contact(i, c, a, b)?);
     }
 
-    // [[body]]
+    Ok((pairs, laws))
+}
+
+/// Checks `[[body]]`: names, materials, radii, state, masses; the material of
+/// each sphere and the sum of the diameters (m).
+fn check_bodies(
+    scene: &MdScene,
+    names: &HashMap<&str, usize>,
+    materials: &[md::Material],
+) -> Result<(Vec<usize>, f64)> {
     if scene.bodies.is_empty() {
         return err("body: the scene has no [[body]] (no sphere)".into());
     }
@@ -246,7 +299,7 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
                 return err(format!("{}: duplicate body name (also body[{j}])", ctx("name")));
             }
         }
-        let m = material(&ctx("material"), &b.material)?;
+        let m = material_index(names, &ctx("material"), &b.material)?;
         let r = length(&ctx("sphere"), b.sphere)?;
         if r < MIN_SIZE {
             return err(format!("{}: must be at least {MIN_SIZE:e} m, got {}", ctx("sphere"), num(r)));
@@ -262,7 +315,12 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
         diameters += 2.0 * r;
     }
 
-    // [[wall]]
+    Ok((sphere_materials, diameters))
+}
+
+/// Checks `[[wall]]`: names, materials, shapes, servo motions (a stress on the
+/// box area needs a closed box).
+fn check_walls(scene: &MdScene, names: &HashMap<&str, usize>) -> Result<Vec<Wall>> {
     let mut wall_names: HashMap<&str, usize> = HashMap::new();
     let mut walls = Vec::with_capacity(scene.walls.len());
     for (i, w) in scene.walls.iter().enumerate() {
@@ -273,7 +331,7 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
             return err(format!("wall[{i}].name: duplicate wall '{}' (also wall[{j}])", crate::scene::clip(&w.name)));
         }
         let name = label("wall", i, &w.name);
-        let m = material(&format!("{name}: material"), &w.material)?;
+        let m = material_index(names, &format!("{name}: material"), &w.material)?;
         walls.push(check_wall(&name, w, m as u32)?);
     }
     // A stress on the box area needs a closed box around the wall's axis.
@@ -295,9 +353,19 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
         }
     }
 
-    // Every pair of materials that can touch has a law: spheres with spheres
-    // (of one material: two spheres, or one and its symmetry image) and with walls.
-    let n = materials.len();
+    Ok(walls)
+}
+
+/// Every pair of materials that can touch has a law: spheres with spheres (of
+/// one material: two spheres, or one and its symmetry image) and with walls.
+fn check_laws_cover(
+    scene: &MdScene,
+    sphere_materials: &[usize],
+    walls: &[Wall],
+    planes: &[SymmetryPlane],
+    pairs: &HashMap<(usize, usize), usize>,
+) -> Result<()> {
+    let n = scene.materials.len();
     let (mut first, mut second) = (vec![None; n], vec![None; n]);
     for (i, &m) in sphere_materials.iter().enumerate() {
         if first[m].is_none() {
@@ -337,23 +405,7 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
         }
     }
 
-    let skin = ms.skin.unwrap_or(DEFAULT_SKIN_FRACTION * diameters / scene.bodies.len() as f64);
-    let settings =
-        MdSettings { dt: sim.dt, gravity, integrator, skin, background_damping, background_rotational_damping };
-    let mut table = LawTable::new(n);
-    for l in &laws {
-        table.set(l.a, l.b, pair_law(l, &materials));
-    }
-    safety::check(&Resolved {
-        scene,
-        settings: &settings,
-        densities: materials.iter().map(|m| m.density).collect(),
-        sphere_materials: &sphere_materials,
-        laws: &table,
-        walls: &walls,
-        planes: &planes,
-    })?;
-    Ok(CheckedMd { settings, materials, sphere_materials, laws: table, walls, planes, threads: ms.threads, cycles })
+    Ok(())
 }
 
 /// [`md::law::hertz_alpha_for_restitution`], remembered: each call integrates
