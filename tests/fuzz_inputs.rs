@@ -1258,7 +1258,6 @@ const MODEL: &[&str] = &[
     "system.ghosts.planes",
     "system.measure_every",
     "system.neighbours.skin",
-    "system.energy_start",
     // Both: the zero of the gravitational energy (set by the first step, NSCD,
     // or when the system is built, MD).
     "system.gravity_reference",

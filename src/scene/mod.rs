@@ -144,7 +144,8 @@ impl Scene {
     /// # Errors
     /// [`Error::Scene`] if the scene is invalid.
     pub fn plan(&self) -> Result<crate::run::RunPlan> {
-        let cycles = validate::check(self)?.cycles;
+        let body = |name: &str| self.bodies.iter().position(|b| b.name == name);
+        let cycles = common::check_output(self.output.as_ref(), true, body)?;
         Ok(common::run_plan(&self.simulation, self.output.as_ref(), cycles))
     }
 }

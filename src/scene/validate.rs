@@ -56,8 +56,6 @@ pub(crate) struct Checked {
     pub alert_distance: f64,
     pub bodies: Vec<CheckedBody>,
     pub springs: Vec<CheckedSpring>,
-    /// The per-cycle output, followed body resolved.
-    pub cycles: Option<crate::run::CyclePlan>,
 }
 
 /// `v` in plain notation when that is short, else in scientific notation.
@@ -246,8 +244,8 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
     let (bodies, names) = check_bodies(scene, &materials, scene.simulation.thickness())?;
     let springs = check_springs(scene, &names)?;
     let alert_distance = alert_distance(scene, &ns, &bodies);
-    let cycles = super::common::check_output(scene.output.as_ref(), true, |name| names.get(name).copied())?;
-    Ok(Checked { nlgs, theta, alert_distance, bodies, springs, cycles })
+    super::common::check_output(scene.output.as_ref(), true, |name| names.get(name).copied())?;
+    Ok(Checked { nlgs, theta, alert_distance, bodies, springs })
 }
 
 /// Checks `[nscd]`: θ and the NLGS settings, defaults from [`NscdParams::default`].

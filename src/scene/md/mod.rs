@@ -105,7 +105,7 @@ impl MdScene {
     /// # Errors
     /// [`Error::Scene`] if the scene is invalid.
     pub fn plan(&self) -> Result<crate::run::RunPlan> {
-        let cycles = validate::check(self)?.cycles;
+        let cycles = crate::scene::common::check_output(self.output.as_ref(), false, |_| None)?;
         Ok(crate::scene::common::run_plan(&self.simulation, self.output.as_ref(), cycles))
     }
 

@@ -61,8 +61,6 @@ pub(crate) struct CheckedMd {
     pub walls: Vec<Wall>,
     pub planes: Vec<SymmetryPlane>,
     pub threads: Option<usize>,
-    /// The per-cycle output.
-    pub cycles: Option<crate::run::CyclePlan>,
 }
 
 /// `ctx: must be finite, got [x, y, z]` unless every component is finite.
@@ -126,7 +124,7 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
     let gravity = V3::from(sim.gravity_or(defaults.gravity.into()));
     let ms = scene.md.clone().unwrap_or_default();
     let (integrator, background_damping, background_rotational_damping) = check_md(&ms, &defaults)?;
-    let cycles = crate::scene::common::check_output(scene.output.as_ref(), false, |_| None)?;
+    crate::scene::common::check_output(scene.output.as_ref(), false, |_| None)?;
     let planes = check_symmetry(scene)?;
     let (names, materials) = check_materials(scene)?;
     let (pairs, laws) = check_contacts(scene, &names)?;
@@ -150,7 +148,7 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
         walls: &walls,
         planes: &planes,
     })?;
-    Ok(CheckedMd { settings, materials, sphere_materials, laws: table, walls, planes, threads: ms.threads, cycles })
+    Ok(CheckedMd { settings, materials, sphere_materials, laws: table, walls, planes, threads: ms.threads })
 }
 
 /// Checks `[md]`: the integrator, the skin, the background damping (kg/s) and
