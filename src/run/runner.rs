@@ -165,7 +165,8 @@ pub struct RunOutcome {
     pub end_step: u64,
     /// Kinetic energy (J) of the last step.
     pub kinetic_energy: f64,
-    /// The report of the run (also in `summary.json` once it has ended).
+    /// The report of the run so far (written to `summary.json` once the run has
+    /// ended; while it is only stopped, its `end` is not yet meaningful).
     pub report: RunReport,
     /// Wall time of this call (s).
     pub elapsed_s: f64,
