@@ -14,4 +14,12 @@ pub enum Error {
     Io(#[from] std::io::Error),
 }
 
+impl Error {
+    /// The message on a single line (white space folded), as the command line
+    /// prints it and the study tables record a failed run.
+    pub fn one_line(&self) -> String {
+        self.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
+    }
+}
+
 pub type Result<T> = std::result::Result<T, Error>;

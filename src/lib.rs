@@ -18,6 +18,10 @@
 //!   ParaView, figures);
 //! - [`scenarios`]: ready-made scenes (the Saussine pentagon sample and its
 //!   loading, the Karrech sphere sample, the Luding triaxial box, the peers' bed);
+//! - [`studies`]: the papers' experiments run end to end (the Saussine sample,
+//!   settlement and the §3.2/§3.3/§4.2 studies with runs side by side, the
+//!   Karrech and Luding tests), writing their scenes, runs, tables and figures,
+//!   with progress through a [`studies::RunDisplay`];
 //! - [`geometry`]: convex polygons, discs and compounds; [`clock`]: the exact
 //!   simulation and cycle clocks; [`team`]: the two-thread team of a step;
 //!   [`error`]: the crate's error type.
@@ -60,6 +64,7 @@ pub mod nscd;
 pub mod run;
 pub mod scenarios;
 pub mod scene;
+pub mod studies;
 pub mod team;
 
 pub use error::{Error, Result};

@@ -1,24 +1,25 @@
-//! The command line: argument parsing ([`clap`]), progress bars ([`indicatif`])
-//! and printing around the library. Every run goes through the library's run
-//! loop ([`ballast::run`]).
+//! The command line: argument parsing ([`clap`]), progress bars ([`indicatif`],
+//! the library's [`RunDisplay`]) and printing around the library. Every run goes
+//! through the library's run loop ([`ballast::run`]); the experiments are those
+//! of [`ballast::studies`].
 //!
 //! - `run`: a scene file of either engine ([`run`]);
 //! - `deposit`: the scene of a loose pentagon deposit ([`deposit`]);
-//! - `saussine …`: the experiments of Saussine et al. (2006) ([`saussine`],
-//!   [`studies`]);
+//! - `saussine …`: the experiments of Saussine et al. (2006) ([`saussine`]);
 //! - `karrech …`, `luding …`: the ready-made MD tests ([`md_tests`]).
 
 mod deposit;
 mod md_tests;
 mod run;
 mod saussine;
-mod studies;
 
-use ballast::run::{Progress, RunOptions, RunOutcome, Status};
+use ballast::run::{Progress, RunOutcome, Status};
+use ballast::studies::campaigns::StudyReport;
+use ballast::studies::saussine::Sample;
+use ballast::studies::RunDisplay;
 use ballast::Error;
 use clap::{Parser, Subcommand};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::path::Path;
 use std::process::ExitCode;
 
 #[derive(Debug, Parser)]
@@ -83,46 +84,83 @@ pub fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(e)) => {
-            eprintln!("error: {}", one_line(&e));
+            eprintln!("error: {}", e.one_line());
             ExitCode::from(2)
         }
         Err(Failure::Run(e)) => {
-            eprintln!("error: {}", one_line(&e));
+            eprintln!("error: {}", e.one_line());
             ExitCode::from(1)
         }
     }
 }
 
-/// The error's message on a single line.
-pub(crate) fn one_line(e: &Error) -> String {
-    e.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
-}
-
-/// How a run shows its progress: hidden, its own bar, or a bar in a group of
-/// runs side by side (with a label).
-#[derive(Clone, Default)]
-pub(crate) enum Display {
-    #[default]
-    Bar,
+/// How the runs of a command show their progress on the terminal (the
+/// library's [`RunDisplay`]).
+pub(crate) enum Bars {
+    /// One bar on stderr; each run's last line printed.
+    Single,
+    /// No bar; each run's last line printed.
     Quiet,
-    Group(MultiProgress, String),
+    /// One bar per run, labelled, in a group (runs side by side); no last lines.
+    Group(MultiProgress),
 }
 
-/// Runs the scene file `scene` into `out` with a progress bar, and prints the
-/// run's last line (the end, or where it stopped).
-pub(crate) fn run_scene(scene: &Path, out: &Path, opts: &RunOptions, display: &Display) -> Result<RunOutcome, Failure> {
-    let pb = match display {
-        Display::Quiet => ProgressBar::hidden(),
-        Display::Bar => ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr()),
-        Display::Group(group, label) => group.add(ProgressBar::new(0).with_prefix(label.clone())),
-    };
-    if let Ok(style) =
-        ProgressStyle::with_template("{prefix} {bar:40} {pos}/{len} steps, {msg} [{elapsed_precise} < {eta}]")
-    {
-        pb.set_style(style);
+impl Bars {
+    /// For one run at a time.
+    pub(crate) fn single(quiet: bool) -> Self {
+        if quiet {
+            Bars::Quiet
+        } else {
+            Bars::Single
+        }
     }
-    let mut message_at = 0;
-    let mut progress = |p: &Progress| {
+
+    /// For runs side by side.
+    pub(crate) fn group(quiet: bool) -> Self {
+        if quiet {
+            Bars::Quiet
+        } else {
+            Bars::Group(MultiProgress::new())
+        }
+    }
+}
+
+impl RunDisplay for Bars {
+    fn run(&self, label: &str) -> Box<dyn FnMut(&Progress) + '_> {
+        let pb = match self {
+            Bars::Quiet => ProgressBar::hidden(),
+            Bars::Single => ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr()),
+            Bars::Group(group) => group.add(ProgressBar::new(0).with_prefix(label.to_string())),
+        };
+        if let Ok(style) =
+            ProgressStyle::with_template("{prefix} {bar:40} {pos}/{len} steps, {msg} [{elapsed_precise} < {eta}]")
+        {
+            pb.set_style(style);
+        }
+        let mut bar = Bar { pb, message_at: 0 };
+        Box::new(move |p| bar.show(p))
+    }
+
+    fn ended(&self, _label: &str, outcome: &RunOutcome) {
+        if !matches!(self, Bars::Group(_)) {
+            print_outcome(outcome);
+        }
+    }
+
+    fn sample(&self, sample: &Sample) {
+        print_sample(sample);
+    }
+}
+
+/// The bar of one run, cleared when the run returns.
+struct Bar {
+    pb: ProgressBar,
+    message_at: u64,
+}
+
+impl Bar {
+    fn show(&mut self, p: &Progress) {
+        let pb = &self.pb;
         if pb.is_hidden() {
             return;
         }
@@ -130,8 +168,8 @@ pub(crate) fn run_scene(scene: &Path, out: &Path, opts: &RunOptions, display: &D
             pb.set_length(p.end_step);
         }
         pb.set_position(p.step);
-        if p.step >= message_at {
-            message_at = p.step + (p.end_step / 1000).max(1);
+        if p.step >= self.message_at {
+            self.message_at = p.step + (p.end_step / 1000).max(1);
             let cycles = match (p.cycles, p.settlement) {
                 (Some((c, total)), Some(s)) => format!(", cycle {c} of {total}, settlement {:.3} mm", 1e3 * s),
                 (Some((c, total)), None) => format!(", cycle {c} of {total}"),
@@ -139,14 +177,13 @@ pub(crate) fn run_scene(scene: &Path, out: &Path, opts: &RunOptions, display: &D
             };
             pb.set_message(format!("t = {:.4} s, Ek = {:.3e} J{cycles}", p.time, p.kinetic_energy));
         }
-    };
-    let result = ballast::run::run_file(scene, out, opts, &mut progress);
-    pb.finish_and_clear();
-    let outcome = result?;
-    if !matches!(display, Display::Group(..)) {
-        print_outcome(&outcome);
     }
-    Ok(outcome)
+}
+
+impl Drop for Bar {
+    fn drop(&mut self) {
+        self.pb.finish_and_clear();
+    }
 }
 
 /// The last line of a run.
@@ -182,4 +219,37 @@ pub(crate) fn print_outcome(o: &RunOutcome) {
             );
         }
     }
+}
+
+/// The line of a deposited sample.
+pub(crate) fn print_sample(s: &Sample) {
+    let r = &s.report;
+    println!(
+        "sample {}: {} grains, layer {:.1} mm thick; weight {:.2} N, sublayer {:.2} N, walls {:.2} N (balance error \
+         {:.2e}); mean overlap {:.2e} m, max {:.2e} m; solid fraction {:.3}, coordination {:.2} ({:.0} % rattlers)",
+        s.path.display(),
+        r.grains,
+        1e3 * r.thickness_m,
+        r.weight_n,
+        r.sublayer_reaction_n,
+        r.wall_friction_n,
+        r.balance_error,
+        r.mean_overlap_m,
+        r.max_overlap_m,
+        r.solid_fraction,
+        r.coordination,
+        100.0 * r.rattler_fraction
+    );
+}
+
+/// The failed runs of a study (stderr), its summary table and where its outputs are.
+pub(crate) fn print_study(r: &StudyReport) {
+    for (label, e) in &r.failed {
+        eprintln!("run {label} failed: {e}");
+    }
+    println!("{}", r.table.header.join("  "));
+    for row in &r.table.rows {
+        println!("{}", row.join("  "));
+    }
+    println!("summary: {}; runs in {}", r.table.path.display(), r.runs.display());
 }

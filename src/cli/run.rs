@@ -1,8 +1,9 @@
 //! `ballast run SCENE --out DIR`: one scene file of either engine through the
 //! library's run loop ([`ballast::run::run_file`]).
 
-use super::{run_scene, Display, Failure};
+use super::{Bars, Failure};
 use ballast::run::{default_threads, RunOptions};
+use ballast::studies::run_scene;
 use std::path::PathBuf;
 
 /// The arguments of `ballast run`.
@@ -50,6 +51,6 @@ pub fn main(a: RunArgs) -> Result<(), Failure> {
         threads: a.threads.unwrap_or_else(default_threads),
         figures: a.figures,
     };
-    let display = if a.quiet { Display::Quiet } else { Display::Bar };
-    run_scene(&a.scene, &a.out, &opts, &display).map(|_| ())
+    run_scene(&a.scene, &a.out, &opts, &Bars::single(a.quiet), "run")?;
+    Ok(())
 }

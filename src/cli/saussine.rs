@@ -1,6 +1,8 @@
-//! `ballast saussine …`: the numerical experiments of Saussine et al. (2006),
-//! each from scene files that are written into the output folder and run with
-//! the same loop as `ballast run` (progress, checkpoints, `--resume`).
+//! `ballast saussine …`: the arguments of the numerical experiments of Saussine
+//! et al. (2006), which [`ballast::studies::saussine`] and
+//! [`ballast::studies::campaigns`] carry out: each from scene files that are
+//! written into the output folder and run with the same loop as `ballast run`
+//! (progress, checkpoints, `--resume`).
 //!
 //! - `sample`: generate and deposit the sample (stage 1, and 1b for a free bank),
 //!   save it as `sample.toml`, measure its balance, solid fraction and
@@ -10,21 +12,18 @@
 //! - `settle`: load a sample and run N cycles (§4): `cycles.csv`, `summary.json`,
 //!   VTK snapshots every few cycles, figures;
 //! - `convergence`, `steps`, `ensemble`: the studies of §3.2, §3.3 and §4.2
-//!   (`studies.rs`).
+//!   ([`ballast::studies::campaigns`]).
 //!
 //! A sample scaled to fewer grains (`--grains`) is loaded with the sleeper's width
 //! and the load scaled alike (same pressure), unless `--sleeper-width` is given.
 
-use super::studies::{self, loading_for, StudyArgs};
-use super::{run_scene, Display, Failure};
-use ballast::run::{default_threads, Prior, RunOptions};
-use ballast::scenarios::saussine::{
-    loaded_scene, measure_sample, open_bank, sample_scene, Guide, LoadingSpec, SampleSpec,
-};
-use ballast::scene::Scene;
-use ballast::Error;
+use super::{input, print_sample, print_study, Bars, Failure};
+use ballast::run::default_threads;
+use ballast::scenarios::saussine::{Guide, SampleSpec};
+use ballast::studies::campaigns::{self, ConvergenceSpec, EnsembleSpec, StepsSpec, StudyOptions};
+use ballast::studies::saussine::{self, Loading, SettleOptions};
 use clap::Subcommand;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Debug, Subcommand)]
 pub enum SaussineCommand {
@@ -146,34 +145,34 @@ pub enum SaussineCommand {
 #[derive(Debug, Clone, clap::Args)]
 pub struct LoadingArgs {
     /// Number of loading cycles.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = Loading::default().cycles)]
     pub cycles: u64,
     /// Angle of the load from the vertical (degrees).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = Loading::default().inclination_deg)]
     pub inclination: f64,
     /// Sleeper guide: vertical (vx, spin imposed), level (spin imposed) or free;
     /// default: vertical for a vertical load, level otherwise.
     #[arg(long)]
     pub guide: Option<String>,
     /// Factor on the sublayer stiffness k_N (§4.2: 1, 100, 1000).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = Loading::default().stiffness_factor)]
     pub stiffness_factor: f64,
     /// Time step (s).
-    #[arg(long, default_value_t = 2e-4)]
+    #[arg(long, default_value_t = Loading::default().dt)]
     pub dt: f64,
     /// Convergence policy: strict, quad, quad_max, energy (default: the cheapest measured to
     /// keep the max overlap below 1 % of the smallest grain over 1000 cycles, BENCHMARKS.md).
-    #[arg(long, default_value = "energy")]
+    #[arg(long, default_value_t = Loading::default().criterion)]
     pub criterion: String,
     /// Tolerance of the policy.
-    #[arg(long, default_value_t = 1.66e-5)]
+    #[arg(long, default_value_t = Loading::default().tolerance)]
     pub tolerance: f64,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = Loading::default().min_iterations)]
     pub min_iterations: usize,
-    #[arg(long, default_value_t = 2000)]
+    #[arg(long, default_value_t = Loading::default().max_iterations)]
     pub max_iterations: usize,
     /// Square bars under the sleeper (0: a flat sleeper).
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = Loading::default().bars)]
     pub bars: usize,
     /// Width of the sleeper (m).
     #[arg(long)]
@@ -181,26 +180,17 @@ pub struct LoadingArgs {
 }
 
 impl LoadingArgs {
-    pub fn spec(&self) -> Result<LoadingSpec, Failure> {
+    /// The library's loading (checked by it when a scene is made from it).
+    pub fn loading(&self) -> Result<Loading, Failure> {
         let guide = match self.guide.as_deref() {
-            None if self.inclination == 0.0 => Guide::Vertical,
-            None => Guide::Level,
-            Some("vertical") => Guide::Vertical,
-            Some("level") => Guide::Level,
-            Some("free") => Guide::Free,
+            None => None,
+            Some("vertical") => Some(Guide::Vertical),
+            Some("level") => Some(Guide::Level),
+            Some("free") => Some(Guide::Free),
             Some(g) => return Err(input(format!("--guide: expected vertical, level or free, got '{g}'"))),
         };
-        if !(self.stiffness_factor.is_finite() && self.stiffness_factor > 0.0) {
-            return Err(input(format!("--stiffness-factor: must be positive, got {}", self.stiffness_factor)));
-        }
-        if !(self.inclination.is_finite() && self.inclination.abs() < 90.0) {
-            return Err(input(format!("--inclination: must be in (-90, 90) degrees, got {}", self.inclination)));
-        }
-        if self.cycles == 0 {
-            return Err(input("--cycles: must be at least 1".into()));
-        }
-        let base = LoadingSpec::saussine(self.cycles);
-        Ok(LoadingSpec {
+        Ok(Loading {
+            cycles: self.cycles,
             inclination_deg: self.inclination,
             guide,
             stiffness_factor: self.stiffness_factor,
@@ -210,19 +200,54 @@ impl LoadingArgs {
             min_iterations: self.min_iterations,
             max_iterations: self.max_iterations,
             bars: self.bars,
-            sleeper_width: self.sleeper_width.unwrap_or(base.sleeper_width),
-            ..base
+            sleeper_width: self.sleeper_width,
         })
     }
 }
 
-fn input(msg: String) -> Failure {
-    Failure::Input(Error::Scene(msg))
+/// Settings shared by the studies.
+#[derive(Debug, Clone, clap::Args)]
+pub struct StudyArgs {
+    /// Output directory of the study.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Runs at once, each on one core (default: the number of cores).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Skip the finished runs and resume the checkpointed ones of an interrupted study.
+    #[arg(long)]
+    pub resume: bool,
+    /// Wall-clock seconds between checkpoints of each run.
+    #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
+    pub checkpoint_every: f64,
+    /// No progress bars.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
-/// Writes `text` to `path`; the error names the file.
-fn write(path: &Path, text: &str) -> Result<(), Failure> {
-    std::fs::write(path, text).map_err(|e| Failure::Run(ballast::io::io_error(path, "write", e)))
+impl StudyArgs {
+    fn options(&self) -> StudyOptions {
+        StudyOptions {
+            out: self.out.clone(),
+            jobs: self.jobs,
+            resume: self.resume,
+            checkpoint_every_s: self.checkpoint_every,
+        }
+    }
+}
+
+/// `--policies`: POLICY:TOLERANCE pairs.
+fn policies(given: &[String]) -> Result<Vec<(String, f64)>, Failure> {
+    given
+        .iter()
+        .map(|p| {
+            let (name, tol) = p
+                .split_once(':')
+                .ok_or_else(|| input(format!("--policies: expected POLICY:TOLERANCE (e.g. quad:1e-6), got '{p}'")))?;
+            let tol: f64 = tol.parse().map_err(|_| input(format!("--policies: '{tol}' in '{p}' is not a number")))?;
+            Ok((name.to_string(), tol))
+        })
+        .collect()
 }
 
 pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
@@ -235,105 +260,29 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                 }
                 spec = spec.scaled(n);
             }
-            sample(&spec, &out, resume, if quiet { &Display::Quiet } else { &Display::Bar })
+            let sample = saussine::sample(&spec, &out, resume, default_threads(), &Bars::single(quiet))?;
+            print_sample(&sample);
         }
         SaussineCommand::Load { sample, out, loading } => {
-            let scene = Scene::load(&sample).map_err(Failure::Input)?;
-            let loaded = loaded_scene(&scene, &loading_for(&scene, &loading)?).map_err(Failure::Input)?;
-            write_scene(&out, &loaded, &format!("loaded from {}", sample.display()))?;
+            saussine::load(&sample, &loading.loading()?, &out)?;
             println!("wrote {}", out.display());
-            Ok(())
         }
         SaussineCommand::Settle { sample, out, loading, snapshot_every, checkpoint_every, resume, quiet } => {
-            let scene = Scene::load(&sample).map_err(Failure::Input)?;
-            let spec = loading_for(&scene, &loading)?;
-            let loaded = loaded_scene(&scene, &spec).map_err(Failure::Input)?;
-            ballast::io::create_output_dir(&out).map_err(Failure::Run)?;
-            let path = out.join("loaded.toml");
-            if !resume {
-                write_scene(&path, &loaded, &format!("loaded from {}", sample.display()))?;
-            }
-            let steps_per_cycle = (1.0 / (spec.frequency * spec.dt)).round().max(1.0) as u64;
-            let opts = RunOptions {
-                checkpoint_every_s: checkpoint_every,
-                resume,
-                vtk_every: snapshot_every.saturating_mul(steps_per_cycle),
-                figures: true,
-                threads: default_threads(),
-                ..RunOptions::default()
-            };
-            let display = if quiet { Display::Quiet } else { Display::Bar };
-            run_scene(&path, &out, &opts, &display).map(|_| ())
+            let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume };
+            saussine::settle(&sample, &loading.loading()?, &out, &opts, &Bars::single(quiet))?;
         }
-        SaussineCommand::Convergence { sample, policies, loading, study } => {
-            studies::convergence(&sample, &policies, &loading, &study)
+        SaussineCommand::Convergence { sample, policies: given, loading, study } => {
+            let spec = ConvergenceSpec { sample, policies: policies(&given)?, loading: loading.loading()? };
+            print_study(&campaigns::convergence(&spec, &study.options(), &Bars::group(study.quiet))?);
         }
         SaussineCommand::Steps { sample, dts, inclinations, loading, study } => {
-            studies::steps(&sample, &dts, &inclinations, &loading, &study)
+            let spec = StepsSpec { sample, dts, inclinations, loading: loading.loading()? };
+            print_study(&campaigns::steps(&spec, &study.options(), &Bars::group(study.quiet))?);
         }
         SaussineCommand::Ensemble { samples, first_seed, factors, grains, sample_dt, loading, study } => {
-            studies::ensemble(samples, first_seed, &factors, grains, sample_dt, &loading, &study)
+            let spec = EnsembleSpec { samples, first_seed, factors, grains, sample_dt, loading: loading.loading()? };
+            print_study(&campaigns::ensemble(&spec, &study.options(), &Bars::group(study.quiet))?);
         }
     }
-}
-
-/// Writes `scene` to `path` with a header line.
-pub(crate) fn write_scene(path: &Path, scene: &Scene, what: &str) -> Result<(), Failure> {
-    let text = format!(
-        "# Written by ballast {} (Saussine et al. 2006 experiments): {}.\n\n{}",
-        env!("CARGO_PKG_VERSION"),
-        what.replace(char::is_control, "?"),
-        scene.to_toml_string().map_err(Failure::Run)?
-    );
-    write(path, &text)
-}
-
-/// Runs `scene_path` into `dir` unless a finished run is there already.
-fn run_stage(scene_path: &Path, dir: &Path, resume: bool, display: &Display) -> Result<Scene, Failure> {
-    let final_scene = dir.join("final_scene.toml");
-    let prior = Prior::of(dir, "final_scene.toml", resume);
-    if prior != Prior::Finished {
-        let resume = prior == Prior::Checkpointed;
-        // One sweep thread per run when deposits run side by side (an ensemble).
-        let threads = if matches!(display, Display::Group(..)) { 1 } else { default_threads() };
-        let opts = RunOptions { checkpoint_every_s: 300.0, resume, threads, ..RunOptions::default() };
-        run_scene(scene_path, dir, &opts, display)?;
-    }
-    Scene::load(&final_scene).map_err(Failure::Run)
-}
-
-/// Deposits the sample of `spec` into `out` (`sample.toml`, `sample.json`).
-pub(crate) fn sample(spec: &SampleSpec, out: &Path, resume: bool, display: &Display) -> Result<(), Failure> {
-    let scene = sample_scene(spec).map_err(Failure::Input)?;
-    ballast::io::create_output_dir(out).map_err(Failure::Run)?;
-    let deposit = out.join("deposit.toml");
-    write_scene(&deposit, &scene, &format!("stage 1 (deposit) of the sample, seed {}", spec.seed))?;
-    let mut settled = run_stage(&deposit, &out.join("deposit"), resume, display)?;
-    if spec.bank {
-        let opened = open_bank(&settled).map_err(Failure::Run)?;
-        let bank = out.join("bank.toml");
-        write_scene(&bank, &opened, "the deposited sample without its mould, to settle into free banks")?;
-        settled = run_stage(&bank, &out.join("bank"), resume, display)?;
-    }
-    let path = out.join("sample.toml");
-    write_scene(&path, &settled, &format!("deposited sample, seed {}", spec.seed))?;
-    let report = measure_sample(&settled).map_err(Failure::Run)?;
-    ballast::io::write_json(&out.join("sample.json"), &report).map_err(Failure::Run)?;
-    println!(
-        "sample {}: {} grains, layer {:.1} mm thick; weight {:.2} N, sublayer {:.2} N, walls {:.2} N (balance error \
-         {:.2e}); mean overlap {:.2e} m, max {:.2e} m; solid fraction {:.3}, coordination {:.2} ({:.0} % rattlers)",
-        path.display(),
-        report.grains,
-        1e3 * report.thickness_m,
-        report.weight_n,
-        report.sublayer_reaction_n,
-        report.wall_friction_n,
-        report.balance_error,
-        report.mean_overlap_m,
-        report.max_overlap_m,
-        report.solid_fraction,
-        report.coordination,
-        100.0 * report.rattler_fraction
-    );
     Ok(())
 }

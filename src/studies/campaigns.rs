@@ -1,60 +1,88 @@
-//! The campaigns of Saussine et al. (2006) as single commands: many loaded runs
-//! of the same sample, run side by side (one run per core, `--jobs`), each in its
-//! own folder with the outputs of `ballast run` (series, cycles, summary,
-//! checkpoints, figures), then one summary CSV and the study's figures.
+//! The studies of Saussine et al. (2006) §3.2, §3.3 and §4.2, each one call
+//! (`ballast saussine convergence | steps | ensemble`): many loaded runs of the
+//! same sample, run side by side on a thread pool (one run per core,
+//! [`StudyOptions::jobs`]), each in its own folder with the outputs of
+//! `ballast run` (series, cycles, summary, checkpoints, figures), then read back
+//! through the row types into one summary CSV and the study's figures.
 //!
-//! - `convergence` (§3.2): one run per policy × tolerance of the paper's table
+//! - [`convergence`] (§3.2): one run per policy × tolerance of the paper's table
 //!   (energy 1.66e-3/-4/-5, strict 1e-3 and 1e-4, non-strict "quad" 1e-5/-6/-7);
 //!   `convergence.csv` (mean NLGS iterations, wall time, interpenetration),
 //!   `cumulated_interpenetration` (Fig. 2), `iterations_vs_tolerance`.
 //!   The first strict tolerance is illegible in the paper's table ("1 ×"): 1e-3 is
 //!   taken, a decade above its other strict value as for the other policies.
-//! - `steps` (§3.3): one run per time step (1e-4 … 1e-3 s, ten values) × inclination
+//! - [`steps`] (§3.3): one run per time step (1e-4 … 1e-3 s, ten values) × inclination
 //!   (0°, 5°); `steps.csv`, `max_interpenetration_<a>deg` (Fig. 3),
 //!   `mean_interpenetration_<a>deg` (Fig. 4), `interpenetration_vs_dt`.
-//! - `ensemble` (§4.2): samples that differ only by their seed, deposited, then
+//! - [`ensemble`] (§4.2): samples that differ only by their seed, deposited, then
 //!   loaded on sublayers of stiffness k_N × 1, × 100, × 1000; `ensemble.csv` (mean,
 //!   standard deviation, min and max of the settlement over the samples, per
 //!   stiffness and cycle) and `settlement_ensemble` (mean ± one standard deviation).
 //!
 //! Layout: `DIR/scenes/<run>.toml` and `DIR/runs/<run>/`. A run that diverges is
-//! reported in the summary (`status`), the others go on. `--resume` skips the
-//! finished runs and resumes the checkpointed ones.
+//! reported in the summary (`status`) and in [`StudyReport::failed`], the others
+//! go on. [`StudyOptions::resume`] skips the finished runs and resumes the
+//! checkpointed ones.
 
-use super::saussine::{sample, LoadingArgs};
-use super::{run_scene, Display, Failure};
-use ballast::io::cycles::NscdCycleRow as CycleRow;
-use ballast::io::figures::{self, Axes, Series};
-use ballast::io::series::NscdSeriesRow as SeriesRow;
-use ballast::io::table::TableWriter;
-use ballast::io::{self, RunReport};
-use ballast::run::{cores, default_threads, Prior, RunOptions};
-use ballast::scenarios::saussine::{loaded_scene, LoadingSpec, SampleSpec, GRAIN_PREFIX};
-use ballast::scene::Scene;
-use ballast::Error;
-use indicatif::MultiProgress;
+use super::saussine::{sample, Loading};
+use super::{axes, output_error, run_scene, RunDisplay, SummaryTable};
+use crate::error::{Error, Result};
+use crate::io::cycles::NscdCycleRow as CycleRow;
+use crate::io::figures::{self, Series};
+use crate::io::series::NscdSeriesRow as SeriesRow;
+use crate::io::table::TableWriter;
+use crate::io::{self, RunReport};
+use crate::run::{cores, default_threads, files, Prior, RunOptions};
+use crate::scenarios::saussine::{loaded_scene, LoadingSpec, SampleSpec};
+use crate::scene::Scene;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// Settings shared by the studies.
-#[derive(Debug, Clone, clap::Args)]
-pub struct StudyArgs {
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudyOptions {
     /// Output directory of the study.
-    #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Runs at once, each on one core (default: the number of cores).
-    #[arg(long)]
+    /// Runs at once, each on one core (`None`: the number of cores).
     pub jobs: Option<usize>,
     /// Skip the finished runs and resume the checkpointed ones of an interrupted study.
-    #[arg(long)]
     pub resume: bool,
     /// Wall-clock seconds between checkpoints of each run.
-    #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
-    pub checkpoint_every: f64,
-    /// No progress bars.
-    #[arg(long)]
-    pub quiet: bool,
+    pub checkpoint_every_s: f64,
+}
+
+impl StudyOptions {
+    /// A fresh study in `out`: one run per core, checkpoints every 5 minutes.
+    pub fn new(out: impl Into<PathBuf>) -> Self {
+        Self { out: out.into(), jobs: None, resume: false, checkpoint_every_s: 300.0 }
+    }
+
+    /// The runs at once (the pool's threads).
+    fn threads(&self) -> Result<usize> {
+        if !(self.checkpoint_every_s.is_finite() && self.checkpoint_every_s >= 0.0) {
+            return Err(Error::Scene(format!(
+                "--checkpoint-every: must be non-negative, got {}",
+                self.checkpoint_every_s
+            )));
+        }
+        match self.jobs.unwrap_or_else(cores) {
+            0 => Err(Error::Scene("--jobs: must be at least 1".into())),
+            n => Ok(n),
+        }
+    }
+}
+
+/// What a study wrote: its summary table (read back), where its runs are, and
+/// the runs that failed (reported in the table's `status`; the others went on).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudyReport {
+    /// The summary CSV: `convergence.csv`, `steps.csv` or `runs.csv`.
+    pub table: SummaryTable,
+    /// The folder of the runs, `DIR/runs`.
+    pub runs: PathBuf,
+    /// `(label, error)` of each run that failed in this invocation.
+    pub failed: Vec<(String, String)>,
 }
 
 /// The convergence policies and tolerances of the table of §3.2.
@@ -93,58 +121,37 @@ struct Outcome {
     cycles: Vec<CycleRow>,
 }
 
-fn input(msg: String) -> Failure {
-    Failure::Input(Error::Scene(msg))
-}
-
-/// The number of grains of the reference sample (361 + 242 + 121).
-fn reference_grains() -> usize {
-    SampleSpec::saussine(0).grading.iter().map(|g| g.1).sum()
-}
-
-/// The loading of `args` for `sample`: the sleeper's width and the load scaled
-/// with a sample scaled by `SampleSpec::scaled` (same pressure under the sleeper),
-/// unless `--sleeper-width` is given.
-pub fn loading_for(sample: &Scene, args: &LoadingArgs) -> Result<LoadingSpec, Failure> {
-    let spec = args.spec()?;
-    let grains = sample.bodies.iter().filter(|b| b.name.starts_with(GRAIN_PREFIX)).count();
-    let f = grains as f64 / reference_grains() as f64;
-    if grains == 0 || (f - 1.0).abs() < 1e-3 {
-        return Ok(spec);
-    }
-    let mut scaled = spec.clone().scaled(f);
-    if let Some(w) = args.sleeper_width {
-        // The given sleeper keeps its bars.
-        scaled.sleeper_width = w;
-        scaled.bar_size = spec.bar_size;
-    }
-    Ok(scaled)
-}
-
 fn label_number(x: f64) -> String {
     format!("{x:e}").replace('.', "p")
 }
 
 /// A pool of `threads` threads for runs side by side.
-fn pool(threads: usize) -> Result<rayon::ThreadPool, Failure> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Failure::Run(Error::Io(std::io::Error::other(e))))
+fn pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| Error::Io(std::io::Error::other(e)))
 }
 
-/// Writes the scenes of `jobs`, runs them `study.jobs` at a time and reads back their outcomes.
-fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
+/// Threads of each run on a pool of `pool` threads: one sweep thread each when
+/// several go side by side, else those of a single run.
+fn run_threads(pool: usize) -> usize {
+    if pool == 1 {
+        default_threads()
+    } else {
+        1
+    }
+}
+
+/// Writes the scenes of `jobs`, runs them `study.jobs` at a time and reads
+/// back their outcomes; the failed runs are added to `failed`.
+fn run_jobs(
+    jobs: &[Job],
+    study: &StudyOptions,
+    display: &dyn RunDisplay,
+    failed: &mut Vec<(String, String)>,
+) -> Result<Vec<Outcome>> {
     let out = &study.out;
-    if !(study.checkpoint_every.is_finite() && study.checkpoint_every >= 0.0) {
-        return Err(input(format!("--checkpoint-every: must be non-negative, got {}", study.checkpoint_every)));
-    }
-    let threads = study.jobs.unwrap_or_else(cores);
-    if threads == 0 {
-        return Err(input("--jobs: must be at least 1".into()));
-    }
+    let threads = study.threads()?;
     for dir in ["scenes", "runs"] {
-        io::create_output_dir(&out.join(dir)).map_err(Failure::Run)?;
+        io::create_output_dir(&out.join(dir))?;
     }
     // All scenes first, so that an invalid one stops the study before any run.
     let mut samples: Vec<(PathBuf, Scene)> = Vec::new();
@@ -152,37 +159,33 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
         let sample = match samples.iter().find(|(p, _)| p == &job.sample) {
             Some((_, s)) => s.clone(),
             None => {
-                let s = Scene::load(&job.sample).map_err(Failure::Input)?;
+                let s = Scene::load(&job.sample)?;
                 samples.push((job.sample.clone(), s.clone()));
                 s
             }
         };
-        let loaded = loaded_scene(&sample, &job.spec).map_err(Failure::Input)?;
+        let loaded = loaded_scene(&sample, &job.spec)?;
         let what = format!("{} of the study in {}, from {}", job.label, out.display(), job.sample.display());
         super::saussine::write_scene(&job.scene(out), &loaded, &what)?;
     }
-    let group = MultiProgress::new();
     let pool = pool(threads)?;
-    let results: Vec<Result<(), Failure>> = pool.install(|| {
+    let results: Vec<Result<()>> = pool.install(|| {
         jobs.par_iter()
             .map(|job| {
                 let dir = job.dir(out);
                 // summary.json: a diverged run is finished too (and reported as such).
-                let prior = Prior::of(&dir, "summary.json", study.resume);
+                let prior = Prior::of(&dir, files::SUMMARY, study.resume);
                 if prior == Prior::Finished {
                     return Ok(());
                 }
                 let opts = RunOptions {
-                    checkpoint_every_s: study.checkpoint_every,
+                    checkpoint_every_s: study.checkpoint_every_s,
                     resume: prior == Prior::Checkpointed,
                     figures: true,
-                    // Several runs at once: one sweep thread each, unless one job.
-                    threads: if threads == 1 { default_threads() } else { 1 },
+                    threads: run_threads(threads),
                     ..RunOptions::default()
                 };
-                let display =
-                    if study.quiet { Display::Quiet } else { Display::Group(group.clone(), job.label.clone()) };
-                run_scene(&job.scene(out), &dir, &opts, &display).map(|_| ())
+                run_scene(&job.scene(out), &dir, &opts, display, &job.label).map(|_| ())
             })
             .collect()
     });
@@ -191,22 +194,21 @@ fn run_jobs(jobs: &[Job], study: &StudyArgs) -> Result<Vec<Outcome>, Failure> {
         let dir = job.dir(out);
         let status = match result {
             // Skipped on --resume, but diverged in an earlier invocation (no final scene).
-            Ok(()) if !dir.join("final_scene.toml").exists() => "failed in an earlier invocation".to_string(),
+            Ok(()) if !dir.join(files::FINAL_SCENE).exists() => "failed in an earlier invocation".to_string(),
             Ok(()) => "ok".to_string(),
-            Err(Failure::Input(e)) => return Err(Failure::Input(e)),
+            Err(e @ Error::Scene(_)) => return Err(e),
             // A diverged run still wrote its series and summary: keep it in the study.
-            Err(Failure::Run(e)) => {
-                eprintln!("run {} failed: {e}", job.label);
-                format!("failed: {}", super::one_line(&e))
+            Err(e) => {
+                failed.push((job.label.clone(), e.to_string()));
+                format!("failed: {}", e.one_line())
             }
         };
-        let report = std::fs::read_to_string(dir.join("summary.json"))
+        let report = std::fs::read_to_string(dir.join(files::SUMMARY))
             .ok()
             .and_then(|t| serde_json::from_str::<RunReport>(&t).ok());
-        let series = io::series::read_nscd(&dir.join("series.csv")).unwrap_or_default();
-        let cycles_path = dir.join("cycles.csv");
-        let cycles =
-            if cycles_path.exists() { io::cycles::read_nscd(&cycles_path).map_err(Failure::Run)? } else { vec![] };
+        let series = io::series::read_nscd(&dir.join(files::SERIES)).unwrap_or_default();
+        let cycles_path = dir.join(files::CYCLES);
+        let cycles = if cycles_path.exists() { io::cycles::read_nscd(&cycles_path)? } else { vec![] };
         outcomes.push(Outcome { status, report, series, cycles });
     }
     Ok(outcomes)
@@ -267,43 +269,52 @@ fn run_columns(o: &Outcome) -> RunColumns {
 }
 
 /// Writes a study table: the columns `key` then `rest`, one row per item.
-fn write_table<R: Serialize>(path: &Path, key: &[&str], rest: &[&str], rows: &[R]) -> Result<(), Failure> {
+fn write_table<R: Serialize>(path: &Path, key: &[&str], rest: &[&str], rows: &[R]) -> Result<()> {
     let header: Vec<&str> = key.iter().chain(rest).copied().collect();
-    let mut t = TableWriter::create(path, &header).map_err(Failure::Run)?;
+    let mut t = TableWriter::create(path, &header)?;
     for r in rows {
-        t.write(r).map_err(Failure::Run)?;
+        t.write(r)?;
     }
-    t.finish().map_err(Failure::Run)
+    t.finish()
 }
 
 fn curve(o: &Outcome, label: String, f: fn(&SeriesRow) -> f64, scale: f64) -> Series {
     Series { label, points: o.series.iter().map(|s| (s.time_s, scale * f(s))).collect(), band: vec![] }
 }
 
-fn axes(title: &str, x: &str, y: &str, log_x: bool, log_y: bool) -> Axes {
-    Axes { title: title.into(), x_label: x.into(), y_label: y.into(), log_x, log_y }
+/// The report of a study whose summary table is `DIR/name`.
+fn report(out: &Path, name: &str, failed: Vec<(String, String)>) -> Result<StudyReport> {
+    Ok(StudyReport { table: SummaryTable::read(&out.join(name))?, runs: out.join("runs"), failed })
 }
 
-/// `ballast saussine convergence`: §3.2.
-pub fn convergence(
-    sample_path: &Path,
-    policies: &[String],
-    loading: &LoadingArgs,
-    study: &StudyArgs,
-) -> Result<(), Failure> {
-    let mut runs: Vec<(String, f64)> = Vec::new();
-    if policies.is_empty() {
-        runs.extend(PAPER_POLICIES.iter().map(|&(p, t)| (p.to_string(), t)));
-    }
-    for p in policies {
-        let (name, tol) = p
-            .split_once(':')
-            .ok_or_else(|| input(format!("--policies: expected POLICY:TOLERANCE (e.g. quad:1e-6), got '{p}'")))?;
-        let tol: f64 = tol.parse().map_err(|_| input(format!("--policies: '{tol}' in '{p}' is not a number")))?;
-        runs.push((name.to_string(), tol));
-    }
-    let sample_scene = Scene::load(sample_path).map_err(Failure::Input)?;
-    let base = loading_for(&sample_scene, loading)?;
+/// §3.2: the loaded sample under each convergence policy and tolerance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConvergenceSpec {
+    /// The deposited sample (`sample.toml` of [`super::saussine::sample`]).
+    pub sample: PathBuf,
+    /// The runs as `(policy, tolerance)`; empty: the paper's table ([`PAPER_POLICIES`]).
+    pub policies: Vec<(String, f64)>,
+    /// The loading of every run (its criterion and tolerance replaced by each run's).
+    pub loading: Loading,
+}
+
+/// §3.2 (`ballast saussine convergence`): one run per policy and tolerance,
+/// labelled `<policy>_<tolerance>`; `convergence.csv`,
+/// `cumulated_interpenetration` and `iterations_vs_tolerance`.
+///
+/// # Errors
+/// [`Error::Scene`] for an unreadable sample, an invalid loading or option
+/// (before any run) or an invalid checkpoint; a run that fails is reported in
+/// the table instead; an output that cannot be written is an [`Error::Io`].
+pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
+    let runs: Vec<(String, f64)> = if spec.policies.is_empty() {
+        PAPER_POLICIES.iter().map(|&(p, t)| (p.to_string(), t)).collect()
+    } else {
+        spec.policies.clone()
+    };
+    let sample_path = &spec.sample;
+    let sample_scene = Scene::load(sample_path)?;
+    let base = spec.loading.for_sample(&sample_scene)?;
     let jobs: Vec<Job> = runs
         .iter()
         .map(|(policy, tol)| Job {
@@ -312,7 +323,8 @@ pub fn convergence(
             sample: sample_path.to_path_buf(),
         })
         .collect();
-    let outcomes = run_jobs(&jobs, study)?;
+    let mut failed = Vec::new();
+    let outcomes = run_jobs(&jobs, study, display, &mut failed)?;
 
     let rows: Vec<_> = runs
         .iter()
@@ -332,8 +344,7 @@ pub fn convergence(
         &out.join("cumulated_interpenetration"),
         &axes("Cumulated interpenetration (sum over the contacts)", "time (s)", "cumulated overlap (µm)", false, true),
         &cumulated,
-    )
-    .map_err(Failure::Run)?;
+    )?;
     let mut per_policy: Vec<Series> = Vec::new();
     for ((p, t), o) in runs.iter().zip(&outcomes) {
         let Some(r) = &o.report else { continue };
@@ -351,29 +362,40 @@ pub fn convergence(
         &out.join("iterations_vs_tolerance"),
         &axes("NLGS iterations per step vs tolerance", "tolerance", "mean sweeps per step", true, false),
         &per_policy,
-    )
-    .map_err(Failure::Run)?;
-    print_table(out, "convergence.csv")?;
-    Ok(())
+    )?;
+    report(out, "convergence.csv", failed)
 }
 
-/// `ballast saussine steps`: §3.3.
-pub fn steps(
-    sample_path: &Path,
-    dts: &[f64],
-    inclinations: &[f64],
-    loading: &LoadingArgs,
-    study: &StudyArgs,
-) -> Result<(), Failure> {
+/// §3.3: the loaded sample with each time step, at each inclination.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepsSpec {
+    /// The deposited sample (`sample.toml` of [`super::saussine::sample`]).
+    pub sample: PathBuf,
+    /// Time steps (s).
+    pub dts: Vec<f64>,
+    /// Inclinations of the load (degrees).
+    pub inclinations: Vec<f64>,
+    /// The loading of every run (its time step and inclination replaced by each run's).
+    pub loading: Loading,
+}
+
+/// §3.3 (`ballast saussine steps`): one run per inclination and time step,
+/// labelled `incl_<a>_dt_<dt>`; `steps.csv`, `max_interpenetration_<a>deg`,
+/// `mean_interpenetration_<a>deg` and `interpenetration_vs_dt`.
+///
+/// # Errors
+/// As [`convergence`]; a time step that is not positive is an [`Error::Scene`].
+pub fn steps(spec: &StepsSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
+    let (dts, inclinations) = (&spec.dts, &spec.inclinations);
     if let Some(dt) = dts.iter().find(|dt| !(dt.is_finite() && **dt > 0.0)) {
-        return Err(input(format!("--dts: every time step must be positive, got {dt}")));
+        return Err(Error::Scene(format!("--dts: every time step must be positive, got {dt}")));
     }
-    let sample_scene = Scene::load(sample_path).map_err(Failure::Input)?;
+    let sample_path = &spec.sample;
+    let sample_scene = Scene::load(sample_path)?;
     let mut jobs = Vec::new();
     let mut keys = Vec::new();
     for &a in inclinations {
-        let args = LoadingArgs { inclination: a, ..loading.clone() };
-        let base = loading_for(&sample_scene, &args)?;
+        let base = Loading { inclination_deg: a, ..spec.loading.clone() }.for_sample(&sample_scene)?;
         for &dt in dts {
             jobs.push(Job {
                 label: format!("incl_{}_dt_{}", label_number(a), label_number(dt)),
@@ -383,7 +405,8 @@ pub fn steps(
             keys.push((a, dt));
         }
     }
-    let outcomes = run_jobs(&jobs, study)?;
+    let mut failed = Vec::new();
+    let outcomes = run_jobs(&jobs, study, display, &mut failed)?;
     let out = &study.out;
     let rows: Vec<_> = keys.iter().zip(&outcomes).map(|(&(a, dt), o)| ((a, dt), run_columns(o))).collect();
     write_table(&out.join("steps.csv"), &["inclination_deg", "dt_s"], &RUN_COLUMNS, &rows)?;
@@ -401,8 +424,7 @@ pub fn steps(
                 &out.join(format!("{name}_interpenetration_{tag}deg")),
                 &axes(&format!("{what} interpenetration, load at {a}°"), "time (s)", "overlap (µm)", false, false),
                 &curves,
-            )
-            .map_err(Failure::Run)?;
+            )?;
         }
         for (name, f) in [
             ("mean", (|r: &RunReport| r.mean_overlap_m) as fn(&RunReport) -> f64),
@@ -416,10 +438,8 @@ pub fn steps(
         &out.join("interpenetration_vs_dt"),
         &axes("Interpenetration over the run vs time step", "dt (s)", "overlap (µm)", true, true),
         &vs_dt,
-    )
-    .map_err(Failure::Run)?;
-    print_table(out, "steps.csv")?;
-    Ok(())
+    )?;
+    report(out, "steps.csv", failed)
 }
 
 /// Statistics over the samples of an ensemble.
@@ -446,64 +466,88 @@ impl Spread {
     }
 }
 
-/// `ballast saussine ensemble`: §4.2.
-#[allow(clippy::too_many_arguments)]
-pub fn ensemble(
-    samples: u64,
-    first_seed: u64,
-    factors: &[f64],
-    grains: Option<usize>,
-    sample_dt: f64,
-    loading: &LoadingArgs,
-    study: &StudyArgs,
-) -> Result<(), Failure> {
-    if samples == 0 {
-        return Err(input("--samples: must be at least 1".into()));
+/// §4.2: samples that differ only by their seed, each on sublayers of several stiffnesses.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnsembleSpec {
+    /// Number of samples, of seeds `first_seed`, `first_seed + 1`, …
+    pub samples: u64,
+    pub first_seed: u64,
+    /// Factors on the sublayer stiffness k_N.
+    pub factors: Vec<f64>,
+    /// Scale the grading to about this many grains (and the width with it).
+    pub grains: Option<usize>,
+    /// Time step of the deposits (s).
+    pub sample_dt: f64,
+    /// The loading of every run (its stiffness factor replaced by each run's).
+    pub loading: Loading,
+}
+
+/// §4.2 (`ballast saussine ensemble`): the samples deposited side by side in
+/// `DIR/samples/seed_<seed>/` ([`super::saussine::sample`], each told to
+/// [`RunDisplay::sample`]), then one run per sample and stiffness, labelled
+/// `seed_<seed>_k_<factor>`; `runs.csv`, `ensemble.csv` (mean, standard
+/// deviation, min and max of the settlement over the samples, per stiffness and
+/// cycle) and `settlement_ensemble`.
+///
+/// # Errors
+/// As [`convergence`]; no sample or a stiffness factor that is not positive is
+/// an [`Error::Scene`], and so is an invalid loading or option, before any
+/// deposit. A deposit that fails stops the study.
+pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
+    let factors = &spec.factors;
+    if spec.samples == 0 {
+        return Err(Error::Scene("--samples: must be at least 1".into()));
     }
     if let Some(f) = factors.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
-        return Err(input(format!("--factors: every stiffness factor must be positive, got {f}")));
+        return Err(Error::Scene(format!("--factors: every stiffness factor must be positive, got {f}")));
     }
+    // The loading and the options are checked before the deposits.
+    let loadings: Vec<Loading> =
+        factors.iter().map(|&k| Loading { stiffness_factor: k, ..spec.loading.clone() }).collect();
+    for loading in &loadings {
+        loading.spec()?;
+    }
+    let threads = study.threads()?;
     let out = &study.out;
-    let seeds: Vec<u64> = (0..samples).map(|k| first_seed + k).collect();
+    let seeds: Vec<u64> = (0..spec.samples).map(|k| spec.first_seed + k).collect();
     // 1. The samples, deposited side by side.
-    let pool = pool(study.jobs.unwrap_or_else(cores).max(1))?;
-    let group = MultiProgress::new();
-    let deposited: Vec<Result<(), Failure>> = pool.install(|| {
+    let pool = pool(threads)?;
+    let deposited: Vec<Result<()>> = pool.install(|| {
         seeds
             .par_iter()
             .map(|&seed| {
-                let mut spec = SampleSpec { dt: sample_dt, ..SampleSpec::saussine(seed) };
-                if let Some(n) = grains {
-                    spec = spec.scaled(n);
+                let mut sample_spec = SampleSpec { dt: spec.sample_dt, ..SampleSpec::saussine(seed) };
+                if let Some(n) = spec.grains {
+                    sample_spec = sample_spec.scaled(n);
                 }
                 let dir = out.join("samples").join(format!("seed_{seed}"));
                 if study.resume && dir.join("sample.toml").exists() {
                     return Ok(());
                 }
-                let display =
-                    if study.quiet { Display::Quiet } else { Display::Group(group.clone(), format!("sample {seed}")) };
-                sample(&spec, &dir, study.resume, &display)
+                let s = sample(&sample_spec, &dir, study.resume, run_threads(threads), display)?;
+                display.sample(&s);
+                Ok(())
             })
             .collect()
     });
-    deposited.into_iter().collect::<Result<Vec<()>, Failure>>()?;
+    deposited.into_iter().collect::<Result<Vec<()>>>()?;
     // 2. Every sample on every sublayer.
     let mut jobs = Vec::new();
     let mut keys = Vec::new();
     for &seed in &seeds {
         let sample_path = out.join("samples").join(format!("seed_{seed}")).join("sample.toml");
-        let sample_scene = Scene::load(&sample_path).map_err(Failure::Run)?;
-        for &k in factors {
-            let args = LoadingArgs { stiffness_factor: k, ..loading.clone() };
+        let sample_scene = Scene::load(&sample_path).map_err(output_error)?;
+        for (&k, loading) in factors.iter().zip(&loadings) {
             jobs.push(Job {
                 label: format!("seed_{seed}_k_{}", label_number(k)),
-                spec: loading_for(&sample_scene, &args)?,
+                spec: loading.for_sample(&sample_scene)?,
                 sample: sample_path.clone(),
             });
             keys.push((seed, k));
         }
     }
-    let outcomes = run_jobs(&jobs, study)?;
+    let mut failed = Vec::new();
+    let outcomes = run_jobs(&jobs, study, display, &mut failed)?;
     // 3. Per run, and mean and spread per stiffness and cycle.
     let rows: Vec<_> = keys.iter().zip(&outcomes).map(|(&(seed, k), o)| ((seed, k), run_columns(o))).collect();
     write_table(&out.join("runs.csv"), &["seed", "stiffness_factor"], &RUN_COLUMNS, &rows)?;
@@ -536,15 +580,13 @@ pub fn ensemble(
         }
         curves.push(Series { label: format!("k_N × {k} ({} samples, mean ± 1 sd)", runs.len()), points, band });
     }
-    io::table::write_all(&out.join("ensemble.csv"), &table).map_err(Failure::Run)?;
+    io::table::write_all(&out.join("ensemble.csv"), &table)?;
     figures::line_chart(
         &out.join("settlement_ensemble"),
         &axes("Settlement of the sleeper vs sublayer stiffness", "cycles", "settlement (mm)", false, false),
         &curves,
-    )
-    .map_err(Failure::Run)?;
-    print_table(out, "runs.csv")?;
-    Ok(())
+    )?;
+    report(out, "runs.csv", failed)
 }
 
 /// One row of `ensemble.csv`: the settlement over the samples of one sublayer
@@ -560,17 +602,4 @@ pub struct EnsembleRow {
     pub settlement_max_m: f64,
     pub settlement_at_min_load_mean_m: f64,
     pub settlement_at_min_load_std_m: f64,
-}
-
-/// Prints a summary CSV of the study as a table, and where the outputs are.
-fn print_table(out: &Path, name: &str) -> Result<(), Failure> {
-    let path = out.join(name);
-    let mut reader = csv::Reader::from_path(&path).map_err(|e| Failure::Run(Error::Io(std::io::Error::other(e))))?;
-    let header = reader.headers().map_err(|e| Failure::Run(Error::Io(std::io::Error::other(e))))?.clone();
-    println!("{}", header.iter().collect::<Vec<_>>().join("  "));
-    for rec in reader.records().flatten() {
-        println!("{}", rec.iter().collect::<Vec<_>>().join("  "));
-    }
-    println!("summary: {}; runs in {}", path.display(), out.join("runs").display());
-    Ok(())
 }

@@ -1,0 +1,93 @@
+//! The experiments of the papers as library functions: each writes its scenes
+//! into an output folder, runs them through the run loop ([`crate::run`]) like
+//! `ballast run` (outputs, checkpoints, `--resume`), then reads the runs'
+//! outputs back into its own tables and figures. The `ballast` subcommands
+//! `saussine …`, `karrech …` and `luding …` are these functions behind
+//! command-line arguments.
+//!
+//! - [`saussine`]: the Saussine et al. (2006) sample deposited in stages
+//!   ([`saussine::sample`]), loaded ([`saussine::load`]) and settled over cycles
+//!   (§4, [`saussine::settle`]);
+//! - [`campaigns`]: the studies of Saussine et al. (2006) §3.2 (convergence
+//!   policies), §3.3 (time steps) and §4.2 (ensembles of samples), many runs side
+//!   by side on a thread pool;
+//! - [`karrech`]: the Karrech et al. (2007) deposit and cyclic plate load, with
+//!   the figures of its Fig. 3 and the residual displacement per cycle;
+//! - [`luding`]: the cyclic triaxial box of David, García-Rojo, Herrmann &
+//!   Luding: isotropic compression, cycles (`loops.csv`, `strain.csv`), and the
+//!   comparison of several cycled runs (`compare.csv`);
+//! - [`md_stage`]: what the two-stage MD tests share (`spec.json`, where and how
+//!   a stage runs).
+//!
+//! Progress goes through a [`RunDisplay`]: one callback per run, and a word
+//! when each run ends ([`Quiet`] shows nothing). Invalid inputs are
+//! [`Error::Scene`] with a one-line message naming the option (as the command
+//! line spells it); a failed run or an unwritable output is another error.
+//!
+//! A 60-grain sample, deposited quietly:
+//! ```no_run
+//! use ballast::scenarios::saussine::SampleSpec;
+//! use ballast::studies::{saussine, Quiet};
+//! let spec = SampleSpec::saussine(1).scaled(60);
+//! let sample = saussine::sample(&spec, "out/sample".as_ref(), false, 1, &Quiet)?;
+//! println!("{}: solid fraction {:.3}", sample.path.display(), sample.report.solid_fraction);
+//! # Ok::<(), ballast::Error>(())
+//! ```
+
+pub mod campaigns;
+mod display;
+pub mod karrech;
+pub mod luding;
+pub mod md_stage;
+pub mod saussine;
+
+pub use display::{run_scene, Quiet, RunDisplay};
+
+use crate::error::{Error, Result};
+use crate::io::figures::Axes;
+use std::path::{Path, PathBuf};
+
+/// A summary table a study wrote, read back as text (as the CSV has it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SummaryTable {
+    /// The CSV file.
+    pub path: PathBuf,
+    /// Its column names.
+    pub header: Vec<String>,
+    /// Its rows, each field as written.
+    pub rows: Vec<Vec<String>>,
+}
+
+impl SummaryTable {
+    /// Reads the CSV file at `path` (rows that cannot be read are left out).
+    ///
+    /// # Errors
+    /// [`Error::Io`] if the file or its header cannot be read.
+    pub fn read(path: &Path) -> Result<Self> {
+        let io = |e: csv::Error| Error::Io(std::io::Error::other(e));
+        let mut reader = csv::Reader::from_path(path).map_err(io)?;
+        let header = reader.headers().map_err(io)?.iter().map(String::from).collect();
+        let rows = reader.records().flatten().map(|r| r.iter().map(String::from).collect()).collect();
+        Ok(Self { path: path.to_path_buf(), header, rows })
+    }
+}
+
+/// An error on a file the study wrote itself, or on a run's outputs: a failure
+/// of the study, not of its input ([`Error::Scene`] becomes [`Error::Io`] with
+/// the same message; the others are kept).
+pub(crate) fn output_error(e: Error) -> Error {
+    match e {
+        Error::Scene(msg) => Error::Io(std::io::Error::other(msg)),
+        e => e,
+    }
+}
+
+/// Writes `text` to `path`; the error names the file.
+pub(crate) fn write_file(path: &Path, text: &str) -> Result<()> {
+    std::fs::write(path, text).map_err(|e| crate::io::io_error(path, "write", e))
+}
+
+/// The axes of a line chart.
+pub(crate) fn axes(title: &str, x: &str, y: &str, log_x: bool, log_y: bool) -> Axes {
+    Axes { title: title.into(), x_label: x.into(), y_label: y.into(), log_x, log_y }
+}

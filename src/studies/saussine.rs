@@ -1,0 +1,280 @@
+//! The experiments of Saussine et al. (2006), §3–4, on one sample (the
+//! scenes of [`crate::scenarios::saussine`]), each from scene
+//! files written into the output folder and run with the same loop as
+//! `ballast run` (progress, checkpoints, `--resume`):
+//!
+//! - [`sample`]: generate and deposit the sample (stage 1, and 1b for a
+//!   free bank), save it as `sample.toml`, measure its balance, solid fraction
+//!   and coordination number (`sample.json`);
+//! - [`load`]: write the loaded scene (sleeper with bars, load, sublayer
+//!   stiffness, solver, time step, number of cycles) from a deposited sample;
+//! - [`settle`] (§4): load a sample and run its cycles: `cycles.csv`,
+//!   `summary.json`, VTK snapshots every few cycles, figures.
+//!
+//! The settings of the loaded stage are a [`Loading`] (the options of
+//! `ballast saussine load`); a sample scaled to fewer grains is loaded with the
+//! sleeper's width and the load scaled alike (same pressure,
+//! [`Loading::for_sample`]), unless the sleeper's width is given.
+
+use super::{output_error, run_scene, write_file, RunDisplay};
+use crate::error::{Error, Result};
+use crate::io;
+use crate::run::{default_threads, files, Prior, RunOptions, RunOutcome};
+use crate::scenarios::saussine::{
+    loaded_scene, measure_sample, open_bank, sample_scene, Guide, LoadingSpec, SampleReport, SampleSpec, GRAIN_PREFIX,
+};
+use crate::scene::Scene;
+use std::path::{Path, PathBuf};
+
+/// The settings of a loaded stage, as `ballast saussine load` takes them
+/// ([`Loading::default`]: its defaults). [`Loading::spec`] checks them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Loading {
+    /// Number of loading cycles.
+    pub cycles: u64,
+    /// Angle of the load from the vertical (degrees).
+    pub inclination_deg: f64,
+    /// Sleeper guide; `None`: vertical for a vertical load, level otherwise.
+    pub guide: Option<Guide>,
+    /// Factor on the sublayer stiffness k_N (§4.2: 1, 100, 1000).
+    pub stiffness_factor: f64,
+    /// Time step (s).
+    pub dt: f64,
+    /// Convergence policy (strict, quad, quad_max, energy) and its tolerance.
+    pub criterion: String,
+    pub tolerance: f64,
+    /// Bounds on the NLGS sweeps of a step.
+    pub min_iterations: usize,
+    pub max_iterations: usize,
+    /// Square bars under the sleeper (0: a flat sleeper).
+    pub bars: usize,
+    /// Width of the sleeper (m); `None`: the paper's, scaled with the sample.
+    pub sleeper_width: Option<f64>,
+}
+
+impl Default for Loading {
+    /// 100 cycles of a vertical load, sublayer ×1, dt = 2e-4 s, the energy
+    /// policy at 1.66e-5 (the cheapest measured to keep the max overlap below
+    /// 1 % of the smallest grain over 1000 cycles, BENCHMARKS.md), 1 to 2000
+    /// sweeps, two bars.
+    fn default() -> Self {
+        Self {
+            cycles: 100,
+            inclination_deg: 0.0,
+            guide: None,
+            stiffness_factor: 1.0,
+            dt: 2e-4,
+            criterion: "energy".into(),
+            tolerance: 1.66e-5,
+            min_iterations: 1,
+            max_iterations: 2000,
+            bars: 2,
+            sleeper_width: None,
+        }
+    }
+}
+
+impl Loading {
+    /// The loading of the reference (724-grain) sample.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming the option: a stiffness factor that is not
+    /// positive, an inclination outside (−90°, 90°), no cycle.
+    pub fn spec(&self) -> Result<LoadingSpec> {
+        let guide = match self.guide {
+            Some(g) => g,
+            None if self.inclination_deg == 0.0 => Guide::Vertical,
+            None => Guide::Level,
+        };
+        if !(self.stiffness_factor.is_finite() && self.stiffness_factor > 0.0) {
+            return Err(Error::Scene(format!("--stiffness-factor: must be positive, got {}", self.stiffness_factor)));
+        }
+        if !(self.inclination_deg.is_finite() && self.inclination_deg.abs() < 90.0) {
+            return Err(Error::Scene(format!(
+                "--inclination: must be in (-90, 90) degrees, got {}",
+                self.inclination_deg
+            )));
+        }
+        if self.cycles == 0 {
+            return Err(Error::Scene("--cycles: must be at least 1".into()));
+        }
+        let base = LoadingSpec::saussine(self.cycles);
+        Ok(LoadingSpec {
+            inclination_deg: self.inclination_deg,
+            guide,
+            stiffness_factor: self.stiffness_factor,
+            dt: self.dt,
+            criterion: self.criterion.clone(),
+            tolerance: self.tolerance,
+            min_iterations: self.min_iterations,
+            max_iterations: self.max_iterations,
+            bars: self.bars,
+            sleeper_width: self.sleeper_width.unwrap_or(base.sleeper_width),
+            ..base
+        })
+    }
+
+    /// The loading for `sample`: the sleeper's width and the load scaled with a
+    /// sample scaled by [`SampleSpec::scaled`] (same pressure under the
+    /// sleeper), unless the sleeper's width is given (it then keeps its bars).
+    ///
+    /// # Errors
+    /// As [`Loading::spec`].
+    pub fn for_sample(&self, sample: &Scene) -> Result<LoadingSpec> {
+        let spec = self.spec()?;
+        let grains = sample.bodies.iter().filter(|b| b.name.starts_with(GRAIN_PREFIX)).count();
+        let f = grains as f64 / reference_grains() as f64;
+        if grains == 0 || (f - 1.0).abs() < 1e-3 {
+            return Ok(spec);
+        }
+        let mut scaled = spec.clone().scaled(f);
+        if let Some(w) = self.sleeper_width {
+            // The given sleeper keeps its bars.
+            scaled.sleeper_width = w;
+            scaled.bar_size = spec.bar_size;
+        }
+        Ok(scaled)
+    }
+}
+
+/// The number of grains of the reference sample (361 + 242 + 121).
+fn reference_grains() -> usize {
+    SampleSpec::saussine(0).grading.iter().map(|g| g.1).sum()
+}
+
+/// Writes `scene` to `path` with a header line saying `what` it is.
+///
+/// # Errors
+/// [`Error::Io`] naming the file.
+pub fn write_scene(path: &Path, scene: &Scene, what: &str) -> Result<()> {
+    let text = format!(
+        "# Written by ballast {} (Saussine et al. 2006 experiments): {}.\n\n{}",
+        env!("CARGO_PKG_VERSION"),
+        what.replace(char::is_control, "?"),
+        scene.to_toml_string()?
+    );
+    write_file(path, &text)
+}
+
+/// A deposited sample: its scene and what `sample.json` records.
+#[derive(Debug, Clone)]
+pub struct Sample {
+    /// `sample.toml`, the deposited sample as a scene.
+    pub path: PathBuf,
+    /// Its balance, overlaps, solid fraction and coordination (`sample.json`).
+    pub report: SampleReport,
+}
+
+/// Deposits the sample of `spec` into `out`: `deposit.toml` run in
+/// `out/deposit/` until equilibrium, with a bank `bank.toml` run again in
+/// `out/bank/`, then `sample.toml` and `sample.json`. Each stage runs on
+/// `threads` threads; with `resume`, a finished stage is not run again and a
+/// checkpointed one is resumed. The runs are labelled `sample <seed>`.
+///
+/// # Errors
+/// [`Error::Scene`] for an invalid spec (or checkpoint); a stage that fails
+/// (divergence) or an output that cannot be written or read back is another
+/// error.
+pub fn sample(spec: &SampleSpec, out: &Path, resume: bool, threads: usize, display: &dyn RunDisplay) -> Result<Sample> {
+    let label = format!("sample {}", spec.seed);
+    let scene = sample_scene(spec)?;
+    io::create_output_dir(out)?;
+    let deposit = out.join("deposit.toml");
+    write_scene(&deposit, &scene, &format!("stage 1 (deposit) of the sample, seed {}", spec.seed))?;
+    let stage = |scene: &Path, dir: &Path| run_stage(scene, dir, resume, threads, display, &label);
+    let mut settled = stage(&deposit, &out.join("deposit"))?;
+    if spec.bank {
+        let opened = open_bank(&settled).map_err(output_error)?;
+        let bank = out.join("bank.toml");
+        write_scene(&bank, &opened, "the deposited sample without its mould, to settle into free banks")?;
+        settled = stage(&bank, &out.join("bank"))?;
+    }
+    let path = out.join("sample.toml");
+    write_scene(&path, &settled, &format!("deposited sample, seed {}", spec.seed))?;
+    let report = measure_sample(&settled).map_err(output_error)?;
+    io::write_json(&out.join("sample.json"), &report)?;
+    Ok(Sample { path, report })
+}
+
+/// Runs `scene_path` into `dir` unless a finished run is there already; the
+/// state it ends in.
+fn run_stage(
+    scene_path: &Path,
+    dir: &Path,
+    resume: bool,
+    threads: usize,
+    display: &dyn RunDisplay,
+    label: &str,
+) -> Result<Scene> {
+    let prior = Prior::of(dir, files::FINAL_SCENE, resume);
+    if prior != Prior::Finished {
+        let resume = prior == Prior::Checkpointed;
+        let opts = RunOptions { checkpoint_every_s: 300.0, resume, threads, ..RunOptions::default() };
+        run_scene(scene_path, dir, &opts, display, label)?;
+    }
+    Scene::load(dir.join(files::FINAL_SCENE)).map_err(output_error)
+}
+
+/// The loaded scene of the sample at `sample` under `loading` (the sample's
+/// own scaling, [`Loading::for_sample`]), and the loading spec it was made with.
+fn loaded(sample: &Path, loading: &Loading) -> Result<(Scene, LoadingSpec)> {
+    let scene = Scene::load(sample)?;
+    let spec = loading.for_sample(&scene)?;
+    Ok((loaded_scene(&scene, &spec)?, spec))
+}
+
+/// Writes the loaded scene of the sample at `sample` (a `sample.toml` of
+/// [`sample`]) to `out`: the sleeper (and its bars) on top under
+/// F = A + B cos(2π f t − φ), ready for `ballast run`.
+///
+/// # Errors
+/// [`Error::Scene`] for an unreadable sample or an invalid loading;
+/// [`Error::Io`] if `out` cannot be written.
+pub fn load(sample: &Path, loading: &Loading, out: &Path) -> Result<()> {
+    let (scene, _) = loaded(sample, loading)?;
+    write_scene(out, &scene, &format!("loaded from {}", sample.display()))
+}
+
+/// How [`settle`] runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SettleOptions {
+    /// A VTK snapshot (bodies and contact forces) every this many cycles; 0: none.
+    pub snapshot_every: u64,
+    /// Wall-clock seconds between checkpoints.
+    pub checkpoint_every_s: f64,
+    /// Continue a killed run from its checkpoint.
+    pub resume: bool,
+}
+
+/// §4: loads the sample at `sample` and runs its cycles in `out` (the loaded
+/// scene written there as `loaded.toml`, kept on `resume`): per-cycle
+/// settlement, mean grain speed, contacts and iterations (`cycles.csv`), VTK
+/// snapshots, figures. The run is labelled `settle`.
+///
+/// # Errors
+/// [`Error::Scene`] for an unreadable sample, an invalid loading or
+/// checkpoint; else as [`crate::run::Runner::run`].
+pub fn settle(
+    sample: &Path,
+    loading: &Loading,
+    out: &Path,
+    opts: &SettleOptions,
+    display: &dyn RunDisplay,
+) -> Result<RunOutcome> {
+    let (scene, spec) = loaded(sample, loading)?;
+    io::create_output_dir(out)?;
+    let path = out.join("loaded.toml");
+    if !opts.resume {
+        write_scene(&path, &scene, &format!("loaded from {}", sample.display()))?;
+    }
+    let steps_per_cycle = (1.0 / (spec.frequency * spec.dt)).round().max(1.0) as u64;
+    let run = RunOptions {
+        checkpoint_every_s: opts.checkpoint_every_s,
+        resume: opts.resume,
+        vtk_every: opts.snapshot_every.saturating_mul(steps_per_cycle),
+        figures: true,
+        threads: default_threads(),
+        ..RunOptions::default()
+    };
+    run_scene(&path, out, &run, display, "settle")
+}
