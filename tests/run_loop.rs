@@ -315,3 +315,38 @@ fn outputs_read_back_through_the_row_types() {
     assert_eq!((p.reference.dof, p.reference.bodies.clone(), p.cycles.len()), (6, vec![0, 1], 2));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `RunOptions::length` (`ballast run --steps | --duration`) replaces the scene's
+/// duration for one run, on both engines: the run makes exactly that many steps
+/// (the clock is exact, so the last time is steps · dt), the scene copy records
+/// the new duration and plans the same steps when read back; a length the scene
+/// cannot take is an error naming the option.
+#[test]
+fn a_run_length_replaces_the_scene_duration() {
+    use ballast::run::{run_file, RunLength};
+    let dir = temp_dir("length");
+    let md = dir.join("md.toml");
+    std::fs::write(&md, md_scene(0.01, false)).unwrap();
+    let nscd = dir.join("nscd.toml");
+    std::fs::write(&nscd, NSCD).unwrap();
+    for (scene, dt) in [(&nscd, 1e-3), (&md, 2e-6)] {
+        let out = dir.join(format!("out-{}", scene.file_stem().unwrap().to_string_lossy()));
+        for (length, steps) in [(RunLength::Steps(7), 7), (RunLength::Duration(11.0 * dt), 11)] {
+            let opts = RunOptions { length: Some(length), ..quiet() };
+            let run = ballast::run::run_file(scene, &out, &opts, &mut |_| {}).unwrap();
+            assert_eq!(run.step, steps, "{}", scene.display());
+            let copy = std::fs::read_to_string(out.join("scene.toml")).unwrap();
+            let planned = if scene == &md {
+                MdScene::from_toml_str(&copy).unwrap().steps()
+            } else {
+                Scene::from_toml_str(&copy).unwrap().steps()
+            };
+            assert_eq!(planned, steps);
+        }
+        for (length, option) in [(RunLength::Steps(0), "--steps"), (RunLength::Duration(-1.0), "--duration")] {
+            let opts = RunOptions { length: Some(length), ..quiet() };
+            let e = run_file(scene, &out, &opts, &mut |_| {}).unwrap_err().to_string();
+            assert!(e.starts_with(option) && !e.contains('\n'), "{e}");
+        }
+    }
+}

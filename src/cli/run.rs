@@ -2,7 +2,7 @@
 //! library's run loop ([`ballast::run::run_file`]).
 
 use super::{Bars, Failure};
-use ballast::run::{default_threads, RunOptions};
+use ballast::run::{default_threads, RunLength, RunOptions};
 use ballast::studies::run_scene;
 use std::path::PathBuf;
 
@@ -39,6 +39,14 @@ pub struct RunArgs {
     /// curves, force chains, displacement field.
     #[arg(long)]
     figures: bool,
+    /// Simulated seconds to run instead of the scene's `[simulation] duration`
+    /// (for a quick try; the scene copy in DIR records it).
+    #[arg(long, value_name = "SECONDS", conflicts_with = "steps", allow_negative_numbers = true)]
+    duration: Option<f64>,
+    /// Time steps to run instead of the scene's `[simulation] duration`
+    /// (duration = STEPS · dt; the scene copy in DIR records it).
+    #[arg(long, value_name = "STEPS")]
+    steps: Option<u64>,
 }
 
 /// `ballast run`.
@@ -50,6 +58,11 @@ pub fn main(a: RunArgs) -> Result<(), Failure> {
         vtk_every: a.vtk_every,
         threads: a.threads.unwrap_or_else(default_threads),
         figures: a.figures,
+        length: match (a.duration, a.steps) {
+            (Some(d), _) => Some(RunLength::Duration(d)),
+            (None, Some(n)) => Some(RunLength::Steps(n)),
+            (None, None) => None,
+        },
     };
     run_scene(&a.scene, &a.out, &opts, &Bars::single(a.quiet), "run")?;
     Ok(())

@@ -9,7 +9,7 @@
 //! - `final.json`: the state of every body (and wall) at the end ([`FinalState`]);
 //! - `summary.json`: wall time and speed, mean contacts, overlaps, NLGS
 //!   iterations ([`summary::RunReport`]);
-//! - `scene.toml`: a byte copy of the input scene ([`copy_scene`]), or
+//! - `scene.toml`: a copy of the input scene (the text the run read), or
 //!   `initial_state.json` for a system built in code;
 //! - `final_scene.toml`: the input scene with the final state, to restart from;
 //! - `run.json`: seed, engine, crate version, number of steps, time step ([`RunInfo`]);
@@ -77,14 +77,6 @@ pub fn write_atomic(path: &Path, text: &str) -> Result<()> {
     let tmp = PathBuf::from(tmp);
     std::fs::write(&tmp, text).map_err(|e| io_error(&tmp, "write", e))?;
     std::fs::rename(&tmp, path).map_err(|e| io_error(path, "write", e))
-}
-
-/// Copies the scene file `scene` byte for byte to `dir/scene.toml`.
-pub fn copy_scene(scene: &Path, dir: &Path) -> Result<PathBuf> {
-    let bytes = std::fs::read(scene).map_err(|e| io_error(scene, "read", e))?;
-    let path = dir.join("scene.toml");
-    std::fs::write(&path, bytes).map_err(|e| io_error(&path, "write", e))?;
-    Ok(path)
 }
 
 /// Contents of `run.json`: what is needed to reproduce a run.

@@ -20,8 +20,8 @@ mod runner;
 pub use engine::{Configuration, Energies, Engine};
 pub use equilibrium::{Equilibrium, EquilibriumWatch, DEFAULT_EQUILIBRIUM_STEPS};
 pub use runner::{
-    check_options, cores, default_threads, files, CyclePlan, Prior, Progress, Restart, RunOptions, RunOutcome, RunPlan,
-    Runner, Status,
+    check_options, cores, default_threads, files, CyclePlan, Prior, Progress, Restart, RunLength, RunOptions,
+    RunOutcome, RunPlan, Runner, Status,
 };
 
 use crate::error::Result;
@@ -45,14 +45,28 @@ pub fn run_file(
     let name = scene_path.display().to_string();
     match crate::scene::engine_of_named(&text, &name)?.as_str() {
         "md" => {
-            let scene = MdScene::from_toml_str_named(&text, &name)?;
+            let mut scene = MdScene::from_toml_str_named(&text, &name)?;
+            let text = match opts.length {
+                Some(length) => {
+                    scene.simulation.set_length(length)?;
+                    scene.to_toml_string()?
+                }
+                None => text,
+            };
             let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts.clone() };
             let (system, plan) = (scene.build()?, scene.plan()?);
             let restart: Restart<crate::md::MdSystem> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
             Runner::from_scene(system, plan, scene_path, text, Some(restart)).run(out, &opts, progress)
         }
         _ => {
-            let scene = Scene::from_toml_str_named(&text, &name)?;
+            let mut scene = Scene::from_toml_str_named(&text, &name)?;
+            let text = match opts.length {
+                Some(length) => {
+                    scene.simulation.set_length(length)?;
+                    scene.to_toml_string()?
+                }
+                None => text,
+            };
             let (system, plan) = (scene.build()?, scene.plan()?);
             let restart: Restart<crate::nscd::System> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
             Runner::from_scene(system, plan, scene_path, text, Some(restart)).run(out, opts, progress)

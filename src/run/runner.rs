@@ -39,7 +39,8 @@ pub mod files {
     pub const SUMMARY: &str = "summary.json";
     /// Seed, engine, version, steps.
     pub const RUN_INFO: &str = "run.json";
-    /// Byte copy of the scene file.
+    /// Copy of the scene the run read (the file's text, or its serialised form
+    /// with a [`RunOptions::length`] applied).
     pub const SCENE: &str = "scene.toml";
     /// Serde form of the initial system of a run built in code.
     pub const INITIAL_STATE: &str = "initial_state.json";
@@ -100,6 +101,20 @@ pub struct RunOptions {
     pub threads: usize,
     /// Draw the run's figures at the end.
     pub figures: bool,
+    /// A scene file's `[simulation] duration` replaced for this run (for quick
+    /// tries); the scene copy in the output folder records it. `None`: the
+    /// scene's own.
+    pub length: Option<RunLength>,
+}
+
+/// The length of a run that replaces a scene's `[simulation] duration`
+/// ([`RunOptions::length`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RunLength {
+    /// Simulated duration (s), > 0.
+    Duration(f64),
+    /// Number of time steps, ≥ 1 (duration = steps · dt).
+    Steps(u64),
 }
 
 impl Default for RunOptions {
@@ -113,6 +128,7 @@ impl Default for RunOptions {
             vtk_every: 0,
             threads: default_threads(),
             figures: false,
+            length: None,
         }
     }
 }
@@ -450,8 +466,8 @@ impl<E: Engine> Runner<E> {
     /// initial state of a system built in code) and `run.json`.
     fn write_records(&self, out: &Path) -> Result<()> {
         match &self.origin {
-            Origin::Scene { path, .. } => {
-                io::copy_scene(path, out)?;
+            Origin::Scene { text, .. } => {
+                io::write_text(out, files::SCENE, text)?;
             }
             Origin::Code { json } => {
                 io::write_text(out, files::INITIAL_STATE, json)?;

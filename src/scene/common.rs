@@ -50,6 +50,28 @@ impl Simulation {
         steps_of(self.dt, self.duration)
     }
 
+    /// Sets the run's length for one run (`ballast run --duration | --steps`):
+    /// `duration` (s) as is, or `steps` time steps (`duration = steps · dt`).
+    ///
+    /// # Errors
+    /// [`crate::Error::Scene`] naming the option if the length is not a positive
+    /// number of steps the scene allows.
+    pub fn set_length(&mut self, length: crate::run::RunLength) -> crate::Result<()> {
+        use crate::run::RunLength;
+        let duration = match length {
+            RunLength::Duration(d) => d,
+            RunLength::Steps(0) => return Err(crate::Error::Scene("--steps: must be at least 1".into())),
+            RunLength::Steps(n) => n as f64 * self.dt,
+        };
+        super::validate::check_time(self.dt, duration).map_err(|e| match (length, e) {
+            (RunLength::Duration(_), crate::Error::Scene(m)) => crate::Error::Scene(format!("--duration: {m}")),
+            (RunLength::Steps(_), crate::Error::Scene(m)) => crate::Error::Scene(format!("--steps: {m}")),
+            (_, e) => e,
+        })?;
+        self.duration = duration;
+        Ok(())
+    }
+
     /// Random seed recorded in the outputs (default 0).
     pub fn seed(&self) -> u64 {
         self.seed.unwrap_or(0)
