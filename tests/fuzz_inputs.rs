@@ -275,9 +275,8 @@ fn opts(stop_after: u64, resume: bool) -> RunOptions {
         checkpoint_every_s: 0.0,
         resume,
         stop_after: Some(stop_after),
-        vtk_every: 0,
         threads: 1,
-        figures: false,
+        ..RunOptions::default()
     }
 }
 
