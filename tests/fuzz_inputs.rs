@@ -271,13 +271,7 @@ fn scratch(name: &str) -> PathBuf {
 /// Options of a fuzzed run: one thread, no wall-clock checkpoints, at most
 /// `stop_after` steps.
 fn opts(stop_after: u64, resume: bool) -> RunOptions {
-    RunOptions {
-        checkpoint_every_s: 0.0,
-        resume,
-        stop_after: Some(stop_after),
-        threads: 1,
-        ..RunOptions::default()
-    }
+    RunOptions { checkpoint_every_s: 0.0, resume, stop_after: Some(stop_after), threads: 1, ..RunOptions::default() }
 }
 
 /// Runs `scene` into `out` with `o`, recording the progress values that are

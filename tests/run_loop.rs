@@ -320,7 +320,8 @@ fn outputs_read_back_through_the_row_types() {
 /// duration for one run, on both engines: the run makes exactly that many steps
 /// (the clock is exact, so the last time is steps · dt), the scene copy records
 /// the new duration and plans the same steps when read back; a length the scene
-/// cannot take is an error naming the option.
+/// cannot take is an error naming the option. The summary's final overlap is
+/// that of the last row of `series.csv`.
 #[test]
 fn a_run_length_replaces_the_scene_duration() {
     use ballast::run::{run_file, RunLength};
@@ -335,6 +336,14 @@ fn a_run_length_replaces_the_scene_duration() {
             let opts = RunOptions { length: Some(length), ..quiet() };
             let run = ballast::run::run_file(scene, &out, &opts, &mut |_| {}).unwrap();
             assert_eq!(run.step, steps, "{}", scene.display());
+            // The final overlap reported is the last row's; the run's largest bounds it.
+            let last = if scene == &md {
+                ballast::io::series::read_md(&out.join("series.csv")).unwrap().1.last().unwrap().max_overlap_m
+            } else {
+                ballast::io::series::read_nscd(&out.join("series.csv")).unwrap().last().unwrap().max_overlap_m
+            };
+            assert_eq!(run.report.final_max_overlap_m, last);
+            assert!(run.report.max_overlap_m >= last);
             let copy = std::fs::read_to_string(out.join("scene.toml")).unwrap();
             let planned = if scene == &md {
                 MdScene::from_toml_str(&copy).unwrap().steps()

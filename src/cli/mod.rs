@@ -205,7 +205,7 @@ pub(crate) fn print_outcome(o: &RunOutcome) {
             };
             println!(
                 "{} steps to t = {:.6} s{} in {:.2} s ({:.3e} body-steps/s on {} threads): {} bodies, final kinetic \
-                 energy {:.3e} J, max overlap {:.3e} m{solver}; outputs in {}",
+                 energy {:.3e} J, max overlap {:.3e} m at the end ({:.3e} m during the run){solver}; outputs in {}",
                 o.step,
                 o.time,
                 if end == ballast::io::RunEnd::Equilibrium { " (equilibrium reached)" } else { "" },
@@ -214,6 +214,7 @@ pub(crate) fn print_outcome(o: &RunOutcome) {
                 r.threads,
                 r.bodies,
                 o.kinetic_energy,
+                r.final_max_overlap_m,
                 r.max_overlap_m,
                 o.out.display()
             );

@@ -39,6 +39,9 @@ pub struct RunSummary {
     pub steps: u64,
     /// Largest overlap so far, the state before the first step included (m).
     pub max_overlap: f64,
+    /// Largest overlap of the last step (or of the state before the first) (m).
+    #[serde(default)]
+    pub final_max_overlap: f64,
     /// Sum over the steps of the mean overlap of the active contacts (m).
     pub sum_mean_overlap: f64,
     /// Sum over the steps of the contacts.
@@ -59,6 +62,7 @@ impl RunSummary {
     pub fn add(&mut self, s: &StepSummary) {
         self.steps += 1;
         self.max_overlap = self.max_overlap.max(s.max_overlap);
+        self.final_max_overlap = s.max_overlap;
         self.sum_mean_overlap += s.mean_overlap;
         self.contacts += s.contacts;
         self.iterations += s.iterations;
@@ -106,8 +110,11 @@ pub struct RunReport {
     pub mean_contacts: f64,
     /// Mean over the steps of the mean overlap of the active contacts (m).
     pub mean_overlap_m: f64,
-    /// Largest overlap of the run, the initial state included (m).
+    /// Largest overlap of the run, the initial state included (m): during a
+    /// deposit, the impacts of falling grains.
     pub max_overlap_m: f64,
+    /// Largest overlap of the final state (m): what a run leaves to the next.
+    pub final_max_overlap_m: f64,
     /// NSCD: mean NLGS sweeps per step.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mean_iterations: Option<f64>,
@@ -153,6 +160,7 @@ impl RunReport {
             mean_contacts: per_step(s.contacts),
             mean_overlap_m: per_step(s.sum_mean_overlap),
             max_overlap_m: s.max_overlap,
+            final_max_overlap_m: s.final_max_overlap,
             mean_iterations: iterations.then(|| per_step(s.iterations as f64)),
             unconverged_steps: iterations.then_some(s.unconverged),
             equilibrium: end == RunEnd::Equilibrium,

@@ -442,6 +442,7 @@ impl<E: Engine> Runner<E> {
         let mut summary = RunSummary::default();
         if let Some(s) = sys.initial_summary() {
             summary.max_overlap = s.max_overlap;
+            summary.final_max_overlap = s.max_overlap;
         }
         let (cycles, positions) = match self.plan.cycles {
             Some(c) => {
