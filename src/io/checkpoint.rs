@@ -45,14 +45,19 @@ pub struct Checkpoint<S, C> {
     pub first_step: u64,
     /// Steps made by the engine when the checkpoint was written.
     pub step: u64,
-    /// Length of `series.csv` (bytes), rows in it and the CRC-32 of these bytes.
+    /// Length of `series.csv` when the checkpoint was written (bytes); a resumed
+    /// run truncates the file to it.
     pub series_bytes: u64,
+    /// Data rows in those `series_bytes` bytes of `series.csv` (header excluded).
     pub series_rows: u64,
+    /// CRC-32 of those `series_bytes` bytes of `series.csv`.
     pub series_crc32: u32,
-    /// Length of `cycles.csv` (bytes), rows in it and the CRC-32 of these bytes
-    /// (0, 0 and 0 without cycles).
+    /// Length of `cycles.csv` when the checkpoint was written (bytes; 0 without
+    /// `output.cycles`).
     pub cycles_bytes: u64,
+    /// Data rows in those `cycles_bytes` bytes of `cycles.csv` (0 without cycles).
     pub cycles_rows: u64,
+    /// CRC-32 of those `cycles_bytes` bytes of `cycles.csv` (0 without cycles).
     pub cycles_crc32: u32,
     /// Running summary of the run so far.
     pub summary: RunSummary,

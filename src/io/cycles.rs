@@ -34,17 +34,24 @@ pub struct NscdCycleState {
     pub body: usize,
     /// Its initial vertical position (m).
     pub y0: f64,
-    /// Steps of the cycle under way, and the sums over them.
+    /// Steps accumulated so far in the cycle under way (the divisor of the
+    /// means of [`NscdCycleRow`]).
     pub steps: u64,
+    /// Sum over those steps of the followed body's vertical position `y` (m).
     pub sum_y: f64,
     /// Smallest load magnitude of the cycle (N); infinite before its first
     /// step, which JSON writes as `null` (a checkpoint at a cycle end).
     #[serde(deserialize_with = "null_is_infinite")]
     pub min_load: f64,
+    /// Vertical position `y` of the followed body (m) at the step of [`Self::min_load`].
     pub y_at_min_load: f64,
+    /// Sum over the steps of the mean speed `|u|` of the other non-fixed bodies (m/s).
     pub sum_speed: f64,
+    /// Sum over the steps of the contacts detected (count).
     pub sum_contacts: f64,
+    /// Sum over the steps of the NLGS iterations made.
     pub sum_iterations: f64,
+    /// Largest overlap (interpenetration) of any contact over the cycle's steps (m).
     pub max_overlap: f64,
     /// Positions `(x, y, θ)` of every body at the end of the first cycle (for the
     /// displacement field from cycle 1 to the end of the run).
@@ -126,13 +133,24 @@ impl CycleCheck for MdCycleState {
 /// One row of an NSCD `cycles.csv`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NscdCycleRow {
+    /// Column `cycle`: number of the cycle ended (1 for the first).
     pub cycle: u64,
+    /// Column `time_s`: time at the end of the cycle (s).
     pub time_s: f64,
+    /// Column `settlement_mean_m`: `y0 − ⟨y⟩` of the followed body over the cycle's
+    /// steps (m), positive downwards (Saussine et al. 2006, Figs. 6, 11, 12).
     pub settlement_mean_m: f64,
+    /// Column `settlement_at_min_load_m`: `y0 − y` (m) at the step of the cycle where
+    /// the followed body's load magnitude is smallest; positive downwards.
     pub settlement_at_min_load_m: f64,
+    /// Column `mean_grain_speed_m_s`: speed of the non-fixed bodies other than the
+    /// followed one, averaged over bodies then steps (m/s; Saussine et al. 2006, Fig. 7).
     pub mean_grain_speed_m_s: f64,
+    /// Column `contacts`: contacts detected per step, mean over the cycle.
     pub contacts: f64,
+    /// Column `iterations`: NLGS iterations per step, mean over the cycle.
     pub iterations: f64,
+    /// Column `max_overlap_m`: largest contact overlap over the cycle (m).
     pub max_overlap_m: f64,
 }
 
@@ -160,12 +178,21 @@ pub struct MdCycleState {
 /// One row of an MD `cycles.csv`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MdCycleRow {
+    /// Column `cycle`: number of the cycle ended (1 for the first).
     pub cycle: u64,
+    /// Column `time_s`: time at the end of the cycle (s).
     pub time_s: f64,
+    /// Column `mean_displacement_x_m`: x-component of the displacement since the
+    /// start of the run, mean over the spheres (m).
     pub mean_displacement_x_m: f64,
+    /// Column `mean_displacement_y_m`: y-component of the mean displacement (m).
     pub mean_displacement_y_m: f64,
+    /// Column `mean_displacement_z_m`: z-component of the mean displacement (m).
     pub mean_displacement_z_m: f64,
+    /// Column `max_displacement_m`: largest norm of a sphere's displacement since the
+    /// start of the run (m).
     pub max_displacement_m: f64,
+    /// Column `max_overlap_m`: largest contact overlap over the cycle (m).
     pub max_overlap_m: f64,
     /// `<wall>_position_m` for every servo wall.
     pub walls: Vec<f64>,

@@ -29,16 +29,29 @@ use std::path::Path;
 /// One row of an NSCD `series.csv`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct NscdSeriesRow {
+    /// Column `time_s`: time at the end of the step (s).
     pub time_s: f64,
+    /// Column `kinetic_energy_J`: kinetic energy of the non-fixed bodies, translational plus
+    /// rotational, at the end of the step (J).
     #[serde(rename = "kinetic_energy_J")]
     pub kinetic_energy_j: f64,
+    /// Column `contacts`: contacts detected, open ones within the alert distance included.
     pub contacts: usize,
+    /// Column `active_contacts`: contacts carrying an impulse or overlapping at the end of the step.
     pub active_contacts: usize,
+    /// Column `iterations`: NLGS sweeps made in the step.
     pub iterations: usize,
+    /// Column `criterion`: final value of the convergence norm of the policy
+    /// ([`crate::nscd::criterion::evaluate`]; dimensionless, converged below the tolerance).
     pub criterion: f64,
+    /// Column `converged`: 1 if the iterations converged, 0 if they hit the iteration cap.
     pub converged: u8,
+    /// Column `mean_overlap_m`: mean overlap over the active contacts at the end of the step (m).
     pub mean_overlap_m: f64,
+    /// Column `max_overlap_m`: largest overlap at the end of the step (m).
     pub max_overlap_m: f64,
+    /// Column `total_overlap_m`: sum of the overlaps of all contacts (m), the cumulated
+    /// interpenetration of Saussine et al. 2006, Fig. 2.
     pub total_overlap_m: f64,
 }
 
@@ -59,18 +72,32 @@ pub const NSCD_SERIES_COLUMNS: [&str; 10] = [
 /// One row of an MD `series.csv`: the fixed columns, then the wall columns.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MdSeriesRow {
+    /// Column `time_s`: time at the end of the step (s).
     pub time_s: f64,
+    /// Column `kinetic_energy_J`: translational plus rotational kinetic energy of the spheres (J).
     #[serde(rename = "kinetic_energy_J")]
     pub kinetic_energy_j: f64,
+    /// Column `elastic_energy_J`: elastic energy stored in the contacts (J); a contact
+    /// with a symmetry image counts half.
     #[serde(rename = "elastic_energy_J")]
     pub elastic_energy_j: f64,
+    /// Column `potential_energy_J`: gravitational energy above the fixed reference height
+    /// plus `elastic_energy_J` (J; [`crate::md::MdSystem::potential_energy`]).
     #[serde(rename = "potential_energy_J")]
     pub potential_energy_j: f64,
+    /// Column `contacts`: sphere–sphere contacts (a contact with a symmetry image counts half).
     pub contacts: f64,
+    /// Column `wall_contacts`: sphere–wall contacts.
     pub wall_contacts: usize,
+    /// Column `max_overlap_m`: largest overlap `δ` of any contact (m).
     pub max_overlap_m: f64,
+    /// Column `mean_overlap_m`: mean overlap over all contacts (m).
     pub mean_overlap_m: f64,
+    /// Column `coordination`: coordination number `(2 N_c + N_w) / N` (dimensionless;
+    /// Karrech et al. 2007, Fig. 3).
     pub coordination: f64,
+    /// Column `packing_fraction`: sphere volume over container section × sample height
+    /// (dimensionless, [`crate::md::MdSystem::packing_fraction_bulk`]); empty without a container.
     pub packing_fraction: Option<f64>,
     /// `<wall>_force_N` for every wall, then `<wall>_position_m` for every servo wall.
     pub walls: Vec<f64>,

@@ -89,8 +89,9 @@ pub struct RunReport {
     pub engine: String,
     /// How the run ended.
     pub end: RunEnd,
-    /// Steps made and simulated time at the end (s).
+    /// Steps made by the run, over all its `--resume`s.
     pub steps: u64,
+    /// Simulated time at the end (s).
     pub time_s: f64,
     /// Time step (s).
     pub dt_s: f64,
@@ -98,13 +99,15 @@ pub struct RunReport {
     pub bodies: usize,
     /// Threads of the last invocation.
     pub threads: usize,
-    /// Wall time spent stepping (s), and per step.
+    /// Wall time spent stepping (s).
     pub wall_time_s: f64,
+    /// Wall time per step (s).
     pub wall_time_per_step_s: f64,
     /// Bodies × steps per second of wall time.
     pub body_steps_per_s: f64,
-    /// Loading cycles completed (with `output.cycles`) and wall time per cycle (s).
+    /// Loading cycles completed (with `output.cycles`; absent otherwise).
     pub cycles: Option<u64>,
+    /// Wall time per completed loading cycle (s; with `output.cycles`).
     pub wall_time_per_cycle_s: Option<f64>,
     /// Mean contacts per step.
     pub mean_contacts: f64,

@@ -184,6 +184,7 @@ pub struct PvdPart {
 pub struct PvdEntry {
     /// Simulated time (s).
     pub time: f64,
+    /// The blocks written at that time, in part order.
     pub parts: Vec<PvdPart>,
 }
 

@@ -17,7 +17,9 @@ use serde::{Deserialize, Serialize};
 /// A symmetry plane through `point` with unit normal `normal` (into the sample).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SymmetryPlane {
+    /// A point of the plane (m).
     pub point: V3,
+    /// Unit normal pointing into the sample (the real spheres' side).
     pub normal: V3,
 }
 
@@ -46,13 +48,20 @@ impl SymmetryPlane {
 /// `x`, `v`, `w` its mirrored state.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct Ghosts {
+    /// The symmetry planes; plane `s` is bit `s` of [`Self::mask`].
     pub planes: Vec<SymmetryPlane>,
+    /// Index of the real sphere each image mirrors.
     pub origin: Vec<u32>,
+    /// Planes each image is mirrored through (bit `s` for plane `s`; two bits for the
+    /// image through both planes).
     pub mask: Vec<u32>,
     /// `mask << 32 | origin`, the stable key of each ghost in the neighbour list.
     pub key: Vec<u64>,
+    /// Centre of each image (m).
     pub x: Vec<V3>,
+    /// Velocity of each image (m/s), the mirrored velocity of its sphere.
     pub v: Vec<V3>,
+    /// Spin of each image (rad/s), mirrored as a pseudovector (opposite sign of the mirrored vector).
     pub w: Vec<V3>,
 }
 

@@ -32,10 +32,15 @@ use serde::{Deserialize, Serialize};
 /// A Gear coefficient set.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum GearSet {
+    /// Karrech et al. 2007 eqs. 2–4 as printed (`q = 3`, scaled coefficients `(0, 2, 1)`).
     Karrech,
+    /// Allen & Tildesley's third-order set `(0, 1, 1)`.
     Gear3,
+    /// Allen & Tildesley's fourth-order set `(1/6, 5/6, 1, 1/3)`.
     Gear4,
+    /// Allen & Tildesley's fifth-order set `(19/120, 3/4, 1, 1/2, 1/12)`.
     Gear5,
+    /// Allen & Tildesley's sixth-order set `(3/20, 251/360, 1, 11/18, 1/6, 1/60)`.
     Gear6,
 }
 
@@ -83,7 +88,9 @@ impl GearSet {
 /// The integrator of a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Integrator {
+    /// Velocity Verlet (kick–drift–kick), forces evaluated with the half-step velocities.
     Verlet,
+    /// Gear predictor–corrector with the given coefficient set.
     Gear(GearSet),
 }
 

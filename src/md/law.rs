@@ -29,7 +29,7 @@ pub struct Material {
     pub density: f64,
     /// Young's modulus (Pa).
     pub young: f64,
-    /// Poisson's ratio.
+    /// Poisson's ratio `ν` (dimensionless).
     pub poisson: f64,
 }
 
@@ -83,6 +83,8 @@ pub enum Model {
 /// Everything the force loop needs to know about a pair of materials.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PairLaw {
+    /// Which force law the pair follows: Hertz–Mindlin (Karrech et al. 2007) or linear
+    /// spring–dashpot (David et al.).
     pub model: Model,
     /// `hertz`: `E*` (Pa).
     pub e_star: f64,
@@ -231,7 +233,10 @@ pub fn hertz_max_overlap(m_star: f64, r_star: f64, e_star: f64, v: f64) -> f64 {
 /// The pair laws of all material pairs, `n × n`, symmetric.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct LawTable {
+    /// Number of materials (the table is `n × n`).
     pub n: usize,
+    /// Row-major `n × n` table: `laws[a * n + b]` is the law of materials `a` and `b`,
+    /// `None` when the pair does not interact.
     pub laws: Vec<Option<PairLaw>>,
 }
 

@@ -22,18 +22,39 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum Shape {
     /// Infinite plane through `point`, unit `normal` into the free side.
-    Plane { point: V3, normal: V3 },
+    Plane {
+        /// A point of the plane at the start, `s = 0` (m).
+        point: V3,
+        /// Unit normal pointing into the free side (the sample); the wall moves along it.
+        normal: V3,
+    },
     /// The part of a plane within `radius` (m) of `point`.
-    Disc { point: V3, normal: V3, radius: f64 },
+    Disc {
+        /// Centre of the disc at the start, `s = 0` (m).
+        point: V3,
+        /// Unit normal pointing into the free side (the sample); the wall moves along it.
+        normal: V3,
+        /// Radius of the disc (m); a sphere whose centre projects outside it does not touch it.
+        radius: f64,
+    },
     /// The inside of an infinite cylinder (unit `axis`, `radius` m).
-    Cylinder { axis_point: V3, axis: V3, radius: f64 },
+    Cylinder {
+        /// A point of the axis (m).
+        axis_point: V3,
+        /// Unit vector along the axis.
+        axis: V3,
+        /// Inner radius (m); spheres are held inside.
+        radius: f64,
+    },
 }
 
 /// A prescribed history `base + amplitude (1 − cos 2π t / period) / 2`
 /// (constant if `period` is 0), in N or Pa.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct History1 {
+    /// Value at `t = 0` and at the start of every period (N or Pa): `p₀` of David et al.
     pub base: f64,
+    /// Peak-to-base rise reached at half a period (N or Pa): `Δσ` of David et al.
     pub amplitude: f64,
     /// Period (s); 0 for a constant `base`.
     pub period: f64,
@@ -62,11 +83,15 @@ pub enum Drive {
 /// How a wall moves.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum Motion {
+    /// Does not move (`s` stays 0).
     Fixed,
     /// Moves along its normal: mass `mass` (kg), viscosity `viscosity` (kg/s).
     Servo {
+        /// Wall mass `m_w` (kg) in `m_w s̈ = σ(t) A + F_c − γ_w ṡ`.
         mass: f64,
+        /// Wall viscosity `γ_w` (kg/s, i.e. N per m/s) in the same equation.
         viscosity: f64,
+        /// The prescribed force or stress `σ(t) A`.
         drive: Drive,
     },
 }
@@ -74,9 +99,14 @@ pub enum Motion {
 /// A wall and its state.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Wall {
+    /// Name of the wall in the scene; prefixes its `<wall>_force_N` and
+    /// `<wall>_position_m` columns.
     pub name: String,
+    /// Index of the wall's material (its row and column in the [`super::LawTable`]).
     pub material: u32,
+    /// Geometry at the start (`s = 0`).
     pub shape: Shape,
+    /// Fixed, or servo-controlled along the normal.
     pub motion: Motion,
     /// Displacement along the normal since the start (m).
     pub s: f64,

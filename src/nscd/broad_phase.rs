@@ -11,11 +11,14 @@
 /// An axis-aligned box `[min, max]` (m).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Aabb {
+    /// Lower-left corner `(x_min, y_min)` (m).
     pub min: [f64; 2],
+    /// Upper-right corner `(x_max, y_max)` (m).
     pub max: [f64; 2],
 }
 
 impl Aabb {
+    /// Whether the two boxes intersect (closed boxes: touching counts).
     #[inline]
     pub fn overlaps(&self, o: &Aabb) -> bool {
         self.min[0] <= o.max[0] && o.min[0] <= self.max[0] && self.min[1] <= o.max[1] && o.min[1] <= self.max[1]

@@ -35,12 +35,21 @@ pub type ContactKey = (u32, u32, u32);
 /// The solver's record of one contact: contiguous, everything one update needs.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ContactRow {
+    /// Index of the candidate body (the normal points towards it).
     pub a: u32,
+    /// Index of the antagonist body.
     pub b: u32,
+    /// Generalized normal direction of the candidate, `h_n = (n_x, n_y, r_a × n)`
+    /// (dimensionless, dimensionless, m): the row of `H*` of eq. (5) for `U_N`.
     pub hn_a: [f64; 3],
+    /// Generalized tangent direction of the candidate, `h_t = (t_x, t_y, r_a × t)` (–, –, m).
     pub ht_a: [f64; 3],
+    /// Generalized normal direction of the antagonist, `(n_x, n_y, r_b × n)` (–, –, m);
+    /// enters `U_N` with a minus sign.
     pub hn_b: [f64; 3],
+    /// Generalized tangent direction of the antagonist, `(t_x, t_y, r_b × t)` (–, –, m).
     pub ht_b: [f64; 3],
+    /// Local Delassus block `W = H* M⁻¹ H` of the contact (1/kg, i.e. m/s per N·s).
     pub w: Delassus,
     /// Impulse `(P_N, P_T)` (N·s).
     pub p: [f64; 2],
@@ -50,12 +59,15 @@ pub struct ContactRow {
     pub c_closed: f64,
     /// `e_t U_T⁻` added to `U_T` (m/s).
     pub shift_t: f64,
+    /// Coulomb friction coefficient `μ` of law (11) (dimensionless).
     pub mu: f64,
 }
 
 /// Cold per-contact data, parallel to the rows.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 pub struct ContactGeom {
+    /// Identity of the contact across steps: candidate, antagonist, feature pair
+    /// (used to warm-start its impulse).
     pub key: ContactKey,
     /// Contact point at `q_m` (m).
     pub point: Vec2,
@@ -68,8 +80,13 @@ pub struct ContactGeom {
 /// Friction and restitution between two materials.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ContactLaw {
+    /// Coulomb friction coefficient `μ` (dimensionless), law (11) of Saussine et al. 2006.
     pub friction: f64,
+    /// Normal restitution coefficient `e_n` (dimensionless, §2.8): a contact closing at
+    /// `U_N⁻ < 0` leaves at `U_N⁺ = −e_n U_N⁻`; 0 makes impacts fully inelastic.
     pub restitution_n: f64,
+    /// Tangential restitution coefficient `e_t` (dimensionless, §2.8): Coulomb's law acts
+    /// on `U_T⁺ + e_t U_T⁻`.
     pub restitution_t: f64,
 }
 
@@ -79,6 +96,8 @@ impl Default for ContactLaw {
     }
 }
 
+/// Dot product of two generalized 3-vectors, e.g. `h_n · u` = the normal velocity
+/// contribution of one body (m/s when `u = (v_x, v_y, ω)`).
 #[inline(always)]
 pub fn dot3(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]

@@ -12,8 +12,12 @@
 /// Local Delassus block `[[W_NN, W_NT], [W_NT, W_TT]]` (m/s per N·s).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Delassus {
+    /// `W_NN`: normal velocity per unit normal impulse (1/kg); > 0 unless both bodies are immobile along `n`.
     pub nn: f64,
+    /// `W_NT`: normal velocity per unit tangential impulse, equal to the tangential velocity
+    /// per unit normal impulse (1/kg); nonzero through the lever arms.
     pub nt: f64,
+    /// `W_TT`: tangential velocity per unit tangential impulse (1/kg).
     pub tt: f64,
 }
 

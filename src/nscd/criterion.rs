@@ -31,14 +31,24 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum Policy {
+    /// LMGC90's "Maxm ": `|MeanDVoR|`, `MaxmDV` and `MaxmDVR` below the tolerance
+    /// (every row must have converged).
     Strict,
+    /// LMGC90's "Quad " (the default): `|MeanDVoR|`, `QuadDV` and `QuadDVR` below the
+    /// tolerance (quadratic means over the rows).
     #[default]
     Quad,
+    /// LMGC90's "QM/16" family: [`Policy::Quad`], and `MaxmDV`, `MaxmDVR` below
+    /// `max_factor` × tolerance.
     QuadMax,
+    /// Relative change of `Σ P·WP` over a sweep below the tolerance (ours; the
+    /// paper cites an energy criterion without defining it).
     Energy,
 }
 
 impl Policy {
+    /// The policy's name in scenes and reports (`strict`, `quad`, `quad_max`, `energy`),
+    /// as serde writes it.
     pub fn name(self) -> &'static str {
         match self {
             Policy::Strict => "strict",
@@ -54,12 +64,19 @@ impl Policy {
 pub struct SweepNorms {
     /// Rows with a non-zero (mean) impulse.
     pub active: usize,
+    /// `Σ |ΔU|²` over the active rows, `ΔU = W ΔP` the row's local velocity correction ((m/s)²).
     pub sum_dvdv: f64,
+    /// `max |ΔU|²` over the active rows ((m/s)²).
     pub max_dvdv: f64,
+    /// `Σ |ΔU|² |P̄|²` over the active rows, `P̄` the midpoint impulse (J²).
     pub sum_dvdvrr: f64,
+    /// `max |ΔU|² |P̄|²` over the active rows (J²).
     pub max_dvdvrr: f64,
+    /// `Σ P̄·ΔU` over the active rows (J).
     pub sum_dvor: f64,
+    /// `Σ WPP` over the active rows, `WPP = ½ (P_old·W P_old + P_new·W P_new)` (J).
     pub sum_wrr: f64,
+    /// `Σ |WP|²` over the active rows, `|WP|² = ½ (|W P_old|² + |W P_new|²)` ((m/s)²).
     pub sum_wrwr: f64,
     /// Σ P_new·W P_new over all rows (energy criterion).
     pub sum_wpp: f64,

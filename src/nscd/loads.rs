@@ -10,9 +10,14 @@ use serde::{Deserialize, Serialize};
 /// `frequency` is in Hz, `phase` in rad, `t` in s.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Harmonic {
+    /// `A`: the mean value (unit of the quantity driven).
     pub mean: f64,
+    /// `B`: amplitude of the cosine (unit of the quantity driven); its sign sets the
+    /// value at `t = 0` together with `phase`.
     pub amplitude: f64,
+    /// `f`: frequency of the cosine (Hz); one loading cycle lasts `1/f`.
     pub frequency: f64,
+    /// `φ`: phase subtracted from `2π f t` (rad).
     pub phase: f64,
 }
 
@@ -55,10 +60,13 @@ impl Load {
 /// degree of freedom free (driven by forces and contacts).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Imposed {
+    /// Imposed law of `v_x` (m/s), `v_y` (m/s) and the spin `ω` (rad/s), world frame;
+    /// `None` for a free degree of freedom.
     pub dof: [Option<Harmonic>; 3],
 }
 
 impl Imposed {
+    /// Whether no degree of freedom is imposed.
     pub fn is_empty(&self) -> bool {
         self.dof.iter().all(Option::is_none)
     }

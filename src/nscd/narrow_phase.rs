@@ -8,8 +8,15 @@ use crate::geometry::Vec2;
 /// A body's shape placed in the world frame.
 #[derive(Debug, Clone, Copy)]
 pub enum Placed<'a> {
+    /// A convex polygon, vertices and edge normals in the world frame.
     Polygon(PolygonView<'a>),
-    Disc { centre: Vec2, radius: f64 },
+    /// A disc.
+    Disc {
+        /// Centre in the world frame (m).
+        centre: Vec2,
+        /// Radius (m).
+        radius: f64,
+    },
 }
 
 /// Contacts between candidate `a` and antagonist `b` with gap below `alert` (m).

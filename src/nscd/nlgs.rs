@@ -73,17 +73,26 @@ impl Default for NlgsSettings {
 /// impulses (for benchmarks and diagnostics; see [`super::System::nlgs_problem`]).
 #[derive(Debug, Clone)]
 pub struct NlgsProblem {
+    /// Body velocities `[u_x, u_y, ω]` (m/s, m/s, rad/s) before any impulse: `u_free`.
     pub u: Vec<[f64; 3]>,
+    /// Inverse masses `[1/m, 1/m, 1/I]` of the bodies (1/kg, 1/kg, 1/(kg·m²)); zero
+    /// for a fixed body or an imposed component.
     pub inv_m: Vec<[f64; 3]>,
+    /// Contact rows, impulses set to zero.
     pub rows: Vec<ContactRow>,
+    /// Sublayer spring rows ([`super::sublayer`]), impulses set to zero.
     pub springs: Vec<SpringRow>,
 }
 
 /// What the iterations achieved.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct NlgsReport {
+    /// Sweeps made.
     pub iterations: usize,
+    /// Value of the policy's norm after the last sweep (dimensionless; see
+    /// [`super::criterion::evaluate`]).
     pub criterion: f64,
+    /// Whether the last sweep met the tolerance (false when `max_iterations` was reached first).
     pub converged: bool,
 }
 

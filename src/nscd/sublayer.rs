@@ -43,7 +43,7 @@ pub struct Spring {
     pub nu: f64,
     /// Rest length `L0` (m).
     pub rest_length: f64,
-    /// Prestrain `ε0`.
+    /// Prestrain `ε0` (dimensionless), subtracted from the strain `(L − L0)/L0`.
     pub prestrain: f64,
     /// Only pushes (`R_N ≥ 0`).
     pub compression_only: bool,
@@ -54,17 +54,25 @@ pub struct Spring {
 /// The solver's record of one spring.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SpringRow {
+    /// Index of the body at the first end.
     pub a: u32,
     /// `u32::MAX` for a world anchor.
     pub b: u32,
+    /// Generalized axis direction at the first end, `(n_x, n_y, r_a × n)` (–, –, m), `n`
+    /// the unit axis from the second end to the first, at `q_m`.
     pub hn_a: [f64; 3],
+    /// Generalized axis direction at the second end, `(n_x, n_y, r_b × n)` (–, –, m); zero
+    /// lever arm for a world anchor.
     pub hn_b: [f64; 3],
+    /// Delassus scalar `w = h_n M⁻¹ h_n` of the row (1/kg): relative axial velocity per unit impulse.
     pub w: f64,
+    /// Impulse `P = h R` over the step (N·s), positive pushing the ends apart.
     pub p: f64,
     /// `h α` (N·s).
     pub h_alpha: f64,
     /// `h β` (N·s per m/s).
     pub h_beta: f64,
+    /// Clamp the impulse to `P ≥ 0` (unilateral support).
     pub compression_only: bool,
 }
 

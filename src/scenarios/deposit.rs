@@ -28,11 +28,14 @@ pub struct DepositSpec {
     pub width: f64,
     /// Grain density (kg/m³).
     pub density: f64,
-    /// Grain–grain and grain–wall friction.
+    /// Coulomb friction coefficient `μ` of grain–grain and grain–wall contacts (dimensionless).
     pub friction: f64,
+    /// Seed of the ChaCha8 generator of the grain order, lattice jitter, orientations
+    /// and initial velocities; recorded in the scene.
     pub seed: u64,
-    /// Time step (s) and duration (s) of the deposit run.
+    /// Time step of the deposit run (s).
     pub dt: f64,
+    /// Longest deposit (s): the run ends earlier at equilibrium.
     pub duration: f64,
 }
 

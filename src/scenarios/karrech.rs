@@ -35,25 +35,33 @@ use rand_distr::{Distribution, Normal};
 /// Parameters of a Karrech sample.
 #[derive(Debug, Clone, PartialEq)]
 pub struct KarrechSpec {
+    /// Number of spheres in the quarter sample ([`PAPER_SPHERES`] = 850 for the paper's).
     pub spheres: usize,
-    /// Mean and standard deviation (m) of the Gaussian of the radii, both > 0.
+    /// Mean of the Gaussian of the radii (m), > 0.
     pub radius_mean: f64,
+    /// Standard deviation of the radii (m); draws beyond mean ± 3 sd are redrawn.
     pub radius_sd: f64,
     /// Container radius (m).
     pub container_radius: f64,
+    /// Density of the spheres (kg/m³; diorite, 2710).
     pub density: f64,
+    /// Young's modulus `E` of the spheres (Pa; diorite, 46.9 GPa); the walls are steel.
     pub young: f64,
+    /// Poisson's ratio `ν` of the spheres (dimensionless, in (−1, 0.5)).
     pub poisson: f64,
+    /// Coulomb friction coefficient `μ` of sphere–sphere and sphere–wall contacts (dimensionless).
     pub friction: f64,
-    /// Damping ratios α_n = α_t.
+    /// Damping ratios α_n = α_t of eq. (7), `γ = 2 α √(m* k)` (dimensionless).
     pub alpha: f64,
-    /// Initial packing fraction of the loose placement.
+    /// Initial packing fraction of the loose placement (dimensionless, in (0, 1)).
     pub loose_fraction: f64,
+    /// Seed of the random radii and loose positions.
     pub seed: u64,
     /// Time step (s).
     pub dt: f64,
     /// Longest deposit (s); it ends earlier at `E_c/E_p ≤ energy_ratio`.
     pub duration: f64,
+    /// Equilibrium threshold on `E_c / E_p` (dimensionless; 10⁻⁶ in §2.3), held for 1000 steps.
     pub energy_ratio: f64,
 }
 

@@ -37,13 +37,19 @@ use rand_distr::{Distribution, Normal};
 pub struct LudingSpec {
     /// Number of spheres (343, 1000, 1728, 3375 in the paper: cubes).
     pub spheres: usize,
+    /// Coulomb friction coefficient `μ` of sphere–sphere contacts (dimensionless; the
+    /// walls are frictionless).
     pub friction: f64,
     /// Confining stress p₀ (Pa).
     pub p0: f64,
-    /// Amplitude Δσ (Pa) and period t₀ (s) of the cyclic stress.
+    /// Amplitude Δσ of the cyclic stress (Pa): `σ_xx` rises from p₀ to p₀ + Δσ at
+    /// half a period.
     pub amplitude: f64,
+    /// Period `t₀` of the cyclic stress (s).
     pub period: f64,
+    /// Time step (s); the paper's is 2·10⁻⁵ s.
     pub dt: f64,
+    /// Seed of the random sphere radii ([`radii`]).
     pub seed: u64,
 }
 

@@ -21,8 +21,11 @@ use rand_chacha::ChaCha8Rng;
 /// One sphere of a generated sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SphereSpec {
+    /// Radius (m), uniform in 4–6 mm.
     pub radius: f64,
+    /// Centre at the start (m), a lattice site.
     pub position: V3,
+    /// Initial velocity (m/s): horizontal components uniform in ±2.5 cm/s, vertical 0.
     pub velocity: V3,
 }
 
@@ -33,6 +36,7 @@ pub struct BedSpec {
     pub n: usize,
     /// Box side (m): 0.1 for N = 2000, 0.2 for N = 8000.
     pub side: f64,
+    /// Seed of the ChaCha8 generator of the radii and initial velocities.
     pub seed: u64,
 }
 

@@ -60,21 +60,32 @@ pub struct SampleSpec {
     pub bank: bool,
     /// With `bank`: extent of the sublayer and frame beyond the mould on each side (m).
     pub bank_margin: f64,
-    /// Sublayer pads: width and height (m), gap between neighbours (m).
+    /// Width of each sublayer pad (m) as asked; the pads are widened slightly so
+    /// that a whole number of them fills the frame.
     pub pad_width: f64,
+    /// Height of each sublayer pad (m); the pads' top faces are at `y = 0`.
     pub pad_height: f64,
+    /// Gap between neighbouring pads, and between the outer pads and the frame (m).
     pub pad_gap: f64,
     /// Rest length `L0` of the pad springs (m).
     pub spring_length: f64,
-    /// Law (17): force per unit strain `k_N` (N) and per unit strain rate `ν` (N·s).
+    /// Law (17): force per unit strain `k_N` of each pad spring (N), before
+    /// [`LoadingSpec::stiffness_factor`].
     pub k_n: f64,
+    /// Law (17): force per unit strain rate `ν` of each pad spring (N·s), the dashpot.
     pub nu: f64,
-    /// Grain density (kg/m³) and friction coefficient (all contacts).
+    /// Grain density (kg/m³; the out-of-plane thickness is 1 m).
     pub density: f64,
+    /// Coulomb friction coefficient `μ` of grain–grain and grain–pad contacts
+    /// (dimensionless; the side walls are smooth).
     pub friction: f64,
+    /// Seed of the random grading order, grain angles and initial velocities
+    /// (±0.02 m/s per component); recorded in the scene.
     pub seed: u64,
-    /// Time step (s) and longest deposit (s): the run stops at equilibrium before.
+    /// Time step of the deposit (s).
     pub dt: f64,
+    /// Longest deposit (s): the run stops earlier at equilibrium (kinetic energy below
+    /// 1e-11 J per grain for 500 steps).
     pub max_duration: f64,
 }
 
@@ -366,31 +377,45 @@ pub enum Guide {
 /// The loading stage.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoadingSpec {
-    /// Sleeper block: width and height (m), density (kg/m³, aluminium).
+    /// Width of the sleeper block (m).
     pub sleeper_width: f64,
+    /// Height of the sleeper block, bars excluded (m).
     pub sleeper_height: f64,
+    /// Density of the sleeper and its bars (kg/m³; 2700 for aluminium).
     pub sleeper_density: f64,
-    /// Square bars under the sleeper: side (m) and number (evenly spread, the
-    /// outer ones `bar_size` from the ends; 0: a flat sleeper).
+    /// Side of the square bars under the sleeper (m).
     pub bar_size: f64,
+    /// Number of bars, evenly spread, the outer ones `bar_size` in from the ends
+    /// (0: a flat sleeper).
     pub bars: usize,
-    /// `F = A + B cos(2π f t − φ)` (N, N, Hz, rad), A < 0 pushes down.
+    /// `A` of the load `F = A + B cos(2π f t − φ)` along the load direction (N);
+    /// `A < 0` pushes down.
     pub mean: f64,
+    /// `B`: amplitude of the load's cosine (N; the paper's `B = −500 N` with
+    /// `φ = −π` starts unloaded at `A − B` and peaks at `A + B`).
     pub amplitude: f64,
+    /// `f`: loading frequency (Hz); one cycle lasts `1/f` and the run lasts `cycles / f`.
     pub frequency: f64,
+    /// `φ`: phase of the load's cosine (rad).
     pub phase: f64,
     /// Angle of the load from the vertical (degrees, towards +x).
     pub inclination_deg: f64,
+    /// Which of the sleeper's degrees of freedom the loading frame holds.
     pub guide: Guide,
     /// Factor on the sublayer's `k_N` (1, 100, 1000 in §4.2).
     pub stiffness_factor: f64,
     /// Number of loading cycles.
     pub cycles: u64,
-    /// Time step (s), convergence policy, tolerance, sweep bounds.
+    /// Time step of the loading stage (s).
     pub dt: f64,
+    /// NLGS convergence policy by name: `strict`, `quad`, `quad_max` or `energy`
+    /// ([`crate::nscd::criterion`]).
     pub criterion: String,
+    /// Tolerance of the policy (dimensionless), in (0, 1).
     pub tolerance: f64,
+    /// Fewest NLGS sweeps per step (≥ 1).
     pub min_iterations: usize,
+    /// Most NLGS sweeps per step (≥ `min_iterations`); a step reaching it counts as not converged.
     pub max_iterations: usize,
     /// Steps between rows of `series.csv`.
     pub output_every: u64,
@@ -623,21 +648,35 @@ pub fn loaded_scene(sample: &Scene, spec: &LoadingSpec) -> Result<Scene> {
 /// What `sample.json` records about a deposited sample.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct SampleReport {
+    /// Seed of the sample scene.
     pub seed: u64,
+    /// Number of grains (bodies named `g…`).
     pub grains: usize,
-    /// Vertical balance over 20 steps at rest (N).
+    /// Total weight `Σ m |g|` of the non-fixed bodies (N), from the vertical
+    /// balance of the last of 20 steps at rest.
     pub weight_n: f64,
+    /// Upward force of the world-anchored sublayer springs on the pads (N).
     pub sublayer_reaction_n: f64,
+    /// Upward force of the fixed bodies through contacts whose normal is
+    /// closer to vertical than to horizontal (floors; N).
     pub floor_reaction_n: f64,
+    /// Upward force of the fixed bodies through the other contacts (side walls, by friction; N).
     pub wall_friction_n: f64,
     /// (springs + floors + walls − weight) / weight.
     pub balance_error: f64,
+    /// Mean overlap over the active contacts at the last of the 20 steps (m).
     pub mean_overlap_m: f64,
+    /// Largest overlap at the last of the 20 steps (m).
     pub max_overlap_m: f64,
-    /// Window of the solid fraction (m): x0, x1, y0, y1.
+    /// Window of the solid fraction (m): `[x0, x1, y0, y1]`, the middle half of
+    /// the layer's width, from one largest grain size above the pads' top (`y = 0`)
+    /// to one below the lowest surface point of that middle half.
     pub window_m: [f64; 4],
+    /// Solid fraction of the grains in `window_m` (dimensionless); NaN if the window is empty.
     pub solid_fraction: f64,
+    /// Mean number of force-carrying neighbours of the non-rattler grains.
     pub coordination: f64,
+    /// Fraction of the grains with fewer than 2 force-carrying neighbours (dimensionless).
     pub rattler_fraction: f64,
     /// Mean height of the layer's top surface above the sublayer (m).
     pub thickness_m: f64,

@@ -218,17 +218,34 @@ fn run_jobs(
 /// and cycles (NaN where the run left nothing).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunColumns {
+    /// Column `mean_iterations`: NLGS sweeps per step, mean over the run.
     pub mean_iterations: f64,
+    /// Column `mean_contacts`: contacts detected per step, mean over the run.
     pub mean_contacts: f64,
+    /// Column `wall_time_s`: wall-clock time spent stepping, over all invocations (s).
     pub wall_time_s: f64,
+    /// Column `wall_time_per_cycle_s`: wall-clock time per loading cycle (s).
     pub wall_time_per_cycle_s: f64,
+    /// Column `unconverged_steps`: steps whose NLGS hit `max_iterations` before the tolerance.
     pub unconverged_steps: u64,
+    /// Column `mean_overlap_m`: mean over the steps of the mean overlap of the active
+    /// contacts (m; Saussine et al. 2006, Fig. 4).
     pub mean_overlap_m: f64,
+    /// Column `max_overlap_m`: largest overlap of the run (m; Saussine et al. 2006, Fig. 3).
     pub max_overlap_m: f64,
+    /// Column `final_total_overlap_m`: sum of the overlaps of all contacts at the last
+    /// row of `series.csv` (m), the end of the cumulated interpenetration curve (Fig. 2).
     pub final_total_overlap_m: f64,
+    /// Column `cycles`: loading cycles completed (the last row of `cycles.csv`; 0 if none).
     pub cycles: u64,
+    /// Column `settlement_mean_m`: the sleeper's settlement averaged over the last
+    /// completed cycle (m, positive downwards; see
+    /// [`crate::io::cycles::NscdCycleRow::settlement_mean_m`]).
     pub settlement_mean_m: f64,
+    /// Column `settlement_at_min_load_m`: the sleeper's settlement at the smallest load of
+    /// the last completed cycle (m, positive downwards).
     pub settlement_at_min_load_m: f64,
+    /// Column `status`: `ok`, `failed: <error>`, or `failed in an earlier invocation`.
     pub status: String,
 }
 
@@ -445,9 +462,13 @@ pub fn steps(spec: &StepsSpec, study: &StudyOptions, display: &dyn RunDisplay) -
 /// Statistics over the samples of an ensemble.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Spread {
+    /// Arithmetic mean (unit of the values).
     pub mean: f64,
+    /// Sample standard deviation, divisor `n − 1` (unit of the values; 0 for one value).
     pub std: f64,
+    /// Smallest value.
     pub min: f64,
+    /// Largest value.
     pub max: f64,
 }
 
@@ -469,8 +490,9 @@ impl Spread {
 /// §4.2: samples that differ only by their seed, each on sublayers of several stiffnesses.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EnsembleSpec {
-    /// Number of samples, of seeds `first_seed`, `first_seed + 1`, …
+    /// Number of samples, of seeds `first_seed`, `first_seed + 1`, ….
     pub samples: u64,
+    /// Seed of the first sample.
     pub first_seed: u64,
     /// Factors on the sublayer stiffness k_N.
     pub factors: Vec<f64>,
@@ -593,13 +615,24 @@ pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisp
 /// stiffness at one cycle (m).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EnsembleRow {
+    /// Column `stiffness_factor`: the factor on the sublayer's `k_N` (dimensionless).
     pub stiffness_factor: f64,
+    /// Column `cycle`: the loading cycle (1 for the first).
     pub cycle: u64,
+    /// Column `samples`: the samples averaged, all those of this stiffness (the
+    /// table stops at the last cycle every one of their runs reached).
     pub samples: usize,
+    /// Column `settlement_mean_m`: mean over the samples of the cycle's mean settlement (m).
     pub settlement_mean_m: f64,
+    /// Column `settlement_std_m`: its sample standard deviation over the samples (m).
     pub settlement_std_m: f64,
+    /// Column `settlement_min_m`: its smallest value over the samples (m).
     pub settlement_min_m: f64,
+    /// Column `settlement_max_m`: its largest value over the samples (m).
     pub settlement_max_m: f64,
+    /// Column `settlement_at_min_load_mean_m`: mean over the samples of the settlement at
+    /// the cycle's smallest load (m).
     pub settlement_at_min_load_mean_m: f64,
+    /// Column `settlement_at_min_load_std_m`: its sample standard deviation over the samples (m).
     pub settlement_at_min_load_std_m: f64,
 }

@@ -20,10 +20,15 @@ use std::path::Path;
 /// (s) and Young's modulus (Pa).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Deposit {
+    /// Number of spheres in the quarter sample (850 for the paper's).
     pub spheres: usize,
+    /// Seed of the random radii and loose positions.
     pub seed: u64,
+    /// Time step (s).
     pub dt: f64,
+    /// Longest deposit (s): it ends earlier at `E_c / E_p ≤ 10⁻⁶`.
     pub duration: f64,
+    /// Young's modulus `E` of the spheres (Pa); Table 1's is 46.9 GPa.
     pub young: f64,
 }
 

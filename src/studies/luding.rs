@@ -22,9 +22,13 @@ use std::path::{Path, PathBuf};
 /// longest compression (s).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Compression {
+    /// Number of spheres `N` (343, 1000, 1728, 3375 in the paper).
     pub spheres: usize,
+    /// Coulomb friction coefficient `μ` of the sphere contacts (dimensionless).
     pub friction: f64,
+    /// Seed of the random sphere radii ([`crate::scenarios::luding::radii`]).
     pub seed: u64,
+    /// Longest compression (s): the run stops earlier at equilibrium.
     pub duration: f64,
 }
 
@@ -38,28 +42,43 @@ impl Default for Compression {
 /// One row of `loops.csv` (Pa, dimensionless).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LoopRow {
+    /// Column `time_s`: time of the `series.csv` row (s).
     pub time_s: f64,
+    /// Column `sigma_xx_pa`: `σ_xx`, mean of the forces pressing the two x walls over
+    /// the face area `L_y L_z` (Pa, positive in compression).
     pub sigma_xx_pa: f64,
+    /// Column `sigma_yy_pa`: `σ_yy`, the same for the two y walls over `L_x L_z` (Pa).
     pub sigma_yy_pa: f64,
+    /// Column `sigma_d_pa`: deviatoric stress `σ_D = 2 (σ_xx − σ_yy) / 3` (Pa; David et al. §3).
     pub sigma_d_pa: f64,
+    /// Column `epsilon_d`: deviatoric strain `ε_D = ε_xx − ε_yy`, `ε = 1 − L/L⁰` with `L⁰`
+    /// the box extents at the start of the cycled run (dimensionless, positive in compression).
     pub epsilon_d: f64,
 }
 
 /// One row of `strain.csv`: ε_D at the end of a cycle (the nearest row of `series.csv`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StrainRow {
+    /// Column `cycle`: the loading cycle (1 for the first).
     pub cycle: u64,
+    /// Column `time_s`: time of the `series.csv` row nearest the cycle's end `cycle × t₀` (s).
     pub time_s: f64,
+    /// Column `epsilon_n`: accumulated strain `ε_N`, the `ε_D` of that row (dimensionless).
     pub epsilon_n: f64,
 }
 
 /// One row of `compare.csv`: ε_N of a run at a cycle.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CompareRow {
+    /// Column `run`: the folder of the cycled run.
     pub run: String,
+    /// Column `spheres`: its number of spheres `N`.
     pub spheres: usize,
+    /// Column `friction`: its friction coefficient `μ` (dimensionless).
     pub friction: f64,
+    /// Column `cycle`: the loading cycle (1 for the first).
     pub cycle: u64,
+    /// Column `epsilon_n`: accumulated deviatoric strain `ε_N` at the end of that cycle (dimensionless).
     pub epsilon_n: f64,
 }
 

@@ -60,14 +60,18 @@ impl Stage {
 /// `<stem>.svg`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct StageOutcome {
+    /// The run of the stage's scene.
     pub run: RunOutcome,
+    /// What the stage wrote after the run: tables by file name, figures by stem.
     pub written: Vec<String>,
 }
 
 /// `spec.json`: what a first stage was made with, read by the stages after it.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct TestSpec {
+    /// Number of spheres of the sample.
     pub spheres: usize,
+    /// Seed the sample was generated with.
     pub seed: u64,
     /// Time step (s), Karrech.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -75,12 +79,13 @@ pub struct TestSpec {
     /// Young's modulus (Pa), Karrech.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub young: Option<f64>,
-    /// Friction coefficient, Luding.
+    /// Friction coefficient `μ` (dimensionless), Luding.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction: Option<f64>,
-    /// Loading period (s) and cycles, `luding cycle`.
+    /// Loading period `t₀` (s), `luding cycle`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub period: Option<f64>,
+    /// Loading cycles of a `luding cycle` run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cycles: Option<u32>,
 }

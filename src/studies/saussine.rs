@@ -40,11 +40,13 @@ pub struct Loading {
     pub stiffness_factor: f64,
     /// Time step (s).
     pub dt: f64,
-    /// Convergence policy (strict, quad, quad_max, energy) and its tolerance.
+    /// NLGS convergence policy by name: `strict`, `quad`, `quad_max` or `energy`.
     pub criterion: String,
+    /// Tolerance of the policy (dimensionless), in (0, 1).
     pub tolerance: f64,
-    /// Bounds on the NLGS sweeps of a step.
+    /// Fewest NLGS sweeps per step (≥ 1).
     pub min_iterations: usize,
+    /// Most NLGS sweeps per step; a step reaching it counts as not converged.
     pub max_iterations: usize,
     /// Square bars under the sleeper (0: a flat sleeper).
     pub bars: usize,
