@@ -1,10 +1,12 @@
 //! The noise floor of a deposit: the same NSCD scene run to its end (or its
 //! equilibrium) from starts perturbed by `PERTURBATION` (each mobile body moved
-//! by a random vector of that length, seeded), in the split NLGS order and in
-//! the plain one (`split_min_rows = 0`), so that a change of one number of a
-//! single run (steps to equilibrium, final overlap) can be told from chaos.
+//! by a random vector of that length, seeded), in the split NLGS order
+//! (`split`: every problem split), the plain one (`serial`: none) or the
+//! default (`default`: problems of 512 rows or more), so that a change of one
+//! number of a single run (steps to equilibrium, final overlap) can be told
+//! from chaos.
 //!
-//! `cargo run --release --example deposit_replicas -- SCENE OUT REPLICAS [serial|split] [FIRST]`
+//! `cargo run --release --example deposit_replicas -- SCENE OUT REPLICAS [serial|split|default] [FIRST]`
 //! writes `OUT/<order>-<i>/` for each replica and prints one CSV line per run
 //! (replica 0 is the unperturbed start).
 
@@ -19,21 +21,23 @@ const PERTURBATION: f64 = 1e-9;
 fn main() -> Result<(), ballast::Error> {
     let args: Vec<String> = std::env::args().collect();
     if args.len() < 4 {
-        eprintln!("usage: deposit_replicas SCENE OUT REPLICAS [serial|split] [FIRST]");
+        eprintln!("usage: deposit_replicas SCENE OUT REPLICAS [serial|split|default] [FIRST]");
         std::process::exit(2);
     }
     let scene = Scene::load(&args[1])?;
     let out = PathBuf::from(&args[2]);
     let replicas: usize = args[3].parse().expect("REPLICAS: a count");
-    let order = args.get(4).map(String::as_str).unwrap_or("split");
+    let order = args.get(4).map(String::as_str).unwrap_or("default");
     let first: usize = args.get(5).map(|s| s.parse().expect("FIRST: an index")).unwrap_or(0);
     println!(
         "order,replica,end,steps,time_s,final_max_overlap_m,run_max_overlap_m,unconverged_steps,mean_iterations,wall_s"
     );
     for i in first..first + replicas {
         let mut sys = scene.build()?;
-        if order == "serial" {
-            sys.params.nlgs.split_min_rows = 0;
+        match order {
+            "serial" => sys.params.nlgs.split_min_rows = 0,
+            "split" => sys.params.nlgs.split_min_rows = 1,
+            _ => {}
         }
         sys.set_threads(1);
         if i > 0 {

@@ -40,7 +40,7 @@ pub mod files {
     /// Seed, engine, version, steps.
     pub const RUN_INFO: &str = "run.json";
     /// Copy of the scene the run read (the file's text, or its serialised form
-    /// with a [`RunOptions::length`] applied).
+    /// with a [`super::RunOptions::length`] applied).
     pub const SCENE: &str = "scene.toml";
     /// Serde form of the initial system of a run built in code.
     pub const INITIAL_STATE: &str = "initial_state.json";
