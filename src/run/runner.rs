@@ -147,13 +147,15 @@ pub fn default_threads() -> usize {
 /// What the progress callback sees after each step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Progress {
-    /// Steps made by the engine, and the step the run ends at.
+    /// Steps made by the engine (counted from its step origin).
     pub step: u64,
+    /// The step the run ends at if no equilibrium stops it first.
     pub end_step: u64,
     /// Time at the end of the step (s).
     pub time: f64,
-    /// Kinetic energy (J) and contacts of the step.
+    /// Kinetic energy of the step (J).
     pub kinetic_energy: f64,
+    /// Contacts of the step (as [`crate::io::StepSummary::contacts`] counts them).
     pub contacts: f64,
     /// Loading cycles completed, and in the whole run.
     pub cycles: Option<(u64, u64)>,
@@ -173,9 +175,11 @@ pub enum Status {
 /// What a call of [`Runner::run`] did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOutcome {
+    /// Ended or stopped (to resume).
     pub status: Status,
-    /// Steps made by the engine and its time (s) at the end of the call.
+    /// Steps made by the engine at the end of the call.
     pub step: u64,
+    /// The engine's time at the end of the call (s).
     pub time: f64,
     /// The step the run ends at.
     pub end_step: u64,
