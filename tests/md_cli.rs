@@ -392,6 +392,5 @@ fn invalid_scenes_exit_with_code_2_and_one_line() {
         "law",
         "contact: no [[contact]] between materials 'diorite' and 'steel'",
     );
-    assert_refused(&text, &["--figures"], "figures", "--figures: not available for md runs");
     assert_refused(&text, &["--checkpoint-every", "nan"], "checkpoint", "--checkpoint-every");
 }
