@@ -79,7 +79,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             run.elapsed_s,
             run.elapsed_s / cycles as f64
         );
-        settlement.extend(settlement_series(&rows, &format!("k_N × {factor}")));
+        settlement.extend(settlement_series(&rows, &format!("k_N × {factor}"), 1e3));
     }
     let axes = Axes {
         title: "Sleeper settlement".into(),

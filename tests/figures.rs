@@ -186,9 +186,17 @@ fn adapters_read_the_engine_state() {
     assert_eq!(fixed, [true, false]);
     assert!(polygons.iter().all(|p| p.len() == 4));
     let lines = force_lines_of(&sys);
-    assert_eq!(lines.len(), 1, "the block's contact points make one line");
+    // The floor is fixed: one line from the block's centre to each contact point
+    // (its corners), not to the floor's centre.
+    assert_eq!(lines.len(), 2, "one line per contact point with the floor: {lines:?}");
+    let q = sys.bodies.q[1];
+    for l in &lines {
+        assert_eq!(l.from, [q[0], q[1]]);
+        assert!(l.to[1].abs() < 1e-6 && (l.to[0].abs() - 0.05).abs() < 1e-3, "a corner on the floor: {l:?}");
+    }
     let weight = 2700.0 * 0.1 * 0.1 * 9.81;
-    assert!((lines[0].normal_force - weight).abs() < 0.05 * weight, "{:?}", lines[0]);
+    let total: f64 = lines.iter().map(|l| l.normal_force).sum();
+    assert!((total - weight).abs() < 0.05 * weight, "{lines:?}");
     let dir = temp_dir("adapters");
     force_chains(&dir.join("block"), "Block on floor", &polygons, &fixed, &lines).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();

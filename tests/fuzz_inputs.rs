@@ -1282,13 +1282,19 @@ const FREE_LENGTH: &[&str] = &["snapshots", "system.ghosts.x", "system.ghosts.v"
 /// Keys with a serde default whose deletion may leave the same state: the
 /// clock origins (0 here, their default), the MD zero of the gravitational
 /// energy (0 in `md_box`: its base plane), the measurement period (1, its
-/// default), the work of the servo drives (state the run moves on with).
+/// default), the work of the servo drives (state the run moves on with), and
+/// what only the MD contact list reads (each contact's last force, the centres
+/// of the last evaluation), which the next step rewrites and the dynamics never
+/// read.
 const DEFAULTED: &[&str] = &[
     "system.time_origin",
     "system.step_origin",
     "system.gravity_reference",
     "system.drive_work",
     "system.measure_every",
+    "system.neighbours.hist[].force",
+    "system.wall_hist[].force",
+    "system.force_x",
 ];
 
 fn under(norm: &str, list: &[&str]) -> bool {

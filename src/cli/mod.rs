@@ -4,11 +4,13 @@
 //! of [`ballast::studies`].
 //!
 //! - `run`: a scene file of either engine ([`run`]);
+//! - `figures`: the figures of a finished run folder ([`figures`]);
 //! - `deposit`: the scene of a loose pentagon deposit ([`deposit`]);
 //! - `saussine …`: the experiments of Saussine et al. (2006) ([`saussine`]);
 //! - `karrech …`, `luding …`: the ready-made MD tests ([`md_tests`]).
 
 mod deposit;
+mod figures;
 mod md_tests;
 mod run;
 mod saussine;
@@ -33,6 +35,8 @@ struct Cli {
 enum Command {
     /// Runs a scene and writes its outputs to a directory.
     Run(run::RunArgs),
+    /// Draws the figures (PNG + SVG) of a finished run folder of either engine from its files.
+    Figures(figures::FiguresArgs),
     /// Writes the scene of a loose pentagon deposit with the Saussine et al. (2006)
     /// grading (circumradii 5, 7.5, 10 mm in the numbers 361 : 242 : 121), ready for `run`.
     Deposit(deposit::DepositArgs),
@@ -76,6 +80,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => run::main(args),
+        Command::Figures(args) => figures::main(args),
         Command::Deposit(args) => deposit::main(args),
         Command::Saussine(cmd) => saussine::main(cmd),
         Command::Karrech(cmd) => md_tests::karrech_main(cmd),

@@ -35,8 +35,10 @@ pub struct RunArgs {
     /// the machine has 2 cores.
     #[arg(long)]
     threads: Option<usize>,
-    /// At the end, draw the run's figures (PNG + SVG): settlement and interpenetration
-    /// curves, force chains, displacement field.
+    /// At the end, draw the run's figures (PNG + SVG), as `ballast figures DIR`
+    /// does: NSCD settlement and interpenetration curves, force chains,
+    /// displacement field; MD energies, coordination, overlaps, wall forces, plate
+    /// settlement, side view with contact forces.
     #[arg(long)]
     figures: bool,
     /// Simulated seconds to run instead of the scene's `[simulation] duration`

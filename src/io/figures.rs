@@ -6,17 +6,22 @@
 //! them from an NSCD [`System`]. What they draw, for the figures of Saussine et
 //! al. (2006):
 //!
-//! - [`line_chart`]: curves with a legend and optional shaded spreads, on linear or
-//!   logarithmic axes: settlement vs number of cycles (Figs. 6, 11, 12),
-//!   interpenetration vs time (Figs. 2–4), NLGS iterations vs tolerance (§3.2 tables);
+//! - [`line_chart`]: curves with a legend (below the plot, never over the data)
+//!   and optional shaded spreads, on linear or logarithmic axes: settlement vs
+//!   number of cycles (Figs. 6, 11, 12), interpenetration vs time (Figs. 2–4),
+//!   NLGS iterations vs tolerance (§3.2 tables); [`si_scale`] picks the unit
+//!   prefix that makes an axis's numbers plain;
 //! - [`force_chains`]: the grains with the normal forces as segments between the
-//!   centres of the bodies in contact, width proportional to the force (Figs. 8–10);
+//!   centres of the bodies in contact, or from a grain's centre to its contact
+//!   point with a wall, width proportional to the force (Figs. 8–10);
+//!   [`force_lines`] makes the segments from a contact list;
 //! - [`displacement_field`]: the grains with an arrow per grain from its earlier
 //!   centre, coloured by magnitude (Figs. 8–9).
 //!
 //! Non-finite values are skipped (and non-positive ones on a logarithmic axis); a
 //! figure with nothing to draw says "no data" instead of failing.
 
+use super::contacts::{ContactKind, ContactRow};
 use super::io_error;
 use crate::error::Result;
 use crate::nscd::System;
@@ -41,6 +46,8 @@ const MARGIN: u32 = 20;
 const X_LABEL_AREA: u32 = 60;
 const Y_LABEL_AREA: u32 = 100;
 const FOOTER: u32 = 50;
+/// Height of a row of the legend below a chart (px).
+const LEGEND_ROW: u32 = 30;
 /// Force chains (dark red, `#8B0000` in the SVG).
 const FORCE_COLOUR: RGBColor = RGBColor(0x8b, 0, 0);
 const GRAIN: RGBColor = RGBColor(215, 215, 215);
@@ -74,15 +81,21 @@ pub struct Series {
 /// Title, axis labels (with their SI units) and scales of a [`line_chart`].
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Axes {
+    /// Title above the chart.
     pub title: String,
+    /// Label of the horizontal axis, with its unit.
     pub x_label: String,
+    /// Label of the vertical axis, with its unit.
     pub y_label: String,
+    /// Logarithmic horizontal axis.
     pub log_x: bool,
+    /// Logarithmic vertical axis.
     pub log_y: bool,
 }
 
-/// A force chain segment of [`force_chains`]: between the centres (m) of two
-/// bodies in contact, with the normal force (N) between them.
+/// A force chain segment of [`force_chains`] (m, in the plane of the figure):
+/// between the centres of two bodies in contact, or from a body's centre to its
+/// contact point with a wall, with the normal force (N) it carries.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ForceLine {
     pub from: [f64; 2],
@@ -104,13 +117,27 @@ pub fn line_chart(stem: &Path, axes: &Axes, series: &[Series]) -> Result<()> {
 }
 
 /// A 2D sample: `polygons` (world coordinates, m) filled light grey, darker where
-/// `fixed[i]`; force chains as segments between the centres of the bodies in
-/// contact, whose width is proportional to the normal force (the largest is a third
-/// of the smallest free grain's equivalent diameter; forces below 1% of the largest
-/// are omitted); equal aspect ratio.
+/// `fixed[i]`; force chains as segments ([`ForceLine`]) whose width is
+/// proportional to the normal force (the largest is a fifth of the smallest free
+/// grain's equivalent diameter, at most 40 px; forces below 1% of the largest are
+/// omitted);
+/// equal aspect ratio; axes `x (m)` and `y (m)`.
 pub fn force_chains(
     stem: &Path,
     title: &str,
+    polygons: &[Vec<[f64; 2]>],
+    fixed: &[bool],
+    lines: &[ForceLine],
+) -> Result<()> {
+    force_chains_with_axes(stem, title, ["x (m)", "y (m)"], polygons, fixed, lines)
+}
+
+/// [`force_chains`] with other axis labels (`[horizontal, vertical]`, with their
+/// units): a projection of a 3D sample, say.
+pub fn force_chains_with_axes(
+    stem: &Path,
+    title: &str,
+    labels: [&str; 2],
     polygons: &[Vec<[f64; 2]>],
     fixed: &[bool],
     lines: &[ForceLine],
@@ -123,7 +150,8 @@ pub fn force_chains(
     let fmax = lines.iter().map(|l| l.normal_force).fold(0.0, f64::max);
     let lines: Vec<_> = lines.into_iter().filter(|l| l.normal_force >= 0.01 * fmax).collect();
     let extra: Vec<[f64; 2]> = lines.iter().flat_map(|l| [l.from, l.to]).collect();
-    let sample = Sample::new(title.to_string(), polygons, fixed, &extra, 0);
+    let mut sample = Sample::new(title.to_string(), polygons, fixed, &extra, 0);
+    sample.labels = labels.map(String::from);
     write_both(stem, &ForceChains { sample, lines, fmax })
 }
 
@@ -165,19 +193,61 @@ pub fn polygons_of(sys: &System) -> (Vec<Vec<[f64; 2]>>, Vec<bool>) {
     (polygons, fixed)
 }
 
-/// Force chain segments of the last step of `sys`: one per pair of bodies in
-/// contact, between their centres, with the sum of the normal forces `r_n` (N) of
-/// the pair's contact points.
+/// Force chain segments of the last step of `sys` ([`force_lines`] of its
+/// contact list): between the centres of two moving bodies, from a body's
+/// centre to its contact points with a fixed one.
 pub fn force_lines_of(sys: &System) -> Vec<ForceLine> {
-    let mut pairs = BTreeMap::<(usize, usize), f64>::new();
-    for c in sys.contact_forces() {
-        *pairs.entry((c.candidate, c.antagonist)).or_default() += c.r_n;
-    }
+    let rows = crate::run::Engine::contact_rows(sys);
     let q = &sys.bodies.q;
-    pairs
-        .into_iter()
-        .map(|((a, b), f)| ForceLine { from: [q[a][0], q[a][1]], to: [q[b][0], q[b][1]], normal_force: f })
-        .collect()
+    force_lines(&rows, |i| q.get(i).map(|q| [q[0], q[1], 0.0]), |p| [p[0], p[1]])
+}
+
+/// Force chain segments of a contact list ([`super::contacts`]), in the plane
+/// `project` maps a point (m) to: one per pair of moving bodies, between their
+/// centres (`centre` of a body index, m), with the sum of the normal forces (N)
+/// of the pair's contact points; one per contact with a wall, a fixed body or a
+/// symmetry image, from the body's centre to the contact point, with its normal
+/// force (so that a wall's forces are drawn where they act, not at its centre).
+/// Contacts whose body has no centre are left out.
+pub fn force_lines(
+    rows: &[ContactRow],
+    centre: impl Fn(usize) -> Option<[f64; 3]>,
+    project: impl Fn([f64; 3]) -> [f64; 2],
+) -> Vec<ForceLine> {
+    let mut pairs = BTreeMap::<(usize, usize), f64>::new();
+    let mut lines = Vec::new();
+    for r in rows {
+        match r.kind {
+            ContactKind::Pair => *pairs.entry((r.a, r.b)).or_default() += r.f_n,
+            ContactKind::Wall | ContactKind::Image => {
+                if let Some(c) = centre(r.a) {
+                    lines.push(ForceLine { from: project(c), to: project(r.point()), normal_force: r.f_n });
+                }
+            }
+        }
+    }
+    for ((a, b), f) in pairs {
+        if let (Some(ca), Some(cb)) = (centre(a), centre(b)) {
+            lines.push(ForceLine { from: project(ca), to: project(cb), normal_force: f });
+        }
+    }
+    lines
+}
+
+/// The SI prefix for values up to `max_abs` in `unit`: the factor to multiply
+/// them by and the prefixed unit, so that the largest is between 1 and 1000
+/// (`si_scale(2.3e-5, "m")` is `(1e6, "µm")`); `(1, unit)` for 0 or a non-finite
+/// value. From pico to giga.
+pub fn si_scale(max_abs: f64, unit: &str) -> (f64, String) {
+    const PREFIXES: [(&str, f64); 8] =
+        [("G", 1e9), ("M", 1e6), ("k", 1e3), ("", 1.0), ("m", 1e-3), ("µ", 1e-6), ("n", 1e-9), ("p", 1e-12)];
+    let a = max_abs.abs();
+    if !(a.is_finite() && a > 0.0) {
+        return (1.0, unit.to_string());
+    }
+    // The largest prefix not above the value (the smallest one below a pico).
+    let (p, s) = PREFIXES.iter().find(|(_, s)| a >= *s * (1.0 - 1e-12)).unwrap_or(&PREFIXES[PREFIXES.len() - 1]);
+    (1.0 / s, format!("{p}{unit}"))
 }
 
 type DrawError = Box<dyn std::error::Error>;
@@ -333,24 +403,35 @@ impl LineChart<'_> {
             }
             let points: Vec<_> = s.points.iter().copied().filter(|p| self.ok(p.0, p.1)).collect();
             let line = colour.stroke_width(3);
-            let drawn = chart.draw_series(std::iter::once(PathElement::new(points.clone(), line)))?;
-            if !s.label.is_empty() {
-                drawn.label(&s.label).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], line));
-            }
+            chart.draw_series(std::iter::once(PathElement::new(points.clone(), line)))?;
             if points.len() <= 40 {
                 chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))?;
             }
         }
-        if self.series.iter().any(|s| !s.label.is_empty()) {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .label_font(font(20))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()?;
-        }
         Ok(())
+    }
+
+    /// The legend entries (series index, label) laid out in rows below the plot:
+    /// each entry's left edge (px from the plot's left edge) and row; and the
+    /// number of rows, for `width` px.
+    fn legend_layout<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        width: u32,
+    ) -> (Vec<(usize, i32, u32)>, u32) {
+        let (sample, gap) = (36, 30);
+        let (mut x, mut row, mut out) = (0i32, 0u32, Vec::new());
+        for (k, s) in self.series.iter().enumerate().filter(|(_, s)| !s.label.is_empty()) {
+            let text = area.estimate_text_size(&s.label, &font(20)).map_or(12 * s.label.len() as u32, |e| e.0);
+            let w = (sample + text) as i32;
+            if x > 0 && x + w > width as i32 {
+                (x, row) = (0, row + 1);
+            }
+            out.push((k, x, row));
+            x += w + gap;
+        }
+        let rows = if out.is_empty() { 0 } else { row + 1 };
+        (out, rows)
     }
 }
 
@@ -371,6 +452,20 @@ impl Figure for LineChart<'_> {
         let all: Vec<_> = self.series.iter().flat_map(valid).collect();
         let (xr, any) = range(all.iter().map(|p| p.0), a.log_x);
         let (yr, _) = range(all.iter().flat_map(|p| [p.1, p.2]), a.log_y);
+        // The legend goes below the plot, in rows as wide as the plot.
+        let (w, h) = root.dim_in_pixel();
+        let left = (MARGIN + Y_LABEL_AREA) as i32;
+        let (entries, rows) = self.legend_layout(root, w.saturating_sub(2 * MARGIN + Y_LABEL_AREA));
+        let legend_h = if rows > 0 { rows * LEGEND_ROW + 10 } else { 0 };
+        let (plot, legend) = root.split_vertically(h.saturating_sub(legend_h));
+        for (k, x, row) in entries {
+            let colour = PALETTE[k % PALETTE.len()];
+            let y = (row * LEGEND_ROW + LEGEND_ROW / 2) as i32;
+            legend.draw(&PathElement::new(vec![(left + x, y), (left + x + 28, y)], colour.stroke_width(3)))?;
+            let style = font(20).pos(Pos::new(HPos::Left, VPos::Center));
+            legend.draw(&Text::new(self.series[k].label.clone(), (left + x + 36, y), style))?;
+        }
+        let root = &plot;
         let mut b = ChartBuilder::on(root);
         b.caption(&a.title, font(30)).margin(MARGIN).x_label_area_size(X_LABEL_AREA).y_label_area_size(Y_LABEL_AREA);
         let spans = (if a.log_x { 0.0 } else { xr.end - xr.start }, if a.log_y { 0.0 } else { yr.end - yr.start });
@@ -390,6 +485,8 @@ impl Figure for LineChart<'_> {
 /// The grains of a sample figure and its world bounding box.
 struct Sample {
     title: String,
+    /// Axis labels, horizontal and vertical, with their units.
+    labels: [String; 2],
     polygons: Vec<(Vec<(f64, f64)>, bool)>,
     /// `(x0, y0, x1, y1)` (m), `None` when there is nothing to draw.
     bbox: Option<[f64; 4]>,
@@ -412,7 +509,7 @@ impl Sample {
         let bbox = points.fold(None, |b: Option<[f64; 4]>, (x, y)| {
             Some(b.map_or([x, y, x, y], |b| [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)]))
         });
-        Self { title, polygons, bbox, footer }
+        Self { title, labels: ["x (m)".into(), "y (m)".into()], polygons, bbox, footer }
     }
 
     /// The box with a 3% margin, never flat.
@@ -459,8 +556,8 @@ impl Sample {
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_desc("x (m)")
-            .y_desc("y (m)")
+            .x_desc(&self.labels[0])
+            .y_desc(&self.labels[1])
             .x_label_formatter(&fmt)
             .y_label_formatter(&fmt)
             .label_style(font(18))
@@ -507,7 +604,7 @@ impl Figure for ForceChains {
         } else {
             self.sample.polygons.iter().map(|p| diameter(&p.0)).fold(f64::INFINITY, f64::min)
         };
-        let max_width = if d.is_finite() && d > 0.0 { (d * s / 3.0).clamp(1.0, 100.0) } else { 4.0 };
+        let max_width = if d.is_finite() && d > 0.0 { (d * s / 5.0).clamp(1.0, 40.0) } else { 4.0 };
         chart.draw_series(self.lines.iter().map(|l| {
             let w = (max_width * l.normal_force / self.fmax).round().max(1.0) as u32;
             PathElement::new(vec![(l.from[0], l.from[1]), (l.to[0], l.to[1])], FORCE_COLOUR.stroke_width(w))

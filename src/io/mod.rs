@@ -7,6 +7,8 @@
 //!   with `output.cycles.positions` the positions of every mobile body at each
 //!   cycle end ([`positions`]);
 //! - `final.json`: the state of every body (and wall) at the end ([`FinalState`]);
+//! - `contacts.csv`: every contact at the end with its point, normal and forces
+//!   ([`contacts`]);
 //! - `summary.json`: wall time and speed, mean contacts, overlaps, NLGS
 //!   iterations ([`summary::RunReport`]);
 //! - `scene.toml`: a copy of the input scene (the text the run read), or
@@ -18,15 +20,18 @@
 //! - with `--vtk-every N`: `vtk/*.vtp` and `run.pvd`, snapshots that ParaView
 //!   opens and animates ([`vtk`]);
 //! - figures as `<stem>.png` + `<stem>.svg`: curves, force chains, displacement
-//!   fields ([`figures`], [`run_figures`]).
+//!   fields ([`figures`]), those of a run drawn from its folder alone
+//!   ([`run_figures`], [`md_figures`]).
 //!
 //! CSV goes through `csv` and serde row types, JSON through `serde_json`. Every
 //! I/O error names the file it happened on.
 
 pub mod checkpoint;
+pub mod contacts;
 pub mod cycles;
 pub mod figures;
 pub mod final_state;
+pub mod md_figures;
 pub mod positions;
 pub mod run_figures;
 pub mod series;

@@ -1,24 +1,107 @@
-//! The figures of one run, drawn from its output folder and its final state
-//! (`ballast run --figures`, the Saussine studies, the example):
+//! The figures of one finished run, drawn from its output folder alone (`ballast
+//! figures DIR`, and `ballast run --figures` at the end of a run; the Saussine
+//! studies and the example too): [`draw_run_figures`] reads the engine from
+//! `final.json` and draws, as `<stem>.png` + `<stem>.svg` in the folder,
 //!
-//! - `settlement.{png,svg}`: the followed body's settlement vs cycles, mean over
-//!   each cycle and at the load minimum (from `cycles.csv`; Saussine et al. 2006,
+//! NSCD ([`nscd_figures`]):
+//! - `settlement`: the followed body's settlement vs cycles, mean over each
+//!   cycle and at the load minimum (from `cycles.csv`; Saussine et al. 2006,
 //!   Figs. 6, 11);
-//! - `interpenetration.{png,svg}`: mean and max overlap vs time (from
-//!   `series.csv`; Figs. 3–4);
-//! - `force_chains.{png,svg}`: the final state with the normal forces of its last
-//!   step (Figs. 8–10);
-//! - `displacements.{png,svg}`: the grains' displacements from the end of the
-//!   first cycle to the end of the run (Figs. 8–9), when that state is known.
+//! - `interpenetration`: mean and max overlap vs time (from `series.csv`;
+//!   Figs. 3–4), in the length unit that makes the numbers plain;
+//! - `force_chains`: the final state (the shapes from the copy of the scene,
+//!   `scene.toml`, or `initial_state.json` for a system built in code; the
+//!   positions from `final.json`) with the normal forces of the last step (from
+//!   `contacts.csv`; Figs. 8–10);
+//! - `displacements`: the grains' displacements from the end of the first cycle
+//!   to the end of the run (Figs. 8–9), when that state is known (the positions
+//!   files of `output.cycles.positions`, or the run loop's own record);
+//!
+//! MD: see [`super::md_figures`].
+//!
+//! A figure whose data the folder does not hold (no cycles, an older run
+//! without `contacts.csv`) is skipped and said so in [`RunFigures::skipped`].
 
+use super::contacts;
 use super::figures::{self, Arrow, Axes, Series};
-use crate::error::Result;
+use super::final_state::FinalState;
+use crate::error::{Error, Result};
 use crate::nscd::System;
+use crate::run::files;
 use std::path::{Path, PathBuf};
 
-/// Series of a settlement curve in millimetres, from `cycles.csv` rows.
-pub fn settlement_series(rows: &[super::cycles::NscdCycleRow], label: &str) -> [Series; 2] {
-    let pick = |f: fn(&super::cycles::NscdCycleRow) -> f64| rows.iter().map(|r| (r.cycle as f64, 1e3 * f(r))).collect();
+/// What [`draw_run_figures`] did.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RunFigures {
+    /// The stems written (each as `<stem>.png` and `<stem>.svg`).
+    pub written: Vec<PathBuf>,
+    /// The figures not drawn, by stem, and why.
+    pub skipped: Vec<(String, String)>,
+}
+
+impl RunFigures {
+    /// Records `stem` as written.
+    pub(crate) fn wrote(&mut self, stem: PathBuf) {
+        self.written.push(stem);
+    }
+
+    /// Records `stem` as skipped for `why`.
+    pub(crate) fn skip(&mut self, stem: &str, why: &str) {
+        self.skipped.push((stem.to_string(), why.to_string()));
+    }
+}
+
+/// Draws the figures of the finished run in `dir`, of either engine, from its
+/// files (see the module documentation and [`super::md_figures`]).
+///
+/// # Errors
+/// [`Error::Scene`] naming the folder and the missing file if `dir` is not the
+/// folder of a finished run (no `final.json` or `series.csv`, or for NSCD
+/// neither `scene.toml` nor `initial_state.json`), or if a file does not fit
+/// the others; [`Error::Io`] naming the file if one cannot be read or a figure
+/// written.
+pub fn draw_run_figures(dir: &Path) -> Result<RunFigures> {
+    let fin = read_final(dir)?;
+    match fin.engine.as_str() {
+        "nscd" => nscd_figures(dir, None),
+        "md" => super::md_figures::md_figures(dir),
+        other => Err(Error::Scene(format!("{}: unknown engine '{other}'", dir.join(files::FINAL).display()))),
+    }
+}
+
+/// The path of `dir/name`, which must exist.
+pub(crate) fn require(dir: &Path, name: &str) -> Result<PathBuf> {
+    if !dir.is_dir() {
+        return Err(Error::Scene(format!("'{}' is not a folder", dir.display())));
+    }
+    let path = dir.join(name);
+    if path.is_file() {
+        Ok(path)
+    } else {
+        Err(Error::Scene(format!("'{}' is not the folder of a finished run: it has no {name}", dir.display())))
+    }
+}
+
+/// `dir/final.json`, which must exist.
+pub(crate) fn read_final(dir: &Path) -> Result<FinalState> {
+    FinalState::read(&require(dir, files::FINAL)?)
+}
+
+/// Reads `dir/contacts.csv` if it exists (`None` for a run older than the file).
+pub(crate) fn read_contacts(dir: &Path) -> Result<Option<Vec<contacts::ContactRow>>> {
+    let path = dir.join(files::CONTACTS);
+    if path.is_file() {
+        Ok(Some(contacts::read(&path)?))
+    } else {
+        Ok(None)
+    }
+}
+
+/// Series of a settlement curve from `cycles.csv` rows, multiplied by `scale`
+/// (1e3 for millimetres, or from [`figures::si_scale`]).
+pub fn settlement_series(rows: &[super::cycles::NscdCycleRow], label: &str, scale: f64) -> [Series; 2] {
+    let pick =
+        |f: fn(&super::cycles::NscdCycleRow) -> f64| rows.iter().map(|r| (r.cycle as f64, scale * f(r))).collect();
     let sep = if label.is_empty() { "" } else { ", " };
     [
         Series {
@@ -44,57 +127,151 @@ pub fn displacement_arrows(q0: &[[f64; 3]], sys: &System) -> Vec<Arrow> {
         .collect()
 }
 
-/// Writes the figures of the run in `dir` (see the module doc); `first_cycle_q` are
-/// the positions at the end of the first cycle, if known. Returns the stems written.
-pub fn write_run_figures(dir: &Path, sys: &System, first_cycle_q: Option<&[[f64; 3]]>) -> Result<Vec<PathBuf>> {
-    let mut written = Vec::new();
-    let cycles_path = dir.join("cycles.csv");
-    if cycles_path.exists() {
+/// The largest absolute value of `v` (finite ones only; 0 if none).
+pub(crate) fn max_abs(v: impl Iterator<Item = f64>) -> f64 {
+    v.filter(|x| x.is_finite()).fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// The NSCD system of the run in `dir` at its end: the bodies of `scene.toml`
+/// (or of `initial_state.json`) moved to their positions in `fin`.
+fn nscd_final_system(dir: &Path, fin: &FinalState) -> Result<System> {
+    #[derive(serde::Deserialize)]
+    struct Input {
+        system: System,
+    }
+    let (scene, initial) = (dir.join(files::SCENE), dir.join(files::INITIAL_STATE));
+    let (mut sys, source) = if scene.is_file() {
+        (crate::scene::Scene::load(&scene)?.build()?, scene)
+    } else if initial.is_file() {
+        (super::read_json::<Input>(&initial)?.system, initial)
+    } else {
+        return Err(Error::Scene(format!(
+            "'{}' is not the folder of a finished run: it has neither {} nor {} (the shapes of the bodies)",
+            dir.display(),
+            files::SCENE,
+            files::INITIAL_STATE
+        )));
+    };
+    if fin.bodies.len() != sys.bodies.len() {
+        return Err(Error::Scene(format!(
+            "{} has {} bodies, {} has {}",
+            dir.join(files::FINAL).display(),
+            fin.bodies.len(),
+            source.display(),
+            sys.bodies.len()
+        )));
+    }
+    for (q, b) in sys.bodies.q.iter_mut().zip(&fin.bodies) {
+        if let [x, y] = b.position[..] {
+            *q = [x, y, b.angle.unwrap_or(q[2])];
+        }
+    }
+    sys.time = fin.time;
+    Ok(sys)
+}
+
+/// The positions `(x, y, θ)` of every body at the end of the first cycle from
+/// the positions files of the run in `dir`, if it has them (the other bodies,
+/// fixed, where `sys` has them).
+fn first_cycle_from_files(dir: &Path, sys: &System) -> Result<Option<Vec<[f64; 3]>>> {
+    if !dir.join(super::positions::DISPLACEMENTS_FILE).is_file() {
+        return Ok(None);
+    }
+    let positions = super::positions::read(dir)?;
+    let Some(first) = positions.cycles.first().filter(|c| c.dof == 3) else { return Ok(None) };
+    let mut q = sys.bodies.q.clone();
+    for (k, &i) in first.bodies.iter().enumerate() {
+        if let Some(qi) = q.get_mut(i) {
+            qi.copy_from_slice(first.body(k));
+        }
+    }
+    Ok(Some(q))
+}
+
+/// Draws the NSCD figures of the run in `dir` (see the module documentation);
+/// `first_cycle_q` are the positions of every body at the end of the first
+/// cycle if the caller knows them (else they are read from the positions files,
+/// if any).
+///
+/// # Errors
+/// As [`draw_run_figures`].
+pub fn nscd_figures(dir: &Path, first_cycle_q: Option<&[[f64; 3]]>) -> Result<RunFigures> {
+    let fin = read_final(dir)?;
+    let series_path = require(dir, files::SERIES)?;
+    let mut out = RunFigures::default();
+    let cycles_path = dir.join(files::CYCLES);
+    if cycles_path.is_file() {
         let rows = super::cycles::read_nscd(&cycles_path)?;
+        let m = max_abs(rows.iter().flat_map(|r| [r.settlement_mean_m, r.settlement_at_min_load_m]));
+        let (scale, unit) = figures::si_scale(m.max(1e-6), "m");
         let stem = dir.join("settlement");
         let axes = Axes {
             title: "Settlement of the sleeper".into(),
             x_label: "cycles".into(),
-            y_label: "settlement (mm)".into(),
+            y_label: format!("settlement ({unit})"),
             ..Axes::default()
         };
-        figures::line_chart(&stem, &axes, &settlement_series(&rows, ""))?;
-        written.push(stem);
+        figures::line_chart(&stem, &axes, &settlement_series(&rows, "", scale))?;
+        out.wrote(stem);
+    } else {
+        out.skip("settlement", "no cycles.csv (the run had no loading cycles)");
     }
-    let series_path = dir.join("series.csv");
-    if series_path.exists() {
-        let rows = super::series::read_nscd(&series_path)?;
-        let pick = |f: fn(&super::series::NscdSeriesRow) -> f64| rows.iter().map(|r| (r.time_s, 1e6 * f(r))).collect();
-        let stem = dir.join("interpenetration");
-        let axes = Axes {
-            title: "Interpenetration".into(),
-            x_label: "time (s)".into(),
-            y_label: "overlap (µm)".into(),
-            ..Axes::default()
-        };
-        let curves = [
-            Series { label: "mean over the active contacts".into(), points: pick(|r| r.mean_overlap_m), band: vec![] },
-            Series { label: "max".into(), points: pick(|r| r.max_overlap_m), band: vec![] },
-        ];
-        figures::line_chart(&stem, &axes, &curves)?;
-        written.push(stem);
+    let rows = super::series::read_nscd(&series_path)?;
+    // A run without overlaps (or contacts) still gets an axis in µm.
+    let (scale, unit) = figures::si_scale(max_abs(rows.iter().map(|r| r.max_overlap_m)).max(1e-12), "m");
+    let pick = |f: fn(&super::series::NscdSeriesRow) -> f64| rows.iter().map(|r| (r.time_s, scale * f(r))).collect();
+    let stem = dir.join("interpenetration");
+    let axes = Axes {
+        title: "Interpenetration".into(),
+        x_label: "time (s)".into(),
+        y_label: format!("overlap ({unit})"),
+        ..Axes::default()
+    };
+    let curves = [
+        Series { label: "mean over the active contacts".into(), points: pick(|r| r.mean_overlap_m), band: vec![] },
+        Series { label: "max".into(), points: pick(|r| r.max_overlap_m), band: vec![] },
+    ];
+    figures::line_chart(&stem, &axes, &curves)?;
+    out.wrote(stem);
+    let sys = nscd_final_system(dir, &fin)?;
+    let (polygons, fixed) = figures::polygons_of(&sys);
+    match read_contacts(dir)? {
+        Some(rows) => {
+            let q = &sys.bodies.q;
+            let lines = figures::force_lines(&rows, |i| q.get(i).map(|q| [q[0], q[1], 0.0]), |p| [p[0], p[1]]);
+            let stem = dir.join("force_chains");
+            let title = format!("Force chains at t = {:.3} s (line width ∝ normal force)", fin.time);
+            figures::force_chains(&stem, &title, &polygons, &fixed, &lines)?;
+            out.wrote(stem);
+        }
+        None => out.skip("force_chains", "no contacts.csv (a run of an older version)"),
     }
-    let (polygons, fixed) = figures::polygons_of(sys);
-    let stem = dir.join("force_chains");
-    let title = format!("Force chains at t = {:.3} s (line width ∝ normal force)", sys.time);
-    figures::force_chains(&stem, &title, &polygons, &fixed, &figures::force_lines_of(sys))?;
-    written.push(stem);
-    if let Some(q0) = first_cycle_q.filter(|q| q.len() == sys.bodies.len()) {
-        let arrows = displacement_arrows(q0, sys);
-        // Arrows of the largest displacement drawn a tenth of the sample's width.
-        let xs = sys.bodies.q.iter().map(|q| q[0]);
-        let width = xs.clone().fold(f64::NEG_INFINITY, f64::max) - xs.fold(f64::INFINITY, f64::min);
-        let umax = arrows.iter().map(|a| a.displacement[0].hypot(a.displacement[1])).fold(0.0, f64::max);
-        let scale = if umax > 0.0 && width > 0.0 { 0.1 * width / umax } else { 1.0 };
-        let stem = dir.join("displacements");
-        let title = format!("Grain displacements from the end of cycle 1 to t = {:.3} s", sys.time);
-        figures::displacement_field(&stem, &title, &polygons, &fixed, &arrows, scale)?;
-        written.push(stem);
+    let from_files;
+    let first = match first_cycle_q {
+        Some(q) => Some(q),
+        None => {
+            from_files = first_cycle_from_files(dir, &sys)?;
+            from_files.as_deref()
+        }
+    };
+    match first.filter(|q| q.len() == sys.bodies.len()) {
+        Some(q0) => {
+            let arrows = displacement_arrows(q0, &sys);
+            // Arrows of the largest displacement drawn a tenth of the sample's width.
+            let xs = sys.bodies.q.iter().map(|q| q[0]);
+            let width = xs.clone().fold(f64::NEG_INFINITY, f64::max) - xs.fold(f64::INFINITY, f64::min);
+            let umax = arrows.iter().map(|a| a.displacement[0].hypot(a.displacement[1])).fold(0.0, f64::max);
+            let scale = if umax > 0.0 && width > 0.0 { 0.1 * width / umax } else { 1.0 };
+            let stem = dir.join("displacements");
+            let title = format!("Grain displacements from the end of cycle 1 to t = {:.3} s", fin.time);
+            figures::displacement_field(&stem, &title, &polygons, &fixed, &arrows, scale)?;
+            out.wrote(stem);
+        }
+        None => out.skip(
+            "displacements",
+            "the positions at the end of the first cycle are not known (no cycle ended, or no \
+             output.cycles.positions)",
+        ),
     }
-    Ok(written)
+    Ok(out)
 }

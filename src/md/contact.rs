@@ -27,6 +27,12 @@ pub struct History {
     pub delta: f64,
     /// `linear`: 1 while sliding (dynamic friction), 0 while sticking.
     pub sliding: u32,
+    /// The whole contact force on the first body at the last evaluation (N),
+    /// normal and tangential, dashpots included: what the step applied, kept for
+    /// the contact list ([`crate::md::MdSystem::contact_forces`]); zero when not
+    /// touching. Not read by the dynamics.
+    #[serde(default)]
+    pub force: V3,
 }
 
 impl History {

@@ -9,9 +9,11 @@
 //! the default of [`MdSystem`]), so that the largest overlap of `summary.json`
 //! is that of the whole run and the equilibrium rule sees every step.
 
+use super::contacts::MdContactKind;
 use super::system::{MdStepStats, MdSystem};
 use super::walls::Motion;
 use crate::error::{Error, Result};
+use crate::io::contacts::{ContactKind, ContactRow};
 use crate::io::cycles::{MdCycleRow, MdCycleState, MD_CYCLE_COLUMNS};
 use crate::io::final_state::{BodyState, FinalState, Spin, WallState};
 use crate::io::series::{MdSeriesRow, MD_SERIES_COLUMNS};
@@ -128,6 +130,40 @@ impl Engine for MdSystem {
             .map(|w| WallState { name: w.name.clone(), displacement: w.s, force: w.force.into() })
             .collect();
         FinalState { engine: Self::NAME.into(), time: self.time, step: self.step, bodies, walls }
+    }
+
+    /// One row per contact of [`MdSystem::contact_forces`]: `pair`, `image` (`b`
+    /// the imaged sphere) or `wall` (`b` the wall's index among the walls).
+    fn contact_rows(&self) -> Vec<ContactRow> {
+        let name = |i: usize| self.particles.name[i].clone();
+        self.contact_forces()
+            .into_iter()
+            .map(|c| {
+                let (kind, b, b_name) = match c.kind {
+                    MdContactKind::Pair { j } => (ContactKind::Pair, j, name(j)),
+                    MdContactKind::Image { origin, .. } => (ContactKind::Image, origin, name(origin)),
+                    MdContactKind::Wall { wall } => (ContactKind::Wall, wall, self.walls[wall].name.clone()),
+                };
+                ContactRow {
+                    kind,
+                    a: c.sphere,
+                    a_name: name(c.sphere),
+                    b,
+                    b_name,
+                    point_x_m: c.point[0],
+                    point_y_m: c.point[1],
+                    point_z_m: Some(c.point[2]),
+                    normal_x: c.normal[0],
+                    normal_y: c.normal[1],
+                    normal_z: Some(c.normal[2]),
+                    gap_m: -c.overlap,
+                    f_n: c.f_n,
+                    f_t_x: c.f_t[0],
+                    f_t_y: c.f_t[1],
+                    f_t_z: Some(c.f_t[2]),
+                }
+            })
+            .collect()
     }
 
     fn snapshot(&self, dir: &Path, pvd: &mut PvdCollection) -> Result<()> {

@@ -108,6 +108,18 @@ impl Ghosts {
         }
     }
 
+    /// The centre of image `g` for its original at `x` (m): `x` mirrored through
+    /// the image's planes in order, the same operations as [`Ghosts::update`].
+    pub fn image_of(&self, g: usize, x: &V3) -> V3 {
+        let mut x = *x;
+        for (s, plane) in self.planes.iter().enumerate() {
+            if self.mask[g] & (1 << s) != 0 {
+                x = plane.mirror_point(&x);
+            }
+        }
+        x
+    }
+
     /// Mirrors the current state of the originals into the images.
     pub fn update(&mut self, p: &Particles) {
         let n = self.len();

@@ -12,6 +12,7 @@
 //! into the papers' quantities.
 
 pub mod contact;
+pub mod contacts;
 pub mod engine;
 pub mod ghosts;
 pub mod integrator;
@@ -22,6 +23,7 @@ pub mod particles;
 pub mod system;
 pub mod walls;
 
+pub use contacts::{MdContactInfo, MdContactKind};
 pub use ghosts::{Ghosts, SymmetryPlane};
 pub use integrator::{GearSet, Integrator};
 pub use law::{Damping, LawTable, Material, Model, PairLaw};

@@ -183,6 +183,7 @@ struct Backup {
     hist: Vec<History>,
     x_build: Vec<V3>,
     builds: u64,
+    force_x: Vec<V3>,
     ghost_origin: Vec<u32>,
     ghost_mask: Vec<u32>,
     ghost_key: Vec<u64>,
@@ -282,7 +283,15 @@ pub struct MdSystem {
     /// Contact memory of the sphere–wall contacts, sphere by sphere: entry
     /// `i · walls + k` for sphere `i` and wall `k`.
     #[serde(default)]
-    wall_hist: Vec<History>,
+    pub(super) wall_hist: Vec<History>,
+    /// Centres of the spheres at the last force evaluation when they are not
+    /// `particles.x`: with a Gear integrator whose corrector moves the centres
+    /// (`gear4` to `gear6`), the predicted centres; empty otherwise (velocity
+    /// Verlet drifts before the evaluation, Karrech's and `gear3`'s corrector
+    /// leaves the positions) and after the derived state is rebuilt. Read only by
+    /// the contact list ([`MdSystem::contact_forces`]).
+    #[serde(default)]
+    pub(super) force_x: Vec<V3>,
     #[serde(skip)]
     threads: usize,
     #[serde(skip)]
@@ -324,6 +333,7 @@ impl MdSystem {
             measure_every: 1,
             gravity_reference: 0.0,
             wall_hist: Vec::new(),
+            force_x: Vec::new(),
             threads: 1,
             team: Team::default(),
             work: Vec::new(),
@@ -605,7 +615,7 @@ impl MdSystem {
         if let Some(i) = (0..n).find(|&i| p.material[i] as usize >= self.laws.n) {
             return bad(format!("sphere {i}: material {} of {}", p.material[i], self.laws.n));
         }
-        if self.laws.laws.len() != self.laws.n * self.laws.n {
+        if self.laws.n.checked_mul(self.laws.n) != Some(self.laws.laws.len()) {
             return bad(format!("{} laws for {} materials", self.laws.laws.len(), self.laws.n));
         }
         let gear = matches!(self.settings.integrator, Integrator::Gear(_));
@@ -616,6 +626,9 @@ impl MdSystem {
         // The corrector leaves the position in the first Gear row.
         if let Some(i) = (0..self.gear_x.len()).find(|&i| !same_bits(&self.gear_x[i][0], &p.x[i])) {
             return bad(format!("sphere {i}: the Gear position is not the sphere's"));
+        }
+        if !self.force_x.is_empty() && self.force_x.len() != n {
+            return bad(format!("centres of the last force evaluation: {} for {n} spheres", self.force_x.len()));
         }
         let nw = self.walls.len();
         if self.wall_hist.len() != n * nw {
@@ -763,6 +776,7 @@ impl MdSystem {
         b.hist.clone_from(&nb.hist);
         b.x_build.clone_from(&nb.x_build);
         b.builds = nb.builds;
+        b.force_x.clone_from(&self.force_x);
         b.ghost_origin.clone_from(&g.origin);
         b.ghost_mask.clone_from(&g.mask);
         b.ghost_key.clone_from(&g.key);
@@ -799,6 +813,7 @@ impl MdSystem {
         nb.hist.clone_from(&b.hist);
         nb.x_build.clone_from(&b.x_build);
         nb.builds = b.builds;
+        self.force_x.clone_from(&b.force_x);
         let g = &mut self.ghosts;
         g.origin.clone_from(&b.ghost_origin);
         g.mask.clone_from(&b.ghost_mask);
@@ -875,6 +890,14 @@ impl MdSystem {
             measure,
         };
         run_chunks(&self.team, &ctx, &bounds, &mut self.neighbours.hist, 0, &mut self.work);
+        // The centres of this evaluation, for the contact list, if the corrector
+        // is about to move them.
+        let corrects_x = matches!(self.settings.integrator, Integrator::Gear(set) if set.coefficients()[0] != 0.0);
+        if integrate && corrects_x {
+            self.force_x.clone_from(&self.particles.x);
+        } else {
+            self.force_x.clear();
+        }
         // Phase 3: per chunk of spheres, sum, walls, damping, second half.
         let s = &self.settings;
         let ctx = TailContext {
@@ -1039,6 +1062,7 @@ fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offs
                 measure: ctx.measure,
             };
             let cf = contact::force(law, &k, h, dt);
+            h.force = cf.force;
             fi += cf.force;
             let arm = nrm.cross(&cf.tangential);
             ti -= arm * ai;
@@ -1129,6 +1153,7 @@ fn tail(c: View, hist: &mut [History], ctx: &TailContext, out: &mut Tail) {
             let v_rel = c.v[i] + nrm.cross(&c.w[i]) * a - vw;
             let k_ = Kinematics { n: nrm, delta, v_rel, r_star, m_star: c.m[i], measure: true };
             let cf = contact::force(law, &k_, h, dt);
+            h.force = cf.force;
             c.f[i] += cf.force;
             c.t[i] += nrm.cross(&cf.tangential) * (-a);
             out.wall_force[k] -= cf.force;

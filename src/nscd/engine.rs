@@ -6,13 +6,15 @@
 
 use super::system::{StepStats, System};
 use crate::error::{Error, Result};
+use crate::io::contacts::{ContactKind, ContactRow};
 use crate::io::cycles::{NscdCycleRow, NscdCycleState, NSCD_CYCLE_COLUMNS};
 use crate::io::final_state::{BodyState, FinalState, Spin};
+use crate::io::run_figures::RunFigures;
 use crate::io::series::{NscdSeriesRow, NSCD_SERIES_COLUMNS};
 use crate::io::summary::StepSummary;
 use crate::io::vtk::PvdCollection;
 use crate::run::{Configuration, Energies, Engine};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 impl Engine for System {
     const NAME: &'static str = "nscd";
@@ -101,6 +103,43 @@ impl Engine for System {
         FinalState { engine: Self::NAME.into(), time: self.time, step: self.step, bodies, walls: Vec::new() }
     }
 
+    /// One row per contact point; a contact with a fixed body is a `wall` row
+    /// seen from the other body (normal and forces turned round if the fixed
+    /// body was the candidate).
+    fn contact_rows(&self) -> Vec<ContactRow> {
+        let info = &self.bodies.info;
+        self.contact_forces()
+            .map(|c| {
+                let (a, b, s) = if info[c.candidate].fixed && !info[c.antagonist].fixed {
+                    (c.antagonist, c.candidate, -1.0)
+                } else {
+                    (c.candidate, c.antagonist, 1.0)
+                };
+                let kind = if info[a].fixed || info[b].fixed { ContactKind::Wall } else { ContactKind::Pair };
+                // The tangent of `r_t` is the candidate's normal turned by +90°.
+                let t = [-c.normal[1], c.normal[0]];
+                ContactRow {
+                    kind,
+                    a,
+                    a_name: info[a].name.clone(),
+                    b,
+                    b_name: info[b].name.clone(),
+                    point_x_m: c.point[0],
+                    point_y_m: c.point[1],
+                    point_z_m: None,
+                    normal_x: s * c.normal[0],
+                    normal_y: s * c.normal[1],
+                    normal_z: None,
+                    gap_m: c.gap,
+                    f_n: c.r_n,
+                    f_t_x: s * c.r_t * t[0],
+                    f_t_y: s * c.r_t * t[1],
+                    f_t_z: None,
+                }
+            })
+            .collect()
+    }
+
     fn snapshot(&self, dir: &Path, pvd: &mut PvdCollection) -> Result<()> {
         pvd.write_snapshot(dir, self).map(|_| ())
     }
@@ -175,13 +214,9 @@ impl Engine for System {
         self.bodies.q.get(c.body).map(|q| c.y0 - q[1])
     }
 
-    fn figures(&self, dir: &Path, cycles: Option<&NscdCycleState>) -> Result<Vec<PathBuf>> {
+    fn figures(&self, dir: &Path, cycles: Option<&NscdCycleState>) -> Result<RunFigures> {
         let first = cycles.and_then(|c| c.first_cycle_q.as_deref());
-        crate::io::run_figures::write_run_figures(dir, self, first)
-    }
-
-    fn has_figures() -> bool {
-        true
+        crate::io::run_figures::nscd_figures(dir, first)
     }
 
     fn mobile_bodies(&self) -> Vec<usize> {

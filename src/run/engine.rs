@@ -13,13 +13,15 @@
 //! next step starts exactly from the written configuration.
 
 use crate::error::Result;
+use crate::io::contacts::ContactRow;
 use crate::io::cycles::CycleCheck;
+use crate::io::run_figures::RunFigures;
 use crate::io::summary::StepSummary;
 use crate::io::vtk::PvdCollection;
 use crate::io::FinalState;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Energies of the equilibrium rule ([`super::Equilibrium`]) at the end of a step (J).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -156,6 +158,10 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// The state of every body (and wall) for `final.json`.
     fn final_state(&self) -> FinalState;
 
+    /// The contacts of the last step with their forces, for `contacts.csv`
+    /// ([`crate::io::contacts`]).
+    fn contact_rows(&self) -> Vec<ContactRow>;
+
     /// Writes a ParaView snapshot of the current state into `dir` and lists it in `pvd`.
     fn snapshot(&self, dir: &Path, pvd: &mut PvdCollection) -> Result<()>;
 
@@ -187,18 +193,12 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
         None
     }
 
-    /// Draws the figures of a finished run in `dir` (PNG + SVG); `cycles` is the
-    /// per-cycle state if the run had one.
-    ///
-    /// # Errors
-    /// [`crate::Error::Scene`] if the engine has no figures.
-    fn figures(&self, _dir: &Path, _cycles: Option<&Self::CycleState>) -> Result<Vec<PathBuf>> {
-        Err(crate::Error::Scene(format!("--figures: not available for {} runs", Self::NAME)))
-    }
-
-    /// Whether [`Engine::figures`] draws anything.
-    fn has_figures() -> bool {
-        false
+    /// Draws the figures of a finished run from its folder `dir` (PNG + SVG,
+    /// [`crate::io::run_figures::draw_run_figures`], the same as `ballast
+    /// figures`); `cycles` is the per-cycle state if the run had one, for what
+    /// the files do not hold (NSCD: the positions at the end of the first cycle).
+    fn figures(&self, dir: &Path, _cycles: Option<&Self::CycleState>) -> Result<RunFigures> {
+        crate::io::run_figures::draw_run_figures(dir)
     }
 
     /// The bodies a driver may move: every body that is not fixed (NSCD) or

@@ -8,10 +8,11 @@
 //! `cycles.csv` and the positions of the mobile bodies when a loading cycle ends
 //! → a VTK snapshot every `vtk_every` steps → the progress callback → a
 //! checkpoint when the wall clock says so. At the end: `final.json`,
-//! `summary.json`, the figures if asked, the state as a restartable scene.
-//! A step that diverges stops the run with the step and body named; the engine
-//! then holds its last good step, whose row, `final.json` and `summary.json` are
-//! written before the error is returned.
+//! `contacts.csv`, `summary.json`, the figures if asked, the state as a
+//! restartable scene. A step that diverges stops the run with the step and body
+//! named; the engine then holds its last good step, whose row, `final.json`,
+//! `contacts.csv`, `summary.json` (and figures, if asked) are written before the
+//! error is returned.
 
 use super::engine::Engine;
 use super::equilibrium::Equilibrium;
@@ -46,6 +47,8 @@ pub mod files {
     pub const INITIAL_STATE: &str = "initial_state.json";
     /// The final state as a scene to restart from.
     pub const FINAL_SCENE: &str = "final_scene.toml";
+    /// The contacts at the end, with their forces.
+    pub const CONTACTS: &str = "contacts.csv";
     /// ParaView collection of the snapshots.
     pub const PVD: &str = "run.pvd";
     /// Folder of the snapshots.
@@ -268,9 +271,6 @@ impl<E: Engine> Runner<E> {
     /// state has been written (`series.csv` row, `final.json`, `summary.json`).
     pub fn run(&self, out: &Path, opts: &RunOptions, progress: &mut dyn FnMut(&Progress)) -> Result<RunOutcome> {
         check_options(opts)?;
-        if opts.figures && !E::has_figures() {
-            return Err(Error::Scene(format!("--figures: not available for {} runs", E::NAME)));
-        }
         let plan = &self.plan;
         if plan.output_every == 0 {
             return Err(Error::Scene("output.every: must be at least 1, got 0".into()));
@@ -392,6 +392,7 @@ impl<E: Engine> Runner<E> {
         }
         let cycle_state = state.map(|(s, _)| s);
         live.sys.final_state().write(&out.join(files::FINAL))?;
+        io::contacts::write(&out.join(files::CONTACTS), &live.sys.contact_rows())?;
         io::write_json(&out.join(files::SUMMARY), &report)?;
         if opts.figures {
             live.sys.figures(out, cycle_state.as_ref())?;
@@ -425,6 +426,7 @@ impl<E: Engine> Runner<E> {
             CHECKPOINT_FILE,
             files::CYCLES,
             files::FINAL,
+            files::CONTACTS,
             files::SUMMARY,
             BODIES_FILE,
             DISPLACEMENTS_FILE,
