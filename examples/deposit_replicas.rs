@@ -27,7 +27,9 @@ fn main() -> Result<(), ballast::Error> {
     let replicas: usize = args[3].parse().expect("REPLICAS: a count");
     let order = args.get(4).map(String::as_str).unwrap_or("split");
     let first: usize = args.get(5).map(|s| s.parse().expect("FIRST: an index")).unwrap_or(0);
-    println!("order,replica,end,steps,time_s,final_max_overlap_m,run_max_overlap_m,unconverged_steps,mean_iterations,wall_s");
+    println!(
+        "order,replica,end,steps,time_s,final_max_overlap_m,run_max_overlap_m,unconverged_steps,mean_iterations,wall_s"
+    );
     for i in first..first + replicas {
         let mut sys = scene.build()?;
         if order == "serial" {
