@@ -68,11 +68,16 @@ pub struct ContactGeom {
 /// Friction and restitution between two materials.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ContactLaw {
+    /// Coulomb friction coefficient μ (≥ 0).
     pub friction: f64,
+    /// Normal restitution coefficient `e_n` in [0, 1] (0: plastic impact).
     pub restitution_n: f64,
+    /// Tangential restitution coefficient `e_t` in [0, 1].
     pub restitution_t: f64,
 }
 
+/// The law of a pair of materials nobody set: frictionless (μ = 0) and plastic
+/// (`e_n = e_t = 0`), as in a scene without a `[[contact]]` for the pair.
 impl Default for ContactLaw {
     fn default() -> Self {
         Self { friction: 0.0, restitution_n: 0.0, restitution_t: 0.0 }
