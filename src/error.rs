@@ -1,15 +1,25 @@
 //! Errors of the crate.
 
-/// Everything that can go wrong in loading a scene or running it.
+use crate::geometry::GeometryError;
+
+/// Everything that can go wrong in loading a scene, building a system or running it.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// The scene is invalid; the message names the field and the body or section.
+    /// The scene is invalid, or a system built in code is (a contact law missing,
+    /// a mass not positive, …); the message names the field and the body or
+    /// section.
     #[error("{0}")]
     Scene(String),
+    /// A shape was refused ([`GeometryError`]), e.g. a polygon given clockwise to
+    /// a constructor in code; converts with `?`. (Scenes report their shapes'
+    /// errors as [`Error::Scene`], with the body named.)
+    #[error("{0}")]
+    Geometry(#[from] GeometryError),
     /// The simulation produced a non-finite value or a runaway overlap. The system
     /// keeps the state of the last good step.
     #[error("step {step}: body {body} ('{name}'): {what}")]
     Diverged { step: u64, body: usize, name: String, what: String },
+    /// A file could not be read or written.
     #[error("{0}")]
     Io(#[from] std::io::Error),
 }
@@ -22,4 +32,5 @@ impl Error {
     }
 }
 
+/// The crate's result type.
 pub type Result<T> = std::result::Result<T, Error>;

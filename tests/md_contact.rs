@@ -300,7 +300,7 @@ fn symmetry_plane_equals_mirrored_pair() {
     let mut p = Particles::default();
     p.push("b", 0, rho, R, V3::new(x0, 0.0, 0.0), V3::new(-0.5 * v, vy, 0.0), V3::zeros());
     let ghosts = Ghosts::new(vec![SymmetryPlane { point: V3::zeros(), normal: V3::x() }]);
-    let mut half = MdSystem::new(set, p, vec![], laws(law, law), ghosts);
+    let mut half = MdSystem::new(set, p, vec![], laws(law, law), ghosts).unwrap();
 
     let (mut dmax_full, mut dmax_half) = (0.0f64, 0.0f64);
     let mut touched = false;

@@ -223,7 +223,7 @@ fn gear_quarter_sample_with_images_and_servo_plate() {
     ];
     // The first row and column within ±0.4 mm of touching their images.
     let particles = spheres(27, 3, -5e-4, 0.0);
-    let mut sys = MdSystem::new(set, particles, walls, laws(hertz(0.5), hertz(0.3)), Ghosts::new(planes));
+    let mut sys = MdSystem::new(set, particles, walls, laws(hertz(0.5), hertz(0.3)), Ghosts::new(planes)).unwrap();
     let (mut images, mut corrected) = (0, 0.0f64);
     for step in 1..=5000 {
         let stats = sys.step().unwrap();

@@ -390,7 +390,7 @@ fn dense_sample(nx: usize, ny: usize, nz: usize, room: f64, skin: f64) -> MdSyst
     table.set(0, 0, law);
     table.set(0, 1, law);
     let ghosts = Ghosts::new(vec![SymmetryPlane { point: V3::zeros(), normal: V3::x() }]);
-    MdSystem::new(settings(1e-5, V3::new(0.0, 0.0, -G), Integrator::Verlet, skin), p, walls, table, ghosts)
+    MdSystem::new(settings(1e-5, V3::new(0.0, 0.0, -G), Integrator::Verlet, skin), p, walls, table, ghosts).unwrap()
 }
 
 /// Check 10a: the neighbour list is an optimisation only. With a skin of 1e-9 m

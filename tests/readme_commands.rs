@@ -43,7 +43,14 @@ const REDUCTIONS: &[(&str, &[(&str, &str)])] = &[
     ),
     (
         "karrech deposit",
-        &[("--spheres", "40"), ("--young", "1e7"), ("--dt", "2e-6"), ("--duration", "0.6"), ("--every", "1000"), ("--quiet", "")],
+        &[
+            ("--spheres", "40"),
+            ("--young", "1e7"),
+            ("--dt", "2e-6"),
+            ("--duration", "0.6"),
+            ("--every", "1000"),
+            ("--quiet", ""),
+        ],
     ),
     ("karrech load", &[("--cycles", "1"), ("--every", "500"), ("--quiet", "")]),
     ("luding compress", &[("--spheres", "27"), ("--duration", "3"), ("--every", "2000"), ("--quiet", "")]),

@@ -201,7 +201,7 @@ fn fresh_md(scene: &MdScene, sys: &MdSystem, c: &Configuration) -> MdSystem {
     for w in &mut walls {
         w.s_dot = 0.0;
     }
-    MdSystem::new(built.settings, particles, walls, built.laws, Ghosts::new(built.ghosts.planes))
+    MdSystem::new(built.settings, particles, walls, built.laws, Ghosts::new(built.ghosts.planes)).unwrap()
 }
 
 fn md_write_back(md: &str) {

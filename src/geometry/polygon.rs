@@ -290,6 +290,15 @@ impl Shape {
         }
     }
 
+    /// Mass (kg) and polar moment of inertia about the centroid (kg·m²) of the
+    /// shape as a prism of `thickness` (m) out of the plane and `density`
+    /// (kg/m³): `ρ t A` and `ρ t J` ([`Shape::area_and_polar_moment`]). Scenes and
+    /// [`crate::nscd::BodyInfo::new`] both compute their masses here.
+    pub fn mass_properties(&self, density: f64, thickness: f64) -> (f64, f64) {
+        let (area, polar) = self.area_and_polar_moment();
+        (density * thickness * area, density * thickness * polar)
+    }
+
     /// Radius of the smallest centred circle that contains the shape (m).
     pub fn bounding_radius(&self) -> f64 {
         match self {

@@ -231,6 +231,10 @@ pub fn hertz_max_overlap(m_star: f64, r_star: f64, e_star: f64, v: f64) -> f64 {
 }
 
 /// The pair laws of all material pairs, `n × n`, symmetric.
+///
+/// Every pair of materials that can touch needs a law: [`crate::md::MdSystem::new`]
+/// refuses a system with a pair left out ([`LawTable::check_covers`]), as MD
+/// scenes do.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct LawTable {
     /// Number of materials (the table is `n × n`).
@@ -238,12 +242,81 @@ pub struct LawTable {
     /// Row-major `n × n` table: `laws[a * n + b]` is the law of materials `a` and `b`,
     /// `None` when the pair does not interact.
     pub laws: Vec<Option<PairLaw>>,
+    /// Names of the materials (empty, or one per material), for messages (empty:
+    /// they are called by their indices). Scenes set them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub names: Vec<String>,
 }
 
 impl LawTable {
-    /// A table for `n` materials with no law yet (pairs without a law do not interact).
+    /// A table for `n` materials (indices `0..n`) with no law yet.
     pub fn new(n: usize) -> Self {
-        LawTable { n, laws: vec![None; n * n] }
+        LawTable { n, laws: vec![None; n * n], names: Vec::new() }
+    }
+
+    /// A table for the materials `names` (material `i` is `names[i]`), with no
+    /// law yet; the names appear in the messages of [`LawTable::check_covers`].
+    pub fn named<S: AsRef<str>>(names: &[S]) -> Self {
+        LawTable { names: names.iter().map(|s| s.as_ref().to_string()).collect(), ..LawTable::new(names.len()) }
+    }
+
+    /// `'name'` of material `i` if the table has names, else `material i`.
+    pub fn material_name(&self, i: usize) -> String {
+        match self.names.get(i) {
+            Some(name) => format!("'{}'", crate::scene::clip(name)),
+            None => format!("material {i}"),
+        }
+    }
+
+    /// Checks that every pair of materials that can touch in a system of these
+    /// spheres and walls has a law ([`first_uncovered`]: two spheres, a sphere
+    /// and its image by a symmetry plane if `symmetry`, a sphere and a wall), and
+    /// that every material index is below [`LawTable::n`].
+    ///
+    /// # Errors
+    /// [`Error::Scene`](crate::Error::Scene) naming both materials and a sphere
+    /// and its partner, e.g. `no contact law between materials 'glass' and
+    /// 'steel', which can touch (sphere 0 'a' and wall 0 'floor')`.
+    pub fn check_covers(
+        &self,
+        particles: &super::Particles,
+        walls: &[super::Wall],
+        symmetry: bool,
+    ) -> crate::Result<()> {
+        let bad = |msg: String| Err(crate::Error::Scene(msg));
+        let n = self.n;
+        if self.laws.len() != n * n {
+            return bad(format!("contact laws: {} laws for {n} materials (need {})", self.laws.len(), n * n));
+        }
+        let sphere = |i: usize| match particles.name[i].as_str() {
+            "" => format!("sphere {i}"),
+            name => format!("sphere {i} '{}'", crate::scene::clip(name)),
+        };
+        let wall = |k: usize| match walls[k].name.as_str() {
+            "" => format!("wall {k}"),
+            name => format!("wall {k} '{}'", crate::scene::clip(name)),
+        };
+        if let Some(i) = (0..particles.len()).find(|&i| particles.material[i] as usize >= n) {
+            return bad(format!("{}: material {} of {n}", sphere(i), particles.material[i]));
+        }
+        if let Some(k) = (0..walls.len()).find(|&k| walls[k].material as usize >= n) {
+            return bad(format!("{}: material {} of {n}", wall(k), walls[k].material));
+        }
+        let spheres: Vec<usize> = particles.material.iter().map(|&m| m as usize).collect();
+        let wall_materials: Vec<usize> = walls.iter().map(|w| w.material as usize).collect();
+        let Some(u) = first_uncovered(n, &spheres, &wall_materials, symmetry, |a, b| self.get(a, b).is_some()) else {
+            return Ok(());
+        };
+        let what = match u.meeting {
+            Meeting::Spheres(i, j) => format!("{} and {}", sphere(i), sphere(j)),
+            Meeting::Image(i) => format!("{} and its symmetry image", sphere(i)),
+            Meeting::Wall(i, k) => format!("{} and {}", sphere(i), wall(k)),
+        };
+        bad(format!(
+            "no contact law between materials {} and {}, which can touch ({what})",
+            self.material_name(u.a),
+            self.material_name(u.b)
+        ))
     }
 
     /// Sets the law of the pair `(a, b)` and `(b, a)`.
@@ -257,6 +330,74 @@ impl LawTable {
     pub fn get(&self, a: usize, b: usize) -> Option<&PairLaw> {
         self.laws[a * self.n + b].as_ref()
     }
+}
+
+/// Where two materials without a law meet (indices of spheres and walls).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Meeting {
+    /// Spheres `.0` and `.1`.
+    Spheres(usize, usize),
+    /// Sphere `.0` and its image by a symmetry plane.
+    Image(usize),
+    /// Sphere `.0` and wall `.1`.
+    Wall(usize, usize),
+}
+
+/// A pair of materials that can touch and has no law ([`first_uncovered`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Uncovered {
+    /// The sphere's material.
+    pub a: usize,
+    /// The partner's material (a sphere's, or a wall's).
+    pub b: usize,
+    /// The first spheres or walls found that meet with these materials.
+    pub meeting: Meeting,
+}
+
+/// The first pair of materials (of `materials`) that can touch and for which
+/// `has_law(a, b)` (`a ≤ b` for two spheres) is false, if any: two spheres of
+/// materials `a` and `b` (for `a = b`, two spheres of `a`, or one and its image
+/// when `symmetry` planes mirror the spheres), or a sphere of `a` and a wall of
+/// `b`. `spheres[i]` is sphere `i`'s material, `walls[k]` wall `k`'s; any sphere
+/// may meet any sphere or wall (positions are not looked at: spheres move).
+/// Pairs are visited by sphere material `a` (increasing), then partner sphere
+/// materials `b ≥ a`, then walls in order. MD scenes
+/// (`contact: no [[contact]] between …`) and [`LawTable::check_covers`] both
+/// check through it.
+pub fn first_uncovered(
+    materials: usize,
+    spheres: &[usize],
+    walls: &[usize],
+    symmetry: bool,
+    has_law: impl Fn(usize, usize) -> bool,
+) -> Option<Uncovered> {
+    let (mut first, mut second) = (vec![None; materials], vec![None; materials]);
+    for (i, &m) in spheres.iter().enumerate() {
+        if first[m].is_none() {
+            first[m] = Some(i);
+        } else if second[m].is_none() {
+            second[m] = Some(i);
+        }
+    }
+    for a in 0..materials {
+        let Some(i) = first[a] else { continue };
+        for (b, &first_b) in first.iter().enumerate().skip(a) {
+            let partner = if a == b { second[a].or(symmetry.then_some(i)) } else { first_b };
+            match partner {
+                Some(j) if !has_law(a, b) => {
+                    let meeting = if j == i { Meeting::Image(i) } else { Meeting::Spheres(i, j) };
+                    return Some(Uncovered { a, b, meeting });
+                }
+                _ => {}
+            }
+        }
+        for (k, &b) in walls.iter().enumerate() {
+            if !has_law(a.min(b), a.max(b)) {
+                return Some(Uncovered { a, b, meeting: Meeting::Wall(i, k) });
+            }
+        }
+    }
+    None
 }
 
 /// Damping ratio `α = −ln e / √(π² + ln² e)` of a linear spring–dashpot whose

@@ -52,11 +52,40 @@ impl Particles {
         self.x.is_empty()
     }
 
-    /// Adds a solid sphere of radius `r` (m) and density `density` (kg/m³) made of
-    /// `material`, at `x` with velocity `v` and spin `w`; returns its index.
+    /// Adds a solid sphere of `radius` (m) made of material `material` (an index
+    /// of the [`super::LawTable`]) of `density` (kg/m³), centred at `x` (m) with
+    /// velocity `v` (m/s), no spin and no name; returns its index. Its mass is
+    /// `m = ρ 4/3 π r³` (kg) and its moment of inertia `2/5 m r²` (kg·m²)
+    /// ([`sphere_mass`]), as for a sphere of an MD scene. Set a name or a spin
+    /// afterwards through [`Particles::name`] and [`Particles::w`], or use
+    /// [`Particles::push`].
+    ///
+    /// # Errors
+    /// [`crate::Error::Scene`] if `radius` or `density` is not positive and
+    /// finite or `x` or `v` is not finite; the spheres are then unchanged.
+    pub fn add_sphere(&mut self, material: u32, density: f64, radius: f64, x: V3, v: V3) -> crate::Result<usize> {
+        let i = self.len();
+        let bad = |what: String| Err(crate::Error::Scene(format!("sphere {i}: {what}")));
+        for (what, value, unit) in [("radius", radius, "m"), ("density", density, "kg/m^3")] {
+            if !(value.is_finite() && value > 0.0) {
+                return bad(format!("{what} must be positive and finite, got {value} {unit}"));
+            }
+        }
+        for (what, p) in [("position", x), ("velocity", v)] {
+            if p.iter().any(|c| !c.is_finite()) {
+                return bad(format!("{what} must be finite, got [{}, {}, {}]", p[0], p[1], p[2]));
+            }
+        }
+        Ok(self.push("", material, density, radius, x, v, V3::zeros()))
+    }
+
+    /// Adds a solid sphere named `name` of radius `r` (m) and density `density`
+    /// (kg/m³) made of `material`, at `x` (m) with velocity `v` (m/s) and spin `w`
+    /// (rad/s); returns its index. Mass and inertia as [`Particles::add_sphere`];
+    /// nothing is checked.
     #[allow(clippy::too_many_arguments)]
     pub fn push(&mut self, name: &str, material: u32, density: f64, r: f64, x: V3, v: V3, w: V3) -> usize {
-        let m = density * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
+        let m = sphere_mass(density, r);
         self.x.push(x);
         self.v.push(v);
         self.w.push(w);
@@ -88,6 +117,12 @@ impl Particles {
     pub fn max_radius(&self) -> f64 {
         self.r.iter().cloned().fold(0.0, f64::max)
     }
+}
+
+/// Mass (kg) of a solid sphere of `density` (kg/m³) and `radius` (m):
+/// `ρ 4/3 π r³`. Its moment of inertia is `2/5 m r²` (kg·m²).
+pub fn sphere_mass(density: f64, radius: f64) -> f64 {
+    density * 4.0 / 3.0 * std::f64::consts::PI * radius * radius * radius
 }
 
 /// Rotates `q` by the spin `w` (rad/s) held for `dt` (s): `q ← q + dt/2 (0, w) q`,

@@ -310,9 +310,29 @@ pub struct MdSystem {
 }
 
 impl MdSystem {
-    /// A system at time 0; forces are evaluated once so that the first step starts
-    /// from the right accelerations.
-    pub fn new(settings: MdSettings, particles: Particles, walls: Vec<Wall>, laws: LawTable, ghosts: Ghosts) -> Self {
+    /// A system at time 0 of `particles` (spheres, [`Particles::add_sphere`]),
+    /// `walls`, the contact `laws` of the pairs of materials and the symmetry
+    /// planes of `ghosts` (`Ghosts::new(Vec::new())`: none), stepped with
+    /// `settings` ([`MdSettings::default`] and its fields); forces are evaluated
+    /// once so that the first step starts from the right accelerations.
+    ///
+    /// The time step is not checked against the contacts' stability limit (MD
+    /// scenes check it; [`super::law::PairLaw::contact_time`] gives the time
+    /// scale a step must resolve, some 1/50 of it is safe).
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if a pair of materials that can touch (two spheres, a
+    /// sphere and its symmetry image, a sphere and a wall) has no law, naming both
+    /// materials and where they meet ([`LawTable::check_covers`]), or if a sphere
+    /// or wall has a material index not below `laws.n`.
+    pub fn new(
+        settings: MdSettings,
+        particles: Particles,
+        walls: Vec<Wall>,
+        laws: LawTable,
+        ghosts: Ghosts,
+    ) -> Result<Self> {
+        laws.check_covers(&particles, &walls, !ghosts.planes.is_empty())?;
         let mut sys = MdSystem {
             settings,
             neighbours: Neighbours::new(settings.skin),
@@ -344,7 +364,7 @@ impl MdSystem {
         };
         sys.gravity_reference = sys.initial_reference();
         sys.reset_derived();
-        sys
+        Ok(sys)
     }
 
     /// Rebuilds every state derived from the positions and velocities, as at the
@@ -617,6 +637,9 @@ impl MdSystem {
         }
         if self.laws.n.checked_mul(self.laws.n) != Some(self.laws.laws.len()) {
             return bad(format!("{} laws for {} materials", self.laws.laws.len(), self.laws.n));
+        }
+        if !(self.laws.names.is_empty() || self.laws.names.len() == self.laws.n) {
+            return bad(format!("{} material names for {} materials", self.laws.names.len(), self.laws.n));
         }
         let gear = matches!(self.settings.integrator, Integrator::Gear(_));
         let expected = if gear { n } else { 0 };

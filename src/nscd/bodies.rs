@@ -5,9 +5,35 @@
 //! §2.1: for a rigid body the inertia block is constant and diagonal). The
 //! inverse mass is kept per degree of freedom so that fixed bodies and imposed
 //! velocity components simply have a zero entry: contacts cannot move them.
+//!
+//! Building bodies in code: [`BodyInfo::new`] takes a shape in its body frame
+//! (centroid at the origin) and computes the mass `ρ t A` and the inertia
+//! `ρ t J` about the centroid, with `t` the out-of-plane thickness (the prism a
+//! 2D body stands for, [`crate::geometry`]); [`BodyInfo::polygon`],
+//! [`BodyInfo::compound`] and [`BodyInfo::disc`] take the shape where it is in
+//! the world and also return the position `q = (x_c, y_c, 0)` of its centroid to
+//! [`Bodies::push`]. [`BodyInfo::into_fixed`], [`BodyInfo::with_imposed`] and
+//! [`BodyInfo::with_load`] make it fixed, drive it, load it. Scenes build their
+//! bodies through the same constructor and [`centroid_state`].
+//!
+//! ```
+//! use ballast::nscd::{BodyInfo, Harmonic, Load, NscdParams, System};
+//! let mut sys = System::new(NscdParams::default(), 1);
+//! // A 1 m × 0.2 m floor, fixed; a 0.1 m square of granite (2700 kg/m³) on it,
+//! // both 1 m thick; world coordinates (m), counter-clockwise.
+//! let (floor, q) = BodyInfo::polygon("floor", &[[-0.5, -0.2], [0.5, -0.2], [0.5, 0.0], [-0.5, 0.0]], 0, 2700.0, 1.0)?;
+//! sys.bodies.push(floor.into_fixed(), q, [0.0; 3]);
+//! let (block, q) = BodyInfo::polygon("block", &[[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.0, 0.1]], 0, 2700.0, 1.0)?;
+//! assert!((q[0] - 0.05).abs() < 1e-15 && (q[1] - 0.05).abs() < 1e-15); // the centroid
+//! assert!((block.mass - 27.0).abs() < 1e-12); // ρ a² t
+//! let block = block.with_load(Load::new([0.0, -1.0], Harmonic::constant(100.0))); // 100 N down
+//! sys.bodies.push(block, q, [0.0; 3]);
+//! # Ok::<(), ballast::Error>(())
+//! ```
 
 use super::loads::{Imposed, Load};
-use crate::geometry::Shape;
+use crate::error::{Error, Result};
+use crate::geometry::{perp, rotate, Compound, ConvexPolygon, Shape, Vec2};
 use serde::{Deserialize, Serialize};
 
 /// Static description of one body (cold data).
@@ -31,9 +57,145 @@ pub struct BodyInfo {
     pub loads: Vec<Load>,
 }
 
+impl BodyInfo {
+    /// A free body (not fixed, no imposed velocity, no load) of `shape`, given in
+    /// its body frame with its centroid at the origin (as [`ConvexPolygon::new`],
+    /// [`ConvexPolygon::regular`], [`Compound::new`] and [`Shape::disc`] give it),
+    /// made of material `material` (an index of the system's materials) of
+    /// `density` (kg/m³), as a prism of `thickness` (m) out of the plane: mass
+    /// `ρ t A` (kg) and polar inertia `ρ t J` about the centroid (kg·m²)
+    /// ([`Shape::mass_properties`]; a scene's `simulation.thickness` defaults to 1 m).
+    /// Push it with the position of its centroid.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if `density` or `thickness` is not positive and finite, or
+    /// the mass or inertia is not (a shape too small or too large for `f64`).
+    pub fn new(name: impl Into<String>, shape: Shape, material: usize, density: f64, thickness: f64) -> Result<Self> {
+        let name = name.into();
+        let who = || crate::scene::clip(&name);
+        for (what, v, unit) in [("density", density, "kg/m^3"), ("thickness", thickness, "m")] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::Scene(format!(
+                    "body '{}': {what} must be positive and finite, got {v} {unit}",
+                    who()
+                )));
+            }
+        }
+        let (mass, inertia) = shape.mass_properties(density, thickness);
+        if !(mass.is_finite() && mass > 0.0 && inertia.is_finite() && inertia > 0.0) {
+            return Err(Error::Scene(format!("body '{}': {}", who(), mass_error(mass, inertia))));
+        }
+        Ok(Self { name, shape, material, mass, inertia, fixed: false, imposed: Imposed::default(), loads: Vec::new() })
+    }
+
+    /// A free convex polygon whose `vertices` (m) are given where they are in the
+    /// world, counter-clockwise: the body (its shape re-centred on the centroid,
+    /// mass and inertia as [`BodyInfo::new`]) and the position `q = (x_c, y_c, 0)`
+    /// of its centroid (m, m, rad) to [`Bodies::push`] it at.
+    ///
+    /// # Errors
+    /// [`Error::Geometry`] if the polygon is refused ([`ConvexPolygon::new`]);
+    /// those of [`BodyInfo::new`].
+    pub fn polygon(
+        name: impl Into<String>,
+        vertices: &[[f64; 2]],
+        material: usize,
+        density: f64,
+        thickness: f64,
+    ) -> Result<(Self, [f64; 3])> {
+        let (polygon, c) = ConvexPolygon::new(vertices)?;
+        Ok((Self::new(name, Shape::Polygon(polygon), material, density, thickness)?, [c.x, c.y, 0.0]))
+    }
+
+    /// A free compound body (a rigid union of convex polygons that may share
+    /// edges but not overlap), each part a vertex list (m) where it is in the
+    /// world, counter-clockwise: the body and the position `q = (x_c, y_c, 0)`
+    /// of the union's centroid, as [`BodyInfo::polygon`].
+    ///
+    /// # Errors
+    /// [`Error::Geometry`] if the parts are refused ([`Compound::new`]); those of
+    /// [`BodyInfo::new`].
+    pub fn compound(
+        name: impl Into<String>,
+        parts: &[Vec<[f64; 2]>],
+        material: usize,
+        density: f64,
+        thickness: f64,
+    ) -> Result<(Self, [f64; 3])> {
+        let (compound, c) = Compound::new(parts)?;
+        Ok((Self::new(name, Shape::Compound(compound), material, density, thickness)?, [c.x, c.y, 0.0]))
+    }
+
+    /// A free disc of `radius` (m) centred at `centre` (m): the body (mass
+    /// `ρ t π r²`, inertia `ρ t π r⁴ / 2`) and `q = (x_c, y_c, 0)`.
+    ///
+    /// # Errors
+    /// [`Error::Geometry`] if the radius is not positive and finite; those of
+    /// [`BodyInfo::new`].
+    pub fn disc(
+        name: impl Into<String>,
+        centre: [f64; 2],
+        radius: f64,
+        material: usize,
+        density: f64,
+        thickness: f64,
+    ) -> Result<(Self, [f64; 3])> {
+        Ok((Self::new(name, Shape::disc(radius)?, material, density, thickness)?, [centre[0], centre[1], 0.0]))
+    }
+
+    /// The same body, fixed: it never moves (its velocity is zero whatever is
+    /// pushed, its imposed velocities and loads are ignored); its mass and
+    /// inertia are kept (they enter no equation).
+    pub fn into_fixed(mut self) -> Self {
+        self.fixed = true;
+        self
+    }
+
+    /// The same body with `imposed` velocity components ([`Imposed`]: each of
+    /// `vx`, `vy` (m/s), spin (rad/s) a [`super::Harmonic`] of time or free),
+    /// replacing any it had. An imposed component takes its value at `t = 0` when
+    /// pushed, whatever velocity is given, and contacts cannot change it.
+    pub fn with_imposed(mut self, imposed: Imposed) -> Self {
+        self.imposed = imposed;
+        self
+    }
+
+    /// The same body with `load` (N, at the centre of mass) added to its loads.
+    pub fn with_load(mut self, load: Load) -> Self {
+        self.loads.push(load);
+        self
+    }
+}
+
+/// The message of a mass or inertia that is not positive and finite.
+pub(crate) fn mass_error(mass: f64, inertia: f64) -> String {
+    format!("mass {mass:e} kg or inertia {inertia:e} kg m^2 (density*thickness*area) is not positive and finite")
+}
+
+/// The state `(q, u)` of a body's centre of mass from that of a frame attached
+/// to it (a scene's body frame): `centroid` (m) is the centroid in that frame,
+/// `position` (m) and `angle` (rad) place the frame's origin, `velocity` (m/s) is
+/// the velocity of that origin and `spin` (rad/s) the body's. With `R` the
+/// rotation by `angle`: `q = (position + R c, angle)`,
+/// `u = (velocity + spin × R c, spin)`.
+pub fn centroid_state(
+    centroid: Vec2,
+    position: [f64; 2],
+    angle: f64,
+    velocity: [f64; 2],
+    spin: f64,
+) -> ([f64; 3], [f64; 3]) {
+    let (s, c) = angle.sin_cos();
+    let rc = rotate(centroid, c, s);
+    let q = [position[0] + rc.x, position[1] + rc.y, angle];
+    let vc = Vec2::new(velocity[0], velocity[1]) + spin * perp(rc);
+    (q, [vc.x, vc.y, spin])
+}
+
 /// The body collection, with hot arrays laid out for the solver.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct Bodies {
+    /// Static description of each body.
     pub info: Vec<BodyInfo>,
     /// `(x, y, θ)`: centre of mass (m) and angle (rad).
     pub q: Vec<[f64; 3]>,
@@ -45,15 +207,20 @@ pub struct Bodies {
 }
 
 impl Bodies {
+    /// Number of bodies.
     pub fn len(&self) -> usize {
         self.q.len()
     }
 
+    /// True if there are no bodies.
     pub fn is_empty(&self) -> bool {
         self.q.is_empty()
     }
 
-    /// Adds a body at centre of mass `q` with velocity `u`; returns its index.
+    /// Adds a body whose centre of mass is at `q = (x, y, θ)` (m, m, rad) with
+    /// velocity `u = (vx, vy, ω)` (m/s, m/s, rad/s); returns its index. A fixed
+    /// body gets `u = 0` and zero inverse masses; an imposed component takes its
+    /// value at `t = 0` and a zero inverse mass.
     pub fn push(&mut self, info: BodyInfo, q: [f64; 3], u: [f64; 3]) -> usize {
         let mut inv = [1.0 / info.mass, 1.0 / info.mass, 1.0 / info.inertia];
         if info.fixed {
@@ -82,6 +249,18 @@ impl Bodies {
     #[inline]
     pub fn is_mobile(&self, i: usize) -> bool {
         self.inv_m[i].iter().any(|&x| x > 0.0)
+    }
+
+    /// The alert distance (m) a scene gets by default:
+    /// [`super::system::DEFAULT_ALERT_FRACTION`] × the smallest inner radius of the
+    /// non-fixed bodies (of all bodies if none moves); the default of
+    /// [`super::NscdParams`] (1e-4 m) if there is no body. Set it on a system built
+    /// in code with `sys.params.alert_distance = sys.bodies.default_alert_distance()`.
+    pub fn default_alert_distance(&self) -> f64 {
+        if self.is_empty() {
+            return super::NscdParams::default().alert_distance;
+        }
+        super::system::default_alert_distance(self.info.iter().map(|b| (b.fixed, b.shape.inner_radius())))
     }
 
     /// Kinetic energy ½ Σ (m v² + I ω²) of all non-fixed bodies (J).

@@ -90,6 +90,8 @@ pub struct ContactLaw {
     pub restitution_t: f64,
 }
 
+/// The law of a pair of materials nobody set: frictionless (μ = 0) and plastic
+/// (`e_n = e_t = 0`), as in a scene without a `[[contact]]` for the pair.
 impl Default for ContactLaw {
     fn default() -> Self {
         Self { friction: 0.0, restitution_n: 0.0, restitution_t: 0.0 }

@@ -48,6 +48,16 @@ pub struct Load {
 }
 
 impl Load {
+    /// The force `force(t)` (N) along `direction` (any non-zero vector, made a
+    /// unit vector here as a scene's `load.direction` is).
+    ///
+    /// A zero or non-finite `direction` gives a non-finite direction (refused by
+    /// scenes; a step with it diverges).
+    pub fn new(direction: [f64; 2], force: Harmonic) -> Self {
+        let n = direction[0].hypot(direction[1]);
+        Self { direction: [direction[0] / n, direction[1] / n], force }
+    }
+
     /// Force vector (N) at time `t` (s).
     #[inline]
     pub fn at(&self, t: f64) -> [f64; 2] {
@@ -66,6 +76,13 @@ pub struct Imposed {
 }
 
 impl Imposed {
+    /// The components `vx` (m/s), `vy` (m/s) and spin (rad/s) imposed as given
+    /// (`None`: free), e.g. `Imposed::new(Some(Harmonic::constant(0.0)), None,
+    /// Some(Harmonic::constant(0.0)))` for a body that may only move vertically.
+    pub fn new(vx: Option<Harmonic>, vy: Option<Harmonic>, spin: Option<Harmonic>) -> Self {
+        Self { dof: [vx, vy, spin] }
+    }
+
     /// Whether no degree of freedom is imposed.
     pub fn is_empty(&self) -> bool {
         self.dof.iter().all(Option::is_none)

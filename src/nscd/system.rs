@@ -15,6 +15,17 @@ use serde::{Deserialize, Serialize};
 /// radius of the non-fixed bodies (of all bodies if none moves) (m/m).
 pub const DEFAULT_ALERT_FRACTION: f64 = 0.01;
 
+/// [`DEFAULT_ALERT_FRACTION`] × the smallest inner radius (m) of the bodies given
+/// as `(fixed, inner radius)`: of the non-fixed ones, or of all if none moves
+/// (infinite if there is none). Scenes and [`super::Bodies::default_alert_distance`].
+pub(crate) fn default_alert_distance(bodies: impl Iterator<Item = (bool, f64)> + Clone) -> f64 {
+    let inner = |mobile_only: bool| {
+        bodies.clone().filter(|&(fixed, _)| !mobile_only || !fixed).map(|(_, r)| r).fold(f64::INFINITY, f64::min)
+    };
+    let r = if bodies.clone().any(|(fixed, _)| !fixed) { inner(true) } else { inner(false) };
+    DEFAULT_ALERT_FRACTION * r
+}
+
 /// Time-stepping parameters. [`NscdParams::default`] gives the defaults of
 /// scenes (`[simulation]` and `[nscd]` of `docs/scene-format.md`), but for the
 /// time step, which a scene must give.
@@ -29,8 +40,10 @@ pub struct NscdParams {
     pub gravity: [f64; 2],
     /// Alert distance (m), ≥ 0: pairs closer than this are contacts (possibly
     /// open). Each step it is raised to `2 h v_max` if the fastest body needs it.
-    /// Default 1e-4 here; a scene's default is [`DEFAULT_ALERT_FRACTION`] × the
-    /// smallest inner radius of its mobile bodies.
+    /// Default 1e-4 m here, whatever the bodies; a scene's default is
+    /// [`DEFAULT_ALERT_FRACTION`] × the smallest inner radius of its mobile
+    /// bodies, which a system built in code gets from
+    /// [`super::Bodies::default_alert_distance`].
     pub alert_distance: f64,
     /// NLGS settings ([`NlgsSettings::default`]).
     pub nlgs: NlgsSettings,
@@ -156,7 +169,13 @@ pub struct System {
 }
 
 impl System {
-    /// An empty system with `materials` materials and frictionless, plastic contacts.
+    /// An empty system with `materials` materials (indices `0..materials`) whose
+    /// pairs all have the default law ([`ContactLaw::default`]: frictionless,
+    /// plastic, as a scene's pairs without a `[[contact]]`); change a pair's with
+    /// [`System::set_law`]. Every pair of materials interacts: there is no pair
+    /// without a law. Push bodies into [`System::bodies`]
+    /// ([`super::BodyInfo::polygon`] and its siblings give the mass and the
+    /// centroid to push at).
     pub fn new(params: NscdParams, materials: usize) -> Self {
         Self {
             params,
@@ -182,7 +201,11 @@ impl System {
         self.params.dt = dt;
     }
 
-    /// Sets the contact law between materials `i` and `j` (both orders).
+    /// Sets the contact law between materials `i` and `j` (both orders); a pair
+    /// never set keeps [`ContactLaw::default`] (frictionless, plastic).
+    ///
+    /// # Panics
+    /// If `i` or `j` is not below [`System::materials`].
     pub fn set_law(&mut self, i: usize, j: usize, law: ContactLaw) {
         self.laws[i * self.materials + j] = law;
         self.laws[j * self.materials + i] = law;

@@ -139,7 +139,7 @@ pub fn bed_system(spec: &BedSpec) -> Result<MdSystem> {
         background_damping: 0.0,
         background_rotational_damping: 0.0,
     };
-    Ok(MdSystem::new(settings, p, walls, laws, Ghosts::new(Vec::new())))
+    MdSystem::new(settings, p, walls, laws, Ghosts::new(Vec::new()))
 }
 
 /// Height of the highest sphere centre (m): the peers' settled-bed figure.

@@ -5,12 +5,14 @@
 //! `angle` (rad), with `velocity` (m/s) the velocity of that origin. The
 //! system works with the centre of mass: with `c` the centroid in the body
 //! frame and `R` the rotation by `angle`,
-//! `q = (position + R c, angle)` and `u = (velocity + spin × R c, spin)`.
+//! `q = (position + R c, angle)` and `u = (velocity + spin × R c, spin)`
+//! ([`centroid_state`]). Bodies are made by [`BodyInfo::new`], as in code.
 
 use super::format::Scene;
 use super::validate::{check, shape_of};
 use crate::error::Result;
 use crate::geometry::{perp, rotate, Vec2};
+use crate::nscd::bodies::centroid_state;
 use crate::nscd::{BodyInfo, ContactLaw, Imposed, NscdParams, Spring, System};
 
 impl Scene {
@@ -35,32 +37,22 @@ impl Scene {
             sys.set_law(material(&c.between[0]), material(&c.between[1]), law);
         }
         let centroids: Vec<Vec2> = checked.bodies.iter().map(|b| b.centroid).collect();
+        let thickness = self.simulation.thickness();
         for (spec, body) in self.bodies.iter().zip(checked.bodies) {
-            let mut imposed = Imposed::default();
+            let density = self.materials[body.material].density;
+            let mut info = BodyInfo::new(spec.name.clone(), body.shape, body.material, density, thickness)?;
             if let Some(imp) = &spec.imposed {
-                for (d, drive) in [imp.vx, imp.vy, imp.spin].into_iter().enumerate() {
-                    imposed.dof[d] = drive.map(|x| x.to_harmonic());
-                }
+                let [vx, vy, spin] = [imp.vx, imp.vy, imp.spin].map(|d| d.map(|x| x.to_harmonic()));
+                info = info.with_imposed(Imposed::new(vx, vy, spin));
             }
-            let loads = spec.load.iter().map(|l| l.to_load()).collect();
-            let angle = spec.angle();
-            let (s, c) = angle.sin_cos();
-            let rc = rotate(body.centroid, c, s);
-            let v = spec.velocity();
-            let spin = spec.spin();
-            let q = [spec.position[0] + rc.x, spec.position[1] + rc.y, angle];
-            let vc = Vec2::new(v[0], v[1]) + spin * perp(rc);
-            let info = BodyInfo {
-                name: spec.name.clone(),
-                shape: body.shape,
-                material: body.material,
-                mass: body.mass,
-                inertia: body.inertia,
-                fixed: spec.is_fixed(),
-                imposed,
-                loads,
-            };
-            sys.bodies.push(info, q, [vc.x, vc.y, spin]);
+            if let Some(load) = &spec.load {
+                info = info.with_load(load.to_load());
+            }
+            if spec.is_fixed() {
+                info = info.into_fixed();
+            }
+            let (q, u) = centroid_state(body.centroid, spec.position, spec.angle(), spec.velocity(), spec.spin());
+            sys.bodies.push(info, q, u);
         }
         for (spec, s) in self.springs.iter().zip(checked.springs) {
             let rel = |i: usize, p: [f64; 2]| [p[0] - centroids[i].x, p[1] - centroids[i].y];

@@ -302,16 +302,15 @@ impl LoadSpec {
     /// As the engine's load: unit direction and harmonic magnitude (N). The
     /// direction must be non-zero (checked by the validation).
     pub fn to_load(&self) -> crate::nscd::Load {
-        let n = self.direction[0].hypot(self.direction[1]);
-        crate::nscd::Load {
-            direction: [self.direction[0] / n, self.direction[1] / n],
-            force: crate::nscd::Harmonic {
+        crate::nscd::Load::new(
+            self.direction,
+            crate::nscd::Harmonic {
                 mean: self.mean,
                 amplitude: self.amplitude,
                 frequency: self.frequency,
                 phase: self.phase,
             },
-        }
+        )
     }
 }
 

@@ -7,7 +7,6 @@
 use super::format::{BodySpec, Drive, NscdSection, Scene};
 use crate::error::{Error, Result};
 use crate::geometry::{rotate, Compound, ConvexPolygon, GeometryError, Shape, Vec2};
-use crate::nscd::system::DEFAULT_ALERT_FRACTION;
 use crate::nscd::{NlgsSettings, NscdParams, Policy};
 use std::collections::HashMap;
 
@@ -23,7 +22,8 @@ pub const MIN_SIZE: f64 = 1.0e-9;
 /// Largest number of sides of a `regular` polygon.
 pub const MAX_SIDES: usize = 10_000;
 
-/// A body resolved by validation.
+/// A body resolved by validation (its mass and inertia are
+/// [`crate::nscd::BodyInfo::new`]'s, checked here).
 #[derive(Debug, Clone)]
 pub(crate) struct CheckedBody {
     /// Shape centred on its centroid.
@@ -31,9 +31,6 @@ pub(crate) struct CheckedBody {
     /// Centroid in the scene's body frame (m).
     pub centroid: Vec2,
     pub material: usize,
-    /// Mass (kg) and polar inertia about the centroid (kg·m²).
-    pub mass: f64,
-    pub inertia: f64,
 }
 
 /// A spring resolved by validation.
@@ -410,17 +407,11 @@ fn check_bodies<'a>(
             finite(&ctx("load.frequency"), l.frequency)?;
             finite(&ctx("load.phase"), l.phase)?;
         }
-        let density = scene.materials[material].density;
-        let (area, polar) = shape.area_and_polar_moment();
-        let mass = density * thickness * area;
-        let inertia = density * thickness * polar;
+        let (mass, inertia) = shape.mass_properties(scene.materials[material].density, thickness);
         if !(mass.is_finite() && mass > 0.0 && inertia.is_finite() && inertia > 0.0) {
-            return err(format!(
-                "{}: mass {mass:e} kg or inertia {inertia:e} kg m^2 (density*thickness*area) is not positive and finite",
-                ctx("shape")
-            ));
+            return err(format!("{}: {}", ctx("shape"), crate::nscd::bodies::mass_error(mass, inertia)));
         }
-        bodies.push(CheckedBody { shape, centroid, material, mass, inertia });
+        bodies.push(CheckedBody { shape, centroid, material });
     }
 
     Ok((bodies, names))
@@ -482,23 +473,13 @@ fn check_springs(scene: &Scene, names: &HashMap<&str, usize>) -> Result<Vec<Chec
     Ok(springs)
 }
 
-/// The alert distance (m): `nscd.alert_distance`, else [`DEFAULT_ALERT_FRACTION`]
+/// The alert distance (m): `nscd.alert_distance`, else [`crate::nscd::system::DEFAULT_ALERT_FRACTION`]
 /// × the smallest inner radius of the non-fixed bodies (of all bodies if none moves).
 fn alert_distance(scene: &Scene, ns: &NscdSection, bodies: &[CheckedBody]) -> f64 {
     match ns.alert_distance {
         Some(a) => a,
-        None => {
-            let inner = |mobile_only: bool| {
-                scene
-                    .bodies
-                    .iter()
-                    .zip(bodies)
-                    .filter(|(s, _)| !mobile_only || !s.is_fixed())
-                    .map(|(_, b)| b.shape.inner_radius())
-                    .fold(f64::INFINITY, f64::min)
-            };
-            let r = if scene.bodies.iter().any(|b| !b.is_fixed()) { inner(true) } else { inner(false) };
-            DEFAULT_ALERT_FRACTION * r
-        }
+        None => crate::nscd::system::default_alert_distance(
+            scene.bodies.iter().zip(bodies).map(|(s, b)| (s.is_fixed(), b.shape.inner_radius())),
+        ),
     }
 }

@@ -38,6 +38,7 @@ pub fn laws(sphere: PairLaw, wall: PairLaw) -> LawTable {
 /// A system without symmetry planes.
 pub fn system(settings: MdSettings, particles: Particles, walls: Vec<Wall>, laws: LawTable) -> MdSystem {
     MdSystem::new(settings, particles, walls, laws, Ghosts::new(Vec::new()))
+        .expect("a law for every pair that can touch")
 }
 
 /// Mass of a sphere of radius `r` (m) and density `rho` (kg/m³).

@@ -28,7 +28,7 @@ impl MdScene {
                 V3::from(b.spin()),
             );
         }
-        let mut sys = MdSystem::new(c.settings, particles, c.walls, c.laws, Ghosts::new(c.planes));
+        let mut sys = MdSystem::new(c.settings, particles, c.walls, c.laws, Ghosts::new(c.planes))?;
         if let Some(t) = c.threads {
             sys.set_threads(t);
         }

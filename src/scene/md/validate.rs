@@ -131,11 +131,10 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
     let (sphere_materials, diameters) = check_bodies(scene, &names, &materials)?;
     let walls = check_walls(scene, &names)?;
     check_laws_cover(scene, &sphere_materials, &walls, &planes, &pairs)?;
-    let n = materials.len();
     let skin = ms.skin.unwrap_or(DEFAULT_SKIN_FRACTION * diameters / scene.bodies.len() as f64);
     let settings =
         MdSettings { dt: sim.dt, gravity, integrator, skin, background_damping, background_rotational_damping };
-    let mut table = LawTable::new(n);
+    let mut table = LawTable::named(&scene.materials.iter().map(|m| m.name.as_str()).collect::<Vec<_>>());
     for l in &laws {
         table.set(l.a, l.b, pair_law(l, &materials));
     }
@@ -305,7 +304,7 @@ fn check_bodies(
         point(&ctx("position"), b.position)?;
         finite3(&ctx("velocity"), b.velocity())?;
         finite3(&ctx("spin"), b.spin())?;
-        let mass = materials[m].density * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
+        let mass = md::particles::sphere_mass(materials[m].density, r);
         if !(mass.is_finite() && mass > 0.0) {
             return err(format!("{}: mass {mass:e} kg (density*4/3*pi*r^3) is not positive and finite", ctx("sphere")));
         }
@@ -355,7 +354,8 @@ fn check_walls(scene: &MdScene, names: &HashMap<&str, usize>) -> Result<Vec<Wall
 }
 
 /// Every pair of materials that can touch has a law: spheres with spheres (of
-/// one material: two spheres, or one and its symmetry image) and with walls.
+/// one material: two spheres, or one and its symmetry image) and with walls
+/// ([`md::law::first_uncovered`], which [`MdSystem::new`](crate::md::MdSystem::new) checks through too).
 fn check_laws_cover(
     scene: &MdScene,
     sphere_materials: &[usize],
@@ -363,47 +363,23 @@ fn check_laws_cover(
     planes: &[SymmetryPlane],
     pairs: &HashMap<(usize, usize), usize>,
 ) -> Result<()> {
-    let n = scene.materials.len();
-    let (mut first, mut second) = (vec![None; n], vec![None; n]);
-    for (i, &m) in sphere_materials.iter().enumerate() {
-        if first[m].is_none() {
-            first[m] = Some(i);
-        } else if second[m].is_none() {
-            second[m] = Some(i);
-        }
-    }
-    let body = |i: usize| label("body", i, &scene.bodies[i].name);
-    let missing = |a: usize, b: usize, what: String| {
-        err(format!(
-            "contact: no [[contact]] between materials '{}' and '{}', which can touch ({what})",
-            scene.materials[a].name, scene.materials[b].name
-        ))
+    let wall_materials: Vec<usize> = walls.iter().map(|w| w.material as usize).collect();
+    let has_law = |a: usize, b: usize| pairs.contains_key(&(a, b));
+    let Some(u) =
+        md::law::first_uncovered(scene.materials.len(), sphere_materials, &wall_materials, !planes.is_empty(), has_law)
+    else {
+        return Ok(());
     };
-    for a in 0..n {
-        let Some(i) = first[a] else { continue };
-        for (b, &first_b) in first.iter().enumerate().skip(a) {
-            let partner = if a == b { second[a].or((!planes.is_empty()).then_some(i)) } else { first_b };
-            match partner {
-                Some(j) if !pairs.contains_key(&(a, b)) => {
-                    let what = if j == i {
-                        format!("{} and its symmetry image", body(i))
-                    } else {
-                        format!("{} and {}", body(i), body(j))
-                    };
-                    return missing(a, b, what);
-                }
-                _ => {}
-            }
-        }
-        for (k, w) in walls.iter().enumerate() {
-            let b = w.material as usize;
-            if !pairs.contains_key(&(a.min(b), a.max(b))) {
-                return missing(a, b, format!("{} and {}", body(i), label("wall", k, &scene.walls[k].name)));
-            }
-        }
-    }
-
-    Ok(())
+    let body = |i: usize| label("body", i, &scene.bodies[i].name);
+    let what = match u.meeting {
+        md::law::Meeting::Spheres(i, j) => format!("{} and {}", body(i), body(j)),
+        md::law::Meeting::Image(i) => format!("{} and its symmetry image", body(i)),
+        md::law::Meeting::Wall(i, k) => format!("{} and {}", body(i), label("wall", k, &scene.walls[k].name)),
+    };
+    err(format!(
+        "contact: no [[contact]] between materials '{}' and '{}', which can touch ({what})",
+        scene.materials[u.a].name, scene.materials[u.b].name
+    ))
 }
 
 /// [`md::law::hertz_alpha_for_restitution`], remembered: each call integrates
