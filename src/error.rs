@@ -18,7 +18,16 @@ pub enum Error {
     /// The simulation produced a non-finite value or a runaway overlap. The system
     /// keeps the state of the last good step.
     #[error("step {step}: body {body} ('{name}'): {what}")]
-    Diverged { step: u64, body: usize, name: String, what: String },
+    Diverged {
+        /// The step being made (counted from the engine's step origin).
+        step: u64,
+        /// Index of the body in the engine (its order in the scene).
+        body: usize,
+        /// Its name.
+        name: String,
+        /// What went wrong (a non-finite value, a runaway overlap, …).
+        what: String,
+    },
     /// A file could not be read or written.
     #[error("{0}")]
     Io(#[from] std::io::Error),

@@ -55,6 +55,8 @@
 //! Steps can also be made one at a time ([`nscd::System::step`],
 //! [`md::MdSystem::step`]); `examples/library_run.rs` shows both engines.
 
+#![deny(missing_docs)]
+
 pub mod clock;
 pub mod error;
 pub mod geometry;

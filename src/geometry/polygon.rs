@@ -9,27 +9,42 @@ use serde::{Deserialize, Serialize};
 /// Why a shape was refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GeometryError {
+    /// Fewer than 3 vertices (the count given).
     #[error("a polygon needs at least 3 vertices, got {0}")]
     TooFewVertices(usize),
+    /// A vertex (its index) has a non-finite coordinate.
     #[error("vertex {0} is not finite")]
     NonFinite(usize),
+    /// Two vertices (their indices) coincide or are collinear with a neighbour.
     #[error("degenerate polygon: vertices {0} and {1} coincide or are collinear with their neighbour")]
     Degenerate(usize, usize),
+    /// The vertices turn clockwise (negative signed area).
     #[error("polygon vertices must be given counter-clockwise (signed area is negative)")]
     Clockwise,
+    /// The turn at a vertex (its index) is clockwise: not convex.
     #[error("non-convex polygon: the turn at vertex {0} is clockwise")]
     NonConvex(usize),
+    /// A disc or regular polygon radius (m) that is not positive and finite.
     #[error("radius must be positive and finite, got {0}")]
     BadRadius(f64),
+    /// A regular polygon with fewer than 3 sides (the count given).
     #[error("a regular polygon needs at least 3 sides, got {0}")]
     BadSides(usize),
+    /// A compound without parts.
     #[error("a compound needs at least one part")]
     NoParts,
+    /// A compound with more than [`Compound::MAX_PARTS`] parts (the count given).
     #[error("a compound has at most {max} parts, got {0}", max = Compound::MAX_PARTS)]
     TooManyParts(usize),
     /// Part `index` of a compound is refused.
     #[error("parts[{index}]: {source}")]
-    Part { index: usize, source: Box<GeometryError> },
+    Part {
+        /// Index of the part in the compound.
+        index: usize,
+        /// Why it was refused.
+        source: Box<GeometryError>,
+    },
+    /// Part `.0` of a compound has `.1` vertices, more than [`Compound::MAX_PART_VERTICES`].
     #[error("parts[{0}]: a part has at most {max} vertices, got {1}", max = Compound::MAX_PART_VERTICES)]
     PartTooManyVertices(usize, usize),
     /// Parts `.1` and `.0` (`.0 < .1`) overlap by a depth `.2` (m).
@@ -262,6 +277,7 @@ fn penetration(a: &ConvexPolygon, ca: Vec2, b: &ConvexPolygon, cb: Vec2) -> f64 
 /// A 2D body shape in its body frame (centroid at the origin).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub enum Shape {
+    /// A convex polygon.
     Polygon(ConvexPolygon),
     /// A disc of the given radius (m).
     Disc(f64),

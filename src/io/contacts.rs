@@ -46,31 +46,40 @@ pub enum ContactKind {
 /// One row of `contacts.csv` (see the module documentation for the columns).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ContactRow {
+    /// Column `kind`: pair, wall or image.
     pub kind: ContactKind,
     /// The body the force acts on.
     pub a: usize,
+    /// Name of body `a`.
     pub a_name: String,
     /// The other body, wall or imaged sphere.
     pub b: usize,
+    /// Name of `b` (a wall's or fixed body's name for a `wall` row).
     pub b_name: String,
-    /// Contact point (m); `z` empty in 2D.
+    /// Contact point, x (m).
     pub point_x_m: f64,
+    /// Contact point, y (m).
     pub point_y_m: f64,
+    /// Contact point, z (m); empty in 2D.
     pub point_z_m: Option<f64>,
-    /// Unit normal from `b` towards `a`; `z` empty in 2D.
+    /// Unit normal from `b` towards `a`, x component.
     pub normal_x: f64,
+    /// Unit normal, y component.
     pub normal_y: f64,
+    /// Unit normal, z component; empty in 2D.
     pub normal_z: Option<f64>,
     /// Gap (m), negative when overlapping.
     pub gap_m: f64,
     /// Normal force on `a` (N), positive when pushing the bodies apart.
     #[serde(rename = "f_n_N")]
     pub f_n: f64,
-    /// Tangential force on `a` (N); `z` empty in 2D.
+    /// Tangential force on `a`, x component (N).
     #[serde(rename = "f_t_x_N")]
     pub f_t_x: f64,
+    /// Tangential force on `a`, y component (N).
     #[serde(rename = "f_t_y_N")]
     pub f_t_y: f64,
+    /// Tangential force on `a`, z component (N); empty in 2D.
     #[serde(rename = "f_t_z_N")]
     pub f_t_z: Option<f64>,
 }

@@ -98,15 +98,20 @@ pub struct Axes {
 /// contact point with a wall, with the normal force (N) it carries.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ForceLine {
+    /// Start of the segment (m).
     pub from: [f64; 2],
+    /// End of the segment (m).
     pub to: [f64; 2],
+    /// Normal force it carries (N); sets the line width.
     pub normal_force: f64,
 }
 
 /// A grain's displacement (m) from its earlier centre `from` (m), for [`displacement_field`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Arrow {
+    /// Earlier centre (m).
     pub from: [f64; 2],
+    /// Displacement from it (m).
     pub displacement: [f64; 2],
 }
 

@@ -61,6 +61,7 @@ pub struct Kinematics {
 
 /// Normal and tangential force on the first body (N), and the scalar normal force.
 pub struct ContactForce {
+    /// Total contact force on the first body (N).
     pub force: V3,
     /// Tangential part of `force` (N), for the torques.
     pub tangential: V3,

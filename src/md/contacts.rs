@@ -31,12 +31,23 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum MdContactKind {
     /// Another sphere, `j > sphere` (each pair once; it gets the opposite force).
-    Pair { j: usize },
+    Pair {
+        /// The other sphere's index.
+        j: usize,
+    },
     /// The image of sphere `origin` through the symmetry planes of bit mask
     /// `planes` (bit `s`: plane `s` of [`super::Ghosts::planes`]).
-    Image { origin: usize, planes: u32 },
+    Image {
+        /// Index of the imaged sphere.
+        origin: usize,
+        /// Bit mask of the planes it is mirrored through.
+        planes: u32,
+    },
     /// Wall `wall` (its index in [`MdSystem::walls`]).
-    Wall { wall: usize },
+    Wall {
+        /// The wall's index.
+        wall: usize,
+    },
 }
 
 /// One contact of the last force evaluation, as seen from outside (SI).

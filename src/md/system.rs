@@ -237,11 +237,17 @@ pub const ENERGY_GROWTH: f64 = 10.0;
 /// A 3D MD system of spheres and walls.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct MdSystem {
+    /// Time step, integrator, damping, gravity, neighbour skin, threads.
     pub settings: MdSettings,
+    /// The spheres: positions, velocities, orientations, forces, masses (struct of arrays).
     pub particles: Particles,
+    /// Planes, discs, cylinders and servo walls.
     pub walls: Vec<Wall>,
+    /// Contact law of every pair of materials.
     pub laws: LawTable,
+    /// Symmetry planes and the images of the spheres near them.
     pub ghosts: Ghosts,
+    /// Verlet neighbour list (with its skin) and the pairs' tangential memory.
     pub neighbours: Neighbours,
     /// Time (s) at the end of the last step: `time_origin + (step − step_origin) dt`
     /// ([`crate::clock`]), never accumulated.
@@ -251,6 +257,7 @@ pub struct MdSystem {
     /// Time (s) and step at which the time step last changed ([`MdSystem::set_dt`]).
     #[serde(default)]
     pub time_origin: f64,
+    /// Step count at which the time step last changed.
     #[serde(default)]
     pub step_origin: u64,
     /// Mechanical energy `E_k + E_g + E_el` (J) when the system was built or its

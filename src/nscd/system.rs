@@ -87,14 +87,17 @@ impl NscdParams {
 pub struct StepStats {
     /// Time at the end of the step (s).
     pub time: f64,
+    /// Steps made by the system, this one included.
     pub step: u64,
     /// Contacts detected (open ones within the alert distance included).
     pub contacts: usize,
     /// Contacts carrying a force or overlapping at the end of the step.
     pub active_contacts: usize,
+    /// NLGS sweeps made.
     pub iterations: usize,
     /// Final value of the convergence norm.
     pub criterion: f64,
+    /// Whether the policy met its tolerance before `max_iterations`.
     pub converged: bool,
     /// Mean overlap over the active contacts at the end of the step (m).
     pub mean_overlap: f64,
@@ -110,15 +113,20 @@ pub struct StepStats {
 /// A contact as seen from outside, with its force over the last step.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ContactInfo {
+    /// Body index of the candidate (the body the force acts on).
     pub candidate: usize,
+    /// Body index of the antagonist.
     pub antagonist: usize,
-    /// Point (m) and unit normal towards the candidate, at `q_m`.
+    /// Contact point at `q_m` (m).
     pub point: [f64; 2],
+    /// Unit normal towards the candidate, at `q_m`.
     pub normal: [f64; 2],
     /// Gap at `q_m` (m).
     pub gap: f64,
     /// Mean normal and tangential force on the candidate over the step (N).
     pub r_n: f64,
+    /// Mean tangential force on the candidate over the step (N), along the
+    /// normal turned by +90°.
     pub r_t: f64,
 }
 
@@ -140,24 +148,32 @@ pub(crate) struct Workspace {
 /// The complete state of an NSCD simulation.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct System {
+    /// Time step, θ, gravity, alert distance, NLGS settings.
     pub params: NscdParams,
+    /// The bodies: shapes, masses, positions `q` (x, y, θ) and velocities `u`.
     pub bodies: Bodies,
+    /// Sublayer springs (law (17) of Saussine et al. 2006).
     pub springs: Vec<Spring>,
     /// Contact law of material pair `(i, j)` at `i * materials + j`.
     pub laws: Vec<ContactLaw>,
+    /// Number of materials.
     pub materials: usize,
     /// Time (s) and number of steps done. The time is recomputed each step as
     /// `time_origin + (step − step_origin) · dt`, never accumulated, so it does not
     /// drift over millions of steps; [`System::set_dt`] rebases the origin.
     pub time: f64,
+    /// Steps done.
     pub step: u64,
+    /// Time (s) at which the time step last changed.
     #[serde(default)]
     pub time_origin: f64,
+    /// Step count at which the time step last changed.
     #[serde(default)]
     pub step_origin: u64,
     /// Contacts of the last step and their impulses `(P_N, P_T)` (N·s), sorted by
     /// key: the warm start of the next step.
     pub contacts: Vec<ContactGeom>,
+    /// Impulses `(P_N, P_T)` (N·s) of `contacts`, in the same order.
     pub impulses: Vec<[f64; 2]>,
     /// Zero of the gravitational energy, as a height along `−g` (m): the lowest
     /// point of the non-fixed bodies when the first step is made (fixed for the
