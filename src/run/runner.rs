@@ -632,6 +632,9 @@ pub fn check_options(opts: &RunOptions) -> Result<()> {
             opts.checkpoint_every_s
         )));
     }
+    if opts.figures {
+        crate::io::figures::require()?;
+    }
     if opts.threads == 0 {
         return Err(Error::Scene("--threads: must be at least 1, got 0".into()));
     }

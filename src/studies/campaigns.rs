@@ -324,6 +324,7 @@ pub struct ConvergenceSpec {
 /// (before any run) or an invalid checkpoint; a run that fails is reported in
 /// the table instead; an output that cannot be written is an [`Error::Io`].
 pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
+    crate::io::figures::require()?; // the stage ends with its figures
     let runs: Vec<(String, f64)> = if spec.policies.is_empty() {
         PAPER_POLICIES.iter().map(|&(p, t)| (p.to_string(), t)).collect()
     } else {
@@ -403,6 +404,7 @@ pub struct StepsSpec {
 /// # Errors
 /// As [`convergence`]; a time step that is not positive is an [`Error::Scene`].
 pub fn steps(spec: &StepsSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
+    crate::io::figures::require()?; // the stage ends with its figures
     let (dts, inclinations) = (&spec.dts, &spec.inclinations);
     if let Some(dt) = dts.iter().find(|dt| !(dt.is_finite() && **dt > 0.0)) {
         return Err(Error::Scene(format!("--dts: every time step must be positive, got {dt}")));
@@ -516,6 +518,7 @@ pub struct EnsembleSpec {
 /// an [`Error::Scene`], and so is an invalid loading or option, before any
 /// deposit. A deposit that fails stops the study.
 pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
+    crate::io::figures::require()?; // the stage ends with its figures
     let factors = &spec.factors;
     if spec.samples == 0 {
         return Err(Error::Scene("--samples: must be at least 1".into()));

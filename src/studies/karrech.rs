@@ -49,6 +49,7 @@ impl Default for Deposit {
 /// positive, or for an invalid scene or checkpoint; else as
 /// [`crate::run::Runner::run`], or an output that cannot be written or read back.
 pub fn deposit(spec: &Deposit, stage: &Stage, display: &dyn RunDisplay) -> Result<StageOutcome> {
+    crate::io::figures::require()?; // the stage ends with its figures
     let Deposit { spheres, seed, dt, duration, young } = *spec;
     if spheres == 0 || !(dt > 0.0 && duration > 0.0 && young > 0.0) {
         return Err(Error::Scene(format!(
@@ -79,6 +80,7 @@ pub fn load(
     stage: &Stage,
     display: &dyn RunDisplay,
 ) -> Result<StageOutcome> {
+    crate::io::figures::require()?; // the stage ends with its figures
     let sys = final_state(from)?;
     let v = TestSpec::read(from)?;
     let paper = Deposit::default();

@@ -90,6 +90,7 @@ pub struct CompareRow {
 /// friction or a duration that is not positive, or for an invalid scene or
 /// checkpoint; else as [`crate::run::Runner::run`].
 pub fn compress(spec: &Compression, stage: &Stage, display: &dyn RunDisplay) -> Result<StageOutcome> {
+    crate::io::figures::require()?; // the stage ends with its figures
     let Compression { spheres, friction, seed, duration } = *spec;
     if spheres == 0 || !(friction >= 0.0 && duration > 0.0) {
         return Err(Error::Scene(format!(
@@ -116,6 +117,7 @@ pub fn compress(spec: &Compression, stage: &Stage, display: &dyn RunDisplay) -> 
 /// invalid scene or checkpoint; else as [`crate::run::Runner::run`], or an
 /// output that cannot be written or read back.
 pub fn cycle(from: &Path, cycles: u32, stage: &Stage, display: &dyn RunDisplay) -> Result<StageOutcome> {
+    crate::io::figures::require()?; // the stage ends with its figures
     let sys = final_state(from)?;
     let v = TestSpec::read(from)?;
     let spec = LudingSpec::paper(sys.particles.len(), v.friction.unwrap_or(0.1), v.seed);
@@ -146,6 +148,7 @@ pub fn cycle(from: &Path, cycles: u32, stage: &Stage, display: &dyn RunDisplay) 
 /// [`Error::Scene`] naming a folder that is not the output of [`cycle`];
 /// [`Error::Io`] if a run's tables cannot be read or an output written.
 pub fn compare(runs: &[PathBuf], out: &Path) -> Result<Vec<String>> {
+    crate::io::figures::require()?; // the stage ends with its figures
     crate::io::create_output_dir(out)?;
     let mut table = Vec::new();
     let (mut strain, mut loops) = (Vec::new(), Vec::new());
