@@ -1297,6 +1297,11 @@ const DEFAULTED: &[&str] = &[
     "system.force_x",
 ];
 
+/// Keys whose legitimate values include a non-finite number, which JSON writes
+/// as `null` and reads back as one (the smallest load of a cycle starts at +∞):
+/// `null` there is a value like any other, not a malformed field.
+const NON_FINITE: &[&str] = &["cycles.min_load"];
+
 fn under(norm: &str, list: &[&str]) -> bool {
     list.iter().any(|p| norm == *p || norm.starts_with(&format!("{p}.")) || norm.starts_with(&format!("{p}[")))
         || list.iter().any(|p| p.ends_with("[]") && norm.starts_with(p))
@@ -1308,7 +1313,7 @@ fn must_refuse(norm: &str, op: Op) -> bool {
     match op {
         _ if top && op != Op::Value && op != Op::Huge => true,
         _ if under(norm, COUNTERS) => true,
-        Op::Null => true,
+        Op::Null => !under(norm, NON_FINITE),
         Op::Text | Op::Type => true,
         Op::Length => !under(norm, FREE_LENGTH),
         Op::Delete => !under(norm, DEFAULTED),

@@ -203,8 +203,9 @@ pub(crate) fn print_outcome(o: &RunOutcome) {
             let solver = match r.unconverged_steps {
                 Some(0) => ", every step converged".to_string(),
                 Some(n) => format!(
-                    ", {n} steps stopped at the iteration cap before the solver's tolerance (see README, \
-                     \"not converged\")"
+                    ", {n} steps stopped at the iteration cap before the solver's tolerance (worst final criterion \
+                     {:.3e}; see README, \"not converged\")",
+                    r.worst_unconverged_criterion.unwrap_or(0.0)
                 ),
                 None => String::new(),
             };

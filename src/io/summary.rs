@@ -30,6 +30,10 @@ pub struct StepSummary {
     pub iterations: u64,
     /// Whether the solver met its tolerance (NSCD; always true for MD).
     pub converged: bool,
+    /// Final value of the solver's convergence norm (NSCD, dimensionless, to
+    /// compare with its tolerance; 0 for MD).
+    #[serde(default)]
+    pub criterion: f64,
 }
 
 /// Running sums over the steps of a run.
@@ -51,6 +55,10 @@ pub struct RunSummary {
     /// Steps that hit the iteration cap (NSCD): the solver stopped at
     /// `max_iterations` before meeting its tolerance.
     pub unconverged: u64,
+    /// Largest final convergence norm of those steps (NSCD, dimensionless; 0
+    /// when every step converged).
+    #[serde(default)]
+    pub worst_unconverged_criterion: f64,
     /// State of the equilibrium rule.
     pub equilibrium: EquilibriumWatch,
     /// Wall time spent stepping so far, over every invocation (s).
@@ -67,6 +75,9 @@ impl RunSummary {
         self.contacts += s.contacts;
         self.iterations += s.iterations;
         self.unconverged += u64::from(!s.converged);
+        if !s.converged && s.criterion > self.worst_unconverged_criterion {
+            self.worst_unconverged_criterion = s.criterion;
+        }
     }
 }
 
@@ -125,6 +136,11 @@ pub struct RunReport {
     /// `max_iterations` before meeting its tolerance).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unconverged_steps: Option<u64>,
+    /// NSCD: the largest final convergence norm among those steps
+    /// (dimensionless, against the policy's tolerance); absent when every step
+    /// converged.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub worst_unconverged_criterion: Option<f64>,
     /// Whether the run stopped on its equilibrium rule.
     pub equilibrium: bool,
 }
@@ -166,7 +182,37 @@ impl RunReport {
             final_max_overlap_m: s.final_max_overlap,
             mean_iterations: iterations.then(|| per_step(s.iterations as f64)),
             unconverged_steps: iterations.then_some(s.unconverged),
+            worst_unconverged_criterion: (iterations && s.unconverged > 0).then_some(s.worst_unconverged_criterion),
             equilibrium: end == RunEnd::Equilibrium,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The worst criterion is the largest final norm among the steps that hit
+    /// the cap only: a converged step with a larger norm (a looser policy) does
+    /// not count.
+    #[test]
+    fn the_worst_unconverged_criterion_counts_capped_steps_only() {
+        let mut run = RunSummary::default();
+        let step = |criterion: f64, converged: bool| StepSummary {
+            criterion,
+            converged,
+            iterations: 5,
+            ..StepSummary::default()
+        };
+        run.add(&step(0.5, true));
+        assert_eq!((run.unconverged, run.worst_unconverged_criterion), (0, 0.0));
+        run.add(&step(2e-4, false));
+        run.add(&step(7e-4, false));
+        run.add(&step(3e-4, false));
+        run.add(&step(0.9, true));
+        assert_eq!((run.unconverged, run.worst_unconverged_criterion), (3, 7e-4));
+        let report = |run: &RunSummary| RunReport::new("nscd", true, run, RunEnd::Finished, 1, 1, 1e-3, 1.0, None);
+        assert_eq!(report(&run).worst_unconverged_criterion, Some(7e-4));
+        assert_eq!(report(&RunSummary::default()).worst_unconverged_criterion, None);
     }
 }

@@ -71,6 +71,7 @@ impl Engine for MdSystem {
             max_overlap: s.max_overlap,
             iterations: 0,
             converged: true,
+            criterion: 0.0,
         }
     }
 

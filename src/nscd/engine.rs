@@ -58,6 +58,7 @@ impl Engine for System {
             max_overlap: s.max_overlap,
             iterations: s.iterations as u64,
             converged: s.converged,
+            criterion: s.criterion,
         }
     }
 
