@@ -10,14 +10,15 @@
 # rate = median over the 3 `run` segments of in.dense of N*S/X, where X, S come from
 # "Loop time of X on 1 procs for S steps with N atoms".  Details go to stderr.
 #
-# Env: PEERS_DIR (default /work/peers-run), NSTEPS (default 10000 per segment),
+# Env: PEERS_DIR (default target/peers-run in the repository), NSTEPS (default 10000 per segment),
 #      REPEAT (default 1: repeat each in.dense this many times),
 #      LMP, LIGGGHTS (executables), MODELS (LAMMPS models, default "0";
 #      "0 1" also times `granular hertz/material` if settled_N_1.restart exists),
 #      LAMMPS_NP (default 1; >1 runs LAMMPS under mpirun -np with `processors * 1 1`,
 #      code name lammps-npK).
 set -u
-PEERS_DIR=${PEERS_DIR:-/work/peers-run}
+ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+PEERS_DIR=${PEERS_DIR:-$ROOT/target/peers-run}
 NSTEPS=${NSTEPS:-10000}
 REPEAT=${REPEAT:-1}
 MODELS=${MODELS:-0}
