@@ -59,6 +59,19 @@ impl Policy {
     }
 }
 
+/// Where the norms of a sweep are measured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Measure {
+    /// During the updating sweep, each row's correction when it is visited (no extra
+    /// pass; the default).
+    #[default]
+    Sweep,
+    /// In a separate pass after the sweep that solves every row from the current
+    /// iterate and updates nothing (LMGC90's check).
+    Check,
+}
+
 /// Running sums over one sweep.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SweepNorms {

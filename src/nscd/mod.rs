@@ -58,7 +58,7 @@ pub mod system;
 
 pub use bodies::{Bodies, BodyInfo};
 pub use contact::ContactLaw;
-pub use criterion::Policy;
+pub use criterion::{Measure, Policy};
 pub use loads::{Harmonic, Imposed, Load};
 pub use nlgs::NlgsSettings;
 pub use sublayer::Spring;

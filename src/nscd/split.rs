@@ -26,7 +26,7 @@
 
 use super::contact::ContactRow;
 use super::criterion::SweepNorms;
-use super::nlgs::sweep;
+use super::nlgs::{pass, Pass};
 use super::sublayer::SpringRow;
 use crate::team::Team;
 
@@ -50,8 +50,8 @@ struct Part {
 }
 
 impl Part {
-    fn sweep(&mut self, backwards: bool) -> SweepNorms {
-        sweep(&mut self.u, &self.inv_m, &mut self.rows, &mut self.springs, backwards)
+    fn pass(&mut self, kind: Pass) -> SweepNorms {
+        pass(kind, &mut self.u, &self.inv_m, &mut self.rows, &mut self.springs)
     }
 
     fn clear(&mut self) {
@@ -229,17 +229,21 @@ impl SplitWorkspace {
 
     /// Runs `sweeps` with a function doing one split sweep (on one thread, or on
     /// two when `threads ≥ 2`), then nothing more: call [`Self::store`] after.
-    pub(crate) fn run<R>(&mut self, threads: usize, sweeps: impl FnOnce(&mut dyn FnMut(bool) -> SweepNorms) -> R) -> R {
+    pub(crate) fn run<R>(&mut self, threads: usize, sweeps: impl FnOnce(&mut dyn FnMut(Pass) -> SweepNorms) -> R) -> R {
         if (threads >= 2) != (self.team.threads() >= 2) {
             self.team = Team::new(threads);
         }
         let Self { left, right, iface, side, slot, team, .. } = self;
         let (side, slot) = (&side[..], &slot[..]);
-        sweeps(&mut |backwards| {
+        sweeps(&mut |kind| {
             // Left and right side by side (in turn on one thread), then the interface.
-            let (l, r) = team.join(|| left.sweep(backwards), || right.sweep(backwards));
+            // A check updates nothing: the interface bodies' velocities are already equal.
+            let (l, r) = team.join(|| left.pass(kind), || right.pass(kind));
+            if kind == Pass::Check {
+                return merge(merge(l, r), iface.pass(kind));
+            }
             Self::exchange(left, right, iface, side, slot, true);
-            let i = iface.sweep(backwards);
+            let i = iface.pass(kind);
             Self::exchange(left, right, iface, side, slot, false);
             merge(merge(l, r), i)
         })

@@ -67,6 +67,10 @@ pub struct NscdSection {
     /// Alternate forward and backward NLGS sweeps (symmetric Gauss–Seidel); default false.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub symmetric: Option<bool>,
+    /// Where the convergence norms are measured: `"sweep"` (during the updating
+    /// sweep) or `"check"` (a separate pass after it that updates nothing, as LMGC90).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measure: Option<String>,
     /// Alert distance (m), ≥ 0; default: [`crate::nscd::system::DEFAULT_ALERT_FRACTION`] times the
     /// smallest inner radius of the non-fixed bodies (of all bodies if none moves).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -7,7 +7,7 @@
 use super::format::{BodySpec, Drive, NscdSection, Scene};
 use crate::error::{Error, Result};
 use crate::geometry::{rotate, Compound, ConvexPolygon, GeometryError, Shape, Vec2};
-use crate::nscd::{NlgsSettings, NscdParams, Policy};
+use crate::nscd::{Measure, NlgsSettings, NscdParams, Policy};
 use std::collections::HashMap;
 
 /// Largest number of steps a scene may ask for (2⁵³, where `f64` stops counting exactly).
@@ -277,6 +277,19 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
     if !(max_factor.is_finite() && max_factor >= 1.0) {
         return err(format!("nscd.max_factor: must be finite and at least 1, got {}", num(max_factor)));
     }
+    let measure = match ns.measure.as_deref() {
+        None => defaults.nlgs.measure,
+        Some("sweep") => Measure::Sweep,
+        Some("check") => Measure::Check,
+        Some(m) => {
+            return err(format!("nscd.measure: unknown value '{}', expected 'sweep' or 'check'", super::clip(m)))
+        }
+    };
+    if measure == Measure::Check && policy == Policy::Energy {
+        return err("nscd.measure: 'check' measures a residual (strict, quad, quad_max); the energy criterion \
+                    is a change from sweep to sweep, measured during the sweeps: remove the key or use 'sweep'"
+            .to_string());
+    }
     if let Some(a) = ns.alert_distance {
         non_negative("nscd.alert_distance", a)?;
         if a > MAX_LENGTH {
@@ -291,6 +304,7 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
         max_factor,
         symmetric: ns.symmetric.unwrap_or(false),
         split_min_rows: defaults.nlgs.split_min_rows,
+        measure,
     };
 
     Ok((theta, nlgs))
