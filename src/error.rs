@@ -28,6 +28,23 @@ pub enum Error {
         /// What went wrong (a non-finite value, a runaway overlap, …).
         what: String,
     },
+    /// An NSCD step reached its sweep cap short of the tolerance and the scene asked
+    /// to stop then (`[nscd] on_stall = "stop"`). The system keeps the state of the
+    /// last good step.
+    #[error(
+        "step {step}: the NLGS stalled: criterion {criterion:.3e} after {iterations} sweeps, tolerance {tolerance:e} \
+         (nscd.on_stall = \"stop\"; raise nscd.max_iterations, use on_stall = \"extend\" or \"accept\", or see README, \"not converged\")"
+    )]
+    Stalled {
+        /// The step being made (counted from the engine's step origin).
+        step: u64,
+        /// Sweeps made.
+        iterations: usize,
+        /// The policy's value after the last sweep (dimensionless).
+        criterion: f64,
+        /// The policy's tolerance.
+        tolerance: f64,
+    },
     /// A file could not be read or written.
     #[error("{0}")]
     Io(#[from] std::io::Error),

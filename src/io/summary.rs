@@ -67,14 +67,15 @@ pub struct RunSummary {
 
 impl RunSummary {
     /// Adds one step.
+    /// The counters saturate: a resumed summary may carry any value.
     pub fn add(&mut self, s: &StepSummary) {
-        self.steps += 1;
+        self.steps = self.steps.saturating_add(1);
         self.max_overlap = self.max_overlap.max(s.max_overlap);
         self.final_max_overlap = s.max_overlap;
         self.sum_mean_overlap += s.mean_overlap;
         self.contacts += s.contacts;
-        self.iterations += s.iterations;
-        self.unconverged += u64::from(!s.converged);
+        self.iterations = self.iterations.saturating_add(s.iterations);
+        self.unconverged = self.unconverged.saturating_add(u64::from(!s.converged));
         if !s.converged && s.criterion > self.worst_unconverged_criterion {
             self.worst_unconverged_criterion = s.criterion;
         }
@@ -91,6 +92,9 @@ pub enum RunEnd {
     Equilibrium,
     /// A step diverged: the outputs hold the last good step.
     Diverged,
+    /// An NSCD step stalled short of its tolerance under `on_stall = "stop"`: the
+    /// outputs hold the last good step.
+    Stalled,
 }
 
 /// Contents of `summary.json`.

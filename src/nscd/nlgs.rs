@@ -45,9 +45,53 @@ pub struct NlgsSettings {
     /// [`DEFAULT_SPLIT_MIN_ROWS`].
     #[serde(default = "default_split_min_rows")]
     pub split_min_rows: usize,
-    /// Where the policy's norms are measured ([`Measure`]); default [`Measure::Sweep`].
+    /// Where the policy's norms are measured ([`Measure`]); default [`Measure::Check`]
+    /// (the energy policy is always measured over the sweeps).
     #[serde(default)]
     pub measure: Measure,
+    /// What a step does when `max_iterations` sweeps have not met the tolerance
+    /// ([`OnStall`]); default [`OnStall::Accept`].
+    #[serde(default)]
+    pub on_stall: OnStall,
+    /// [`OnStall::Extend`]: sweeps made at most in all, ≥ `max_iterations`;
+    /// default 10 × the default `max_iterations`.
+    #[serde(default = "default_stall_max_iterations")]
+    pub stall_max_iterations: usize,
+}
+
+/// What a step does when its sweeps reach `max_iterations` without meeting the
+/// tolerance (a *stalled* step).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum OnStall {
+    /// Keep the impulses of the last sweep and go on; the step is counted as not
+    /// converged and its final criterion reported (the default).
+    #[default]
+    Accept,
+    /// Keep iterating, up to `stall_max_iterations` sweeps in all; a step still
+    /// short of the tolerance then is accepted as with [`OnStall::Accept`].
+    Extend,
+    /// Stop the run with [`crate::Error::Stalled`]; the system keeps the state of
+    /// the start of the step.
+    Stop,
+}
+
+impl OnStall {
+    /// The name in scenes (`accept`, `extend`, `stop`).
+    pub fn name(self) -> &'static str {
+        match self {
+            OnStall::Accept => "accept",
+            OnStall::Extend => "extend",
+            OnStall::Stop => "stop",
+        }
+    }
+}
+
+/// Default of [`NlgsSettings::stall_max_iterations`].
+pub const DEFAULT_STALL_MAX_ITERATIONS: usize = 10_000;
+
+fn default_stall_max_iterations() -> usize {
+    DEFAULT_STALL_MAX_ITERATIONS
 }
 
 /// Default of [`NlgsSettings::split_min_rows`]: below it a sweep is too short
@@ -69,6 +113,8 @@ impl Default for NlgsSettings {
             symmetric: false,
             split_min_rows: DEFAULT_SPLIT_MIN_ROWS,
             measure: Measure::default(),
+            on_stall: OnStall::default(),
+            stall_max_iterations: DEFAULT_STALL_MAX_ITERATIONS,
         }
     }
 }
@@ -295,7 +341,9 @@ fn iterate(settings: &NlgsSettings, mut pass: impl FnMut(Pass) -> SweepNorms) ->
     let mut ratio = FIRST_CHECK_RATIO;
     let mut previous_wpp = 0.0;
     let mut report = NlgsReport::default();
-    for it in 1..=s.max_iterations {
+    let cap =
+        if s.on_stall == OnStall::Extend { s.stall_max_iterations.max(s.max_iterations) } else { s.max_iterations };
+    for it in 1..=cap {
         let kind = if s.symmetric && it % 2 == 0 { Pass::Backward } else { Pass::Forward };
         let norms = pass(kind);
         let (mut value, mut ok) = evaluate(s.policy, s.tolerance, s.max_factor, &norms, previous_wpp);
@@ -303,7 +351,7 @@ fn iterate(settings: &NlgsSettings, mut pass: impl FnMut(Pass) -> SweepNorms) ->
         if checked {
             // The sweep's norm predicts the check's through the last measured ratio;
             // the check runs when the prediction meets the tolerance, and at the cap.
-            let due = it >= s.min_iterations && (ratio * value < s.tolerance || it == s.max_iterations);
+            let due = it >= s.min_iterations && (ratio * value < s.tolerance || it == s.max_iterations || it == cap);
             if due {
                 let (check, check_ok) = evaluate(s.policy, s.tolerance, s.max_factor, &pass(Pass::Check), 0.0);
                 if value > 0.0 && check.is_finite() {

@@ -8,7 +8,8 @@
 //!    impulses of the previous step matched by contact key;
 //! 5. `q_f = q_m + θ h u_f`.
 //!
-//! After the step the state is checked: a non-finite value or an overlap deeper
+//! A step whose sweeps stop short of the tolerance goes on, is extended or stops
+//! the run ([`super::nlgs::OnStall`]). After the step the state is checked: a non-finite value or an overlap deeper
 //! than half the smaller inradius of the two bodies stops the run with an error
 //! naming the step and body, and the state goes back to the start of the step.
 
@@ -117,6 +118,18 @@ impl System {
             &mut ws.rows,
             &mut ws.spring_rows,
         );
+
+        if !report.converged && self.params.nlgs.on_stall == super::nlgs::OnStall::Stop {
+            self.bodies.q.clone_from(&ws.q_i);
+            self.bodies.u.clone_from(&ws.u_i);
+            self.ws = ws;
+            return Err(Error::Stalled {
+                step: self.step + 1,
+                iterations: report.iterations,
+                criterion: report.criterion,
+                tolerance: self.params.nlgs.tolerance,
+            });
+        }
 
         // 5. Final configuration.
         for ((q, qm), u) in self.bodies.q.iter_mut().zip(&ws.q_m).zip(&self.bodies.u) {

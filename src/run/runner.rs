@@ -348,6 +348,7 @@ impl<E: Engine> Runner<E> {
         }
         live.summary.wall_time_s = wall0 + started.elapsed().as_secs_f64();
         let end = match (&diverged, at_equilibrium) {
+            (Some(Error::Stalled { .. }), _) => RunEnd::Stalled,
             (Some(_), _) => RunEnd::Diverged,
             (None, true) => RunEnd::Equilibrium,
             (None, false) => RunEnd::Finished,

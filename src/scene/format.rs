@@ -71,6 +71,13 @@ pub struct NscdSection {
     /// sweep) or `"check"` (a separate pass after it that updates nothing, as LMGC90).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub measure: Option<String>,
+    /// What a step does when `max_iterations` sweeps stop short of the tolerance:
+    /// `"accept"` (default), `"extend"` (up to `stall_max_iterations` sweeps) or `"stop"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub on_stall: Option<String>,
+    /// `on_stall = "extend"`: sweeps made at most in all, ≥ `max_iterations`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stall_max_iterations: Option<usize>,
     /// Alert distance (m), ≥ 0; default: [`crate::nscd::system::DEFAULT_ALERT_FRACTION`] times the
     /// smallest inner radius of the non-fixed bodies (of all bodies if none moves).
     #[serde(default, skip_serializing_if = "Option::is_none")]

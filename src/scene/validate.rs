@@ -7,6 +7,7 @@
 use super::format::{BodySpec, Drive, NscdSection, Scene};
 use crate::error::{Error, Result};
 use crate::geometry::{rotate, Compound, ConvexPolygon, GeometryError, Shape, Vec2};
+use crate::nscd::nlgs::OnStall;
 use crate::nscd::{Measure, NlgsSettings, NscdParams, Policy};
 use std::collections::HashMap;
 
@@ -290,6 +291,28 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
                     is a change from sweep to sweep, measured during the sweeps: remove the key or use 'sweep'"
             .to_string());
     }
+    let on_stall = match ns.on_stall.as_deref() {
+        None => defaults.nlgs.on_stall,
+        Some("accept") => OnStall::Accept,
+        Some("extend") => OnStall::Extend,
+        Some("stop") => OnStall::Stop,
+        Some(m) => {
+            return err(format!(
+                "nscd.on_stall: unknown value '{}', expected 'accept', 'extend' or 'stop'",
+                super::clip(m)
+            ))
+        }
+    };
+    let stall_max_iterations =
+        ns.stall_max_iterations.unwrap_or(defaults.nlgs.stall_max_iterations.max(max_iterations));
+    if stall_max_iterations < max_iterations {
+        return err(format!(
+            "nscd.stall_max_iterations: must be at least max_iterations = {max_iterations}, got {stall_max_iterations}"
+        ));
+    }
+    if ns.stall_max_iterations.is_some() && on_stall != OnStall::Extend {
+        return err("nscd.stall_max_iterations: only used with on_stall = \"extend\"".to_string());
+    }
     if let Some(a) = ns.alert_distance {
         non_negative("nscd.alert_distance", a)?;
         if a > MAX_LENGTH {
@@ -305,6 +328,8 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
         symmetric: ns.symmetric.unwrap_or(false),
         split_min_rows: defaults.nlgs.split_min_rows,
         measure,
+        on_stall,
+        stall_max_iterations,
     };
 
     Ok((theta, nlgs))

@@ -21,7 +21,7 @@ pub fn params(dt: f64) -> NscdParams {
             max_factor: 4.0,
             symmetric: false,
             split_min_rows: ballast::nscd::nlgs::DEFAULT_SPLIT_MIN_ROWS,
-            measure: ballast::nscd::Measure::Sweep,
+            ..NlgsSettings::default()
         },
     }
 }
