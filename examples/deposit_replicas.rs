@@ -13,7 +13,7 @@
 //! writes `OUT/<order>-<i>/` for each replica and prints one CSV line per run
 //! (replica 0 is the unperturbed start).
 
-use ballast::run::{Engine, RunOptions, Runner};
+use ballast::run::{RunOptions, Runner};
 use ballast::scene::Scene;
 use ballast::studies::replicas::{perturb_scene, Perturbation, DEFAULT_PERTURB_SEED};
 use std::path::PathBuf;
