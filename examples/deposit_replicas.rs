@@ -1,6 +1,9 @@
 //! The noise floor of a deposit: the same NSCD scene run to its end (or its
-//! equilibrium) from starts perturbed by `PERTURBATION` (each mobile body moved
-//! by a random vector of that length, seeded), in the split NLGS order
+//! equilibrium) from starts perturbed by at most `PERTURBATION` (each mobile
+//! body moved uniformly in the disc of that radius,
+//! `ballast::studies::replicas::perturb_scene`, seed `PERTURB_SEED`, replica i
+//! on stream i; before the library had it, each body moved by exactly that
+//! length, seeded by i, so older replicas are other draws), in the split NLGS order
 //! (`split`: every problem split), the plain one (`serial`: none) or the
 //! default (`default`: problems of 512 rows or more), so that a change of one
 //! number of a single run (steps to equilibrium, final overlap) can be told
@@ -10,12 +13,12 @@
 //! writes `OUT/<order>-<i>/` for each replica and prints one CSV line per run
 //! (replica 0 is the unperturbed start).
 
-use ballast::run::{Engine, RunOptions, Runner};
+use ballast::run::{RunOptions, Runner};
 use ballast::scene::Scene;
-use rand::{RngExt, SeedableRng};
+use ballast::studies::replicas::{perturb_scene, Perturbation, DEFAULT_PERTURB_SEED};
 use std::path::PathBuf;
 
-/// Length of each body's start displacement, m (the guide's replica size).
+/// Largest start displacement of each body, m (the guide's replica size).
 const PERTURBATION: f64 = 1e-9;
 
 fn main() -> Result<(), ballast::Error> {
@@ -32,26 +35,19 @@ fn main() -> Result<(), ballast::Error> {
     println!(
         "order,replica,end,steps,time_s,final_max_overlap_m,run_max_overlap_m,unconverged_steps,mean_iterations,wall_s"
     );
+    let perturbation = Perturbation { distance_m: PERTURBATION, seed: DEFAULT_PERTURB_SEED };
     for i in first..first + replicas {
-        let mut sys = scene.build()?;
+        let mut start = scene.clone();
+        perturb_scene(&mut start, &perturbation, i as u64)?; // replica 0: unchanged
+        let mut sys = start.build()?;
         match order {
             "serial" => sys.params.nlgs.split_min_rows = 0,
             "split" => sys.params.nlgs.split_min_rows = 1,
             _ => {}
         }
         sys.set_threads(1);
-        if i > 0 {
-            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(i as u64);
-            let mut c = sys.configuration();
-            for b in 0..c.bodies.len() {
-                let a: f64 = rng.random_range(0.0..std::f64::consts::TAU);
-                c.q[3 * b] += PERTURBATION * a.cos();
-                c.q[3 * b + 1] += PERTURBATION * a.sin();
-            }
-            sys.set_configuration(&c)?;
-        }
         let dir = out.join(format!("{order}-{i}"));
-        let run = Runner::from_system(sys, scene.plan()?)?.run(&dir, &RunOptions::default(), &mut |_| {})?;
+        let run = Runner::from_system(sys, start.plan()?)?.run(&dir, &RunOptions::default(), &mut |_| {})?;
         let series = ballast::io::series::read_nscd(&dir.join("series.csv"))?;
         let last = series.last().expect("a run writes at least one row");
         let r = &run.report;

@@ -23,7 +23,14 @@ const REDUCTIONS: &[(&str, &[(&str, &str)])] = &[
     ("saussine settle", &[("--cycles", "1"), ("--dt", "1e-3"), ("--bars", "0"), ("--quiet", "")]),
     (
         "saussine convergence",
-        &[("--policies", "quad:1e-2"), ("--cycles", "1"), ("--dt", "1e-3"), ("--bars", "0"), ("--quiet", "")],
+        &[
+            ("--policies", "quad:1e-2"),
+            ("--cycles", "1"),
+            ("--dt", "1e-3"),
+            ("--bars", "0"),
+            ("--quiet", ""),
+            ("--replicas", "2"),
+        ],
     ),
     (
         "saussine steps",

@@ -10,6 +10,7 @@ use ballast::scene::Scene;
 use ballast::studies::campaigns::{self, ConvergenceSpec, EnsembleRow, EnsembleSpec, StudyOptions};
 use ballast::studies::luding::{self, CompareRow, Compression, LoopRow, StrainRow};
 use ballast::studies::md_stage::{Stage, TestSpec};
+use ballast::studies::replicas::Replicas;
 use ballast::studies::saussine::{self, Loading, Sample};
 use ballast::studies::{karrech, Quiet, RunDisplay};
 use ballast::Error;
@@ -94,6 +95,8 @@ fn saussine_sample_load_and_convergence_study() {
     let conv = ConvergenceSpec {
         sample: sample.path.clone(),
         policies: vec![("quad".into(), 1e-2), ("quad".into(), 1e-5)],
+        reference: None,
+        replicas: Replicas::default(),
         loading: loading.clone(),
     };
     let record = Record::default();

@@ -10,7 +10,8 @@
 //! - `load`: write the loaded scene (sleeper with bars, load, sublayer stiffness,
 //!   solver, time step, number of cycles) from a deposited sample;
 //! - `settle`: load a sample and run N cycles (§4): `cycles.csv`, `summary.json`,
-//!   VTK snapshots every few cycles, figures;
+//!   VTK snapshots every few cycles, figures; with `--replicas R`, R runs from
+//!   perturbed starts and their ensemble (`settlement_ensemble.csv`);
 //! - `convergence`, `steps`, `ensemble`: the studies of §3.2, §3.3 and §4.2
 //!   ([`ballast::studies::campaigns`]).
 //!
@@ -21,7 +22,10 @@ use super::{input, print_sample, print_study, Bars, Failure};
 use ballast::run::default_threads;
 use ballast::scenarios::saussine::{Guide, SampleSpec};
 use ballast::studies::campaigns::{self, ConvergenceSpec, EnsembleSpec, StepsSpec, StudyOptions};
-use ballast::studies::saussine::{self, Loading, SettleOptions};
+use ballast::studies::replicas::{
+    Perturbation, Replicas, DEFAULT_PERTURBATION_M, DEFAULT_PERTURB_SEED, DEFAULT_SEATING_CYCLES,
+};
+use ballast::studies::saussine::{self, Loading, SettleOptions, SettleReplicas};
 use clap::Subcommand;
 use std::path::PathBuf;
 
@@ -65,6 +69,8 @@ pub enum SaussineCommand {
     },
     /// Loads a deposited sample and runs the cycles (§4): per-cycle settlement, mean
     /// grain speed, contacts and iterations (`cycles.csv`), VTK snapshots, figures.
+    /// With --replicas R > 1: R runs from perturbed starts side by side in
+    /// DIR/runs/replica-<r>/, and DIR/settlement_ensemble.csv (mean, sd, 95 % CI per cycle).
     Settle {
         /// A deposited sample (`sample.toml` of `ballast saussine sample`).
         #[arg(long, value_name = "FILE")]
@@ -80,9 +86,15 @@ pub enum SaussineCommand {
         /// Wall-clock seconds between checkpoints.
         #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
         checkpoint_every: f64,
-        /// Continue a killed run from its checkpoint.
+        /// Continue a killed run from its checkpoint (with --replicas: skip the finished
+        /// replicas, resume the checkpointed ones).
         #[arg(long)]
         resume: bool,
+        #[command(flatten)]
+        replicas: ReplicaArgs,
+        /// Replicas run at once, each on one core (default: the number of cores).
+        #[arg(long)]
+        jobs: Option<usize>,
         #[arg(long)]
         quiet: bool,
     },
@@ -95,6 +107,12 @@ pub enum SaussineCommand {
         /// Runs as POLICY:TOLERANCE, comma separated (default: the paper's table).
         #[arg(long, value_delimiter = ',')]
         policies: Vec<String>,
+        /// The setting the others' mean settlements are compared with, POLICY:TOLERANCE
+        /// (default: the tightest strict tolerance among the runs, else the tightest of any policy).
+        #[arg(long, value_name = "POLICY:TOL")]
+        reference: Option<String>,
+        #[command(flatten)]
+        replicas: ReplicaArgs,
         #[command(flatten)]
         loading: LoadingArgs,
         #[command(flatten)]
@@ -111,6 +129,8 @@ pub enum SaussineCommand {
         /// Inclinations of the load (degrees), comma separated.
         #[arg(long, value_delimiter = ',', default_value = "0,5")]
         inclinations: Vec<f64>,
+        #[command(flatten)]
+        replicas: ReplicaArgs,
         #[command(flatten)]
         loading: LoadingArgs,
         #[command(flatten)]
@@ -205,6 +225,36 @@ impl LoadingArgs {
     }
 }
 
+/// Replicas of each setting from perturbed starts (`ballast::studies::replicas`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct ReplicaArgs {
+    /// Runs of each setting: replica 0 from the sample as it is, replicas 1 … R−1 from
+    /// starts with every mobile body moved by at most --perturb; 1: the single run.
+    #[arg(long, value_name = "R", default_value_t = Replicas::default().count)]
+    pub replicas: u64,
+    /// Largest displacement of a body at a replica's start (m), uniform in the disc.
+    #[arg(long, value_name = "DIST", default_value_t = DEFAULT_PERTURBATION_M)]
+    pub perturb: f64,
+    /// Seed of the perturbations (replica r draws from stream r of it).
+    #[arg(long, value_name = "SEED", default_value_t = DEFAULT_PERTURB_SEED)]
+    pub perturb_seed: u64,
+    /// Seating cycles S: seating = settlement after S cycles, accrued = settlement − seating
+    /// (clipped to --cycles).
+    #[arg(long, value_name = "S", default_value_t = DEFAULT_SEATING_CYCLES)]
+    pub seating_cycles: u64,
+}
+
+impl ReplicaArgs {
+    /// The library's replicas (checked by it).
+    pub fn replicas(&self) -> Replicas {
+        Replicas {
+            count: self.replicas,
+            perturbation: Perturbation { distance_m: self.perturb, seed: self.perturb_seed },
+            seating_cycles: self.seating_cycles,
+        }
+    }
+}
+
 /// Settings shared by the studies.
 #[derive(Debug, Clone, clap::Args)]
 pub struct StudyArgs {
@@ -238,16 +288,44 @@ impl StudyArgs {
 
 /// `--policies`: POLICY:TOLERANCE pairs.
 fn policies(given: &[String]) -> Result<Vec<(String, f64)>, Failure> {
-    given
-        .iter()
-        .map(|p| {
-            let (name, tol) = p
-                .split_once(':')
-                .ok_or_else(|| input(format!("--policies: expected POLICY:TOLERANCE (e.g. quad:1e-6), got '{p}'")))?;
-            let tol: f64 = tol.parse().map_err(|_| input(format!("--policies: '{tol}' in '{p}' is not a number")))?;
-            Ok((name.to_string(), tol))
-        })
-        .collect()
+    given.iter().map(|p| policy("--policies", p)).collect()
+}
+
+/// One POLICY:TOLERANCE pair of `option`.
+fn policy(option: &str, p: &str) -> Result<(String, f64), Failure> {
+    let (name, tol) = p
+        .split_once(':')
+        .ok_or_else(|| input(format!("{option}: expected POLICY:TOLERANCE (e.g. quad:1e-6), got '{p}'")))?;
+    let tol: f64 = tol.parse().map_err(|_| input(format!("{option}: '{tol}' in '{p}' is not a number")))?;
+    Ok((name.to_string(), tol))
+}
+
+/// The line of an ensemble of settlement runs.
+fn print_replicas(r: &SettleReplicas) {
+    for (label, e) in &r.failed {
+        eprintln!("run {label} failed: {e}");
+    }
+    let mm = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{:.3}", 1e3 * x));
+    if let Some(last) = r.rows.last() {
+        let s = r.rows.iter().find(|row| row.cycle == last.seating_cycle);
+        println!(
+            "{} replicas, cycle {}: settlement {} mm (95 % CI {} … {}); seating after {} cycles {} mm (CI {} … {}); \
+             accrued since {} mm (CI {} … {})",
+            last.replicas,
+            last.cycle,
+            mm(Some(last.settlement_mean_m)),
+            mm(last.settlement_ci95_low_m),
+            mm(last.settlement_ci95_high_m),
+            last.seating_cycle,
+            mm(s.map(|s| s.settlement_mean_m)),
+            mm(s.and_then(|s| s.settlement_ci95_low_m)),
+            mm(s.and_then(|s| s.settlement_ci95_high_m)),
+            mm(last.accrued_mean_m),
+            mm(last.accrued_ci95_low_m),
+            mm(last.accrued_ci95_high_m),
+        );
+    }
+    println!("ensemble: {}; runs in {}", r.table.display(), r.runs.display());
 }
 
 pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
@@ -267,16 +345,42 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
             saussine::load(&sample, &loading.loading()?, &out)?;
             println!("wrote {}", out.display());
         }
-        SaussineCommand::Settle { sample, out, loading, snapshot_every, checkpoint_every, resume, quiet } => {
+        SaussineCommand::Settle {
+            sample,
+            out,
+            loading,
+            snapshot_every,
+            checkpoint_every,
+            resume,
+            replicas,
+            jobs,
+            quiet,
+        } => {
             let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume };
-            saussine::settle(&sample, &loading.loading()?, &out, &opts, &Bars::single(quiet))?;
+            let replicas = replicas.replicas();
+            if replicas.count == 1 {
+                replicas.check()?;
+                saussine::settle(&sample, &loading.loading()?, &out, &opts, &Bars::single(quiet))?;
+            } else {
+                let bars = Bars::group(quiet);
+                let r = saussine::settle_replicas(&sample, &loading.loading()?, &out, &opts, &replicas, jobs, &bars)?;
+                print_replicas(&r);
+            }
         }
-        SaussineCommand::Convergence { sample, policies: given, loading, study } => {
-            let spec = ConvergenceSpec { sample, policies: policies(&given)?, loading: loading.loading()? };
+        SaussineCommand::Convergence { sample, policies: given, reference, replicas, loading, study } => {
+            let reference = reference.map(|r| policy("--reference", &r)).transpose()?;
+            let spec = ConvergenceSpec {
+                sample,
+                policies: policies(&given)?,
+                reference,
+                replicas: replicas.replicas(),
+                loading: loading.loading()?,
+            };
             print_study(&campaigns::convergence(&spec, &study.options(), &Bars::group(study.quiet))?);
         }
-        SaussineCommand::Steps { sample, dts, inclinations, loading, study } => {
-            let spec = StepsSpec { sample, dts, inclinations, loading: loading.loading()? };
+        SaussineCommand::Steps { sample, dts, inclinations, replicas, loading, study } => {
+            let spec =
+                StepsSpec { sample, dts, inclinations, replicas: replicas.replicas(), loading: loading.loading()? };
             print_study(&campaigns::steps(&spec, &study.options(), &Bars::group(study.quiet))?);
         }
         SaussineCommand::Ensemble { samples, first_seed, factors, grains, sample_dt, loading, study } => {

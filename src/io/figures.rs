@@ -104,6 +104,9 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// `(x, lo, hi)`: a spread drawn as a translucent area behind the curve; may be empty.
     pub band: Vec<(f64, f64, f64)>,
+    /// A thin grey line without markers, drawn before the others (one replica
+    /// among many, behind their mean); it takes no colour of the palette.
+    pub thin: bool,
 }
 
 /// Title, axis labels (with their SI units) and scales of a [`line_chart`].

@@ -46,6 +46,7 @@ pub fn md_figures(dir: &Path) -> Result<RunFigures> {
         label: label.into(),
         points: rows.iter().map(|r| (r.time_s, f(r))).collect(),
         band: vec![],
+        thin: false,
     };
     let chart = |stem: &str, title: &str, y_label: &str, log_y: bool, series: &[Series]| -> Result<_> {
         let axes =
@@ -79,6 +80,7 @@ pub fn md_figures(dir: &Path) -> Result<RunFigures> {
                 label: name.clone(),
                 points: rows.iter().map(|r| (r.time_s, scale * r.walls.get(*k).copied().unwrap_or(f64::NAN))).collect(),
                 band: vec![],
+                thin: false,
             })
             .collect()
     };
@@ -122,6 +124,7 @@ fn plate_cycles(dir: &Path, servos: &[(usize, String)], out: &mut RunFigures) ->
             label: name.clone(),
             points: rows.iter().map(|r| (r.cycle as f64, s * r.walls.get(k).copied().unwrap_or(f64::NAN))).collect(),
             band: vec![],
+            thin: false,
         })
         .collect();
     let axes = Axes {

@@ -108,11 +108,13 @@ pub fn settlement_series(rows: &[super::cycles::NscdCycleRow], label: &str, scal
             label: format!("{label}{sep}mean over the cycle"),
             points: pick(|r| r.settlement_mean_m),
             band: vec![],
+            thin: false,
         },
         Series {
             label: format!("{label}{sep}at the load minimum"),
             points: pick(|r| r.settlement_at_min_load_m),
             band: vec![],
+            thin: false,
         },
     ]
 }
@@ -228,8 +230,13 @@ pub fn nscd_figures(dir: &Path, first_cycle_q: Option<&[[f64; 3]]>) -> Result<Ru
         ..Axes::default()
     };
     let curves = [
-        Series { label: "mean over the active contacts".into(), points: pick(|r| r.mean_overlap_m), band: vec![] },
-        Series { label: "max".into(), points: pick(|r| r.max_overlap_m), band: vec![] },
+        Series {
+            label: "mean over the active contacts".into(),
+            points: pick(|r| r.mean_overlap_m),
+            band: vec![],
+            thin: false,
+        },
+        Series { label: "max".into(), points: pick(|r| r.max_overlap_m), band: vec![], thin: false },
     ];
     figures::line_chart(&stem, &axes, &curves)?;
     out.wrote(stem);

@@ -19,11 +19,26 @@
 //!   standard deviation, min and max of the settlement over the samples, per
 //!   stiffness and cycle) and `settlement_ensemble` (mean ± one standard deviation).
 //!
-//! Layout: `DIR/scenes/<run>.toml` and `DIR/runs/<run>/`. A run that diverges is
+//! With `R` replicas per setting ([`super::replicas::Replicas`]; convergence
+//! and steps), each setting runs from `R` starts, replica 0 the sample as it is,
+//! the others perturbed; the summary CSV has one row per run (column
+//! `replica`) followed by the ensemble columns of its setting (settlement after
+//! the last cycle, seating, accrued: mean, sd, 95 % interval), and for §3.2 the
+//! difference of its setting's mean from the reference setting's with Welch's
+//! 95 % interval; the figures show the replicas' means with their 95 % bands,
+//! and `settlement_ensemble` the mean settlement per cycle of each setting.
+//!
+//! Layout: `DIR/scenes/<run>.toml` and `DIR/runs/<run>/` (`<run>` is
+//! `<setting>/replica-<r>` with several replicas), each run folder with its
+//! `replica.json`. A run that diverges is
 //! reported in the summary (`status`) and in [`StudyReport::failed`], the others
 //! go on. [`StudyOptions::resume`] skips the finished runs and resumes the
 //! checkpointed ones.
 
+use super::replicas::{
+    perturb_scene, settlement_ensemble, EnsembleColumns, Estimate, Perturbation, ReferenceColumns, Replicas,
+    SettlementSummary, ENSEMBLE_COLUMNS, REFERENCE_COLUMNS, REPLICA_FILE,
+};
 use super::saussine::{sample, Loading};
 use super::{axes, output_error, run_scene, RunDisplay, SummaryTable};
 use crate::error::{Error, Result};
@@ -97,11 +112,35 @@ pub const PAPER_POLICIES: [(&str, f64); 8] = [
     ("quad", 1e-7),
 ];
 
-/// One run of a study: its label, the loading and where it goes.
+/// One run of a study: its label, the loading and where it goes, and which
+/// replica of its setting it is.
 struct Job {
     label: String,
     spec: LoadingSpec,
     sample: PathBuf,
+    replica: u64,
+    perturbation: Perturbation,
+}
+
+/// The runs of `settings` (replica 0 each): unchanged for one replica, else
+/// `replicas.count` runs per setting labelled `<setting>/replica-<r>`, setting
+/// after setting.
+fn replicate(settings: Vec<Job>, replicas: &Replicas) -> Vec<Job> {
+    if replicas.count == 1 {
+        return settings;
+    }
+    settings
+        .into_iter()
+        .flat_map(|job| {
+            (0..replicas.count).map(move |r| Job {
+                label: format!("{}/replica-{r}", job.label),
+                spec: job.spec.clone(),
+                sample: job.sample.clone(),
+                replica: r,
+                perturbation: replicas.perturbation,
+            })
+        })
+        .collect()
 }
 
 impl Job {
@@ -121,18 +160,77 @@ struct Outcome {
     cycles: Vec<CycleRow>,
 }
 
+/// The cycles of the runs `outcomes`.
+fn cycles_of<'a>(outcomes: &[&'a Outcome]) -> Vec<&'a [CycleRow]> {
+    outcomes.iter().map(|o| o.cycles.as_slice()).collect()
+}
+
+/// The ensemble columns of the replicas `outcomes` of one setting.
+fn ensemble_columns(outcomes: &[&Outcome], seating: u64) -> EnsembleColumns {
+    SettlementSummary::of(&cycles_of(outcomes), seating)
+        .map_or(EnsembleColumns { replicas: outcomes.len(), ..EnsembleColumns::default() }, |s| s.columns())
+}
+
+/// Mean over the runs `outcomes` of `f` of their series rows (row by row, up to
+/// the shortest run), against time, and its 95 % band (none for one run).
+fn mean_curve(outcomes: &[&Outcome], label: String, f: fn(&SeriesRow) -> f64, scale: f64) -> Series {
+    let n = outcomes.iter().map(|o| o.series.len()).min().unwrap_or(0);
+    let mut series = Series { label, ..Series::default() };
+    for k in 0..n {
+        let values: Vec<f64> = outcomes.iter().map(|o| scale * f(&o.series[k])).collect();
+        let Some(e) = Estimate::of(&values) else { continue };
+        let t = outcomes[0].series[k].time_s;
+        series.points.push((t, e.mean));
+        if let Some((lo, hi)) = e.ci95 {
+            series.band.push((t, lo, hi));
+        }
+    }
+    series
+}
+
+/// The mean settlement per cycle of each setting (`(label, its runs)`), each
+/// with its 95 % band, in `DIR/settlement_ensemble`.
+fn settlement_figure(out: &Path, title: &str, settings: &[(String, Vec<&Outcome>)], seating: u64) -> Result<()> {
+    let curves: Vec<Series> = settings
+        .iter()
+        .map(|(label, runs)| {
+            let rows = settlement_ensemble(&cycles_of(runs), seating);
+            Series {
+                label: if runs.len() > 1 {
+                    format!("{label} (mean of {}, 95 % CI)", runs.len())
+                } else {
+                    label.clone()
+                },
+                points: rows.iter().map(|r| (r.cycle as f64, 1e3 * r.settlement_mean_m)).collect(),
+                band: rows
+                    .iter()
+                    .filter_map(|r| {
+                        Some((r.cycle as f64, 1e3 * r.settlement_ci95_low_m?, 1e3 * r.settlement_ci95_high_m?))
+                    })
+                    .collect(),
+                thin: false,
+            }
+        })
+        .collect();
+    figures::line_chart(
+        &out.join("settlement_ensemble"),
+        &axes(title, "cycles", "settlement at the load minimum (mm)", false, false),
+        &curves,
+    )
+}
+
 fn label_number(x: f64) -> String {
     format!("{x:e}").replace('.', "p")
 }
 
 /// A pool of `threads` threads for runs side by side.
-fn pool(threads: usize) -> Result<rayon::ThreadPool> {
+pub(crate) fn pool(threads: usize) -> Result<rayon::ThreadPool> {
     rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| Error::Io(std::io::Error::other(e)))
 }
 
 /// Threads of each run on a pool of `pool` threads: one sweep thread each when
 /// several go side by side, else those of a single run.
-fn run_threads(pool: usize) -> usize {
+pub(crate) fn run_threads(pool: usize) -> usize {
     if pool == 1 {
         default_threads()
     } else {
@@ -164,9 +262,16 @@ fn run_jobs(
                 s
             }
         };
-        let loaded = loaded_scene(&sample, &job.spec)?;
+        let mut loaded = loaded_scene(&sample, &job.spec)?;
+        let record = perturb_scene(&mut loaded, &job.perturbation, job.replica)?;
         let what = format!("{} of the study in {}, from {}", job.label, out.display(), job.sample.display());
-        super::saussine::write_scene(&job.scene(out), &loaded, &what)?;
+        let scene = job.scene(out);
+        if let Some(parent) = scene.parent() {
+            io::create_output_dir(parent)?;
+        }
+        super::saussine::write_scene(&scene, &loaded, &what)?;
+        io::create_output_dir(&job.dir(out))?;
+        io::write_json(&job.dir(out).join(REPLICA_FILE), &record)?;
     }
     let pool = pool(threads)?;
     let results: Vec<Result<()>> = pool.install(|| {
@@ -295,10 +400,6 @@ fn write_table<R: Serialize>(path: &Path, key: &[&str], rest: &[&str], rows: &[R
     t.finish()
 }
 
-fn curve(o: &Outcome, label: String, f: fn(&SeriesRow) -> f64, scale: f64) -> Series {
-    Series { label, points: o.series.iter().map(|s| (s.time_s, scale * f(s))).collect(), band: vec![] }
-}
-
 /// The report of a study whose summary table is `DIR/name`.
 fn report(out: &Path, name: &str, failed: Vec<(String, String)>) -> Result<StudyReport> {
     Ok(StudyReport { table: SummaryTable::read(&out.join(name))?, runs: out.join("runs"), failed })
@@ -311,13 +412,42 @@ pub struct ConvergenceSpec {
     pub sample: PathBuf,
     /// The runs as `(policy, tolerance)`; empty: the paper's table ([`PAPER_POLICIES`]).
     pub policies: Vec<(String, f64)>,
+    /// The setting the others are compared with, `(policy, tolerance)`, one of
+    /// the runs; `None`: the tightest tolerance of the `strict` policy among the
+    /// runs, else the tightest tolerance of any policy (the first listed of equals).
+    pub reference: Option<(String, f64)>,
+    /// The replicas of each setting ([`Replicas::default`]: one, today's single run).
+    pub replicas: Replicas,
     /// The loading of every run (its criterion and tolerance replaced by each run's).
     pub loading: Loading,
 }
 
+/// The reference setting of [`ConvergenceSpec::reference`] among `runs`: its index.
+fn reference_of(runs: &[(String, f64)], given: Option<&(String, f64)>) -> Result<usize> {
+    if let Some((p, t)) = given {
+        return runs
+            .iter()
+            .position(|(q, u)| q == p && u == t)
+            .ok_or_else(|| Error::Scene(format!("--reference: {p}:{t:e} is not among the runs (--policies)")));
+    }
+    let tightest = |strict: bool| {
+        runs.iter()
+            .enumerate()
+            .filter(|(_, (p, _))| !strict || p == "strict")
+            .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1).then(a.0.cmp(&b.0)))
+            .map(|(i, _)| i)
+    };
+    tightest(true).or_else(|| tightest(false)).ok_or_else(|| Error::Scene("--policies: no run".into()))
+}
+
 /// §3.2 (`ballast saussine convergence`): one run per policy and tolerance,
-/// labelled `<policy>_<tolerance>`; `convergence.csv`,
-/// `cumulated_interpenetration` and `iterations_vs_tolerance`.
+/// labelled `<policy>_<tolerance>` (with `R` replicas, `R` runs labelled
+/// `<policy>_<tolerance>/replica-<r>`, [`super::replicas`]); `convergence.csv`
+/// (one row per run: the setting, `replica`, the [`RunColumns`], the
+/// [`EnsembleColumns`] of its setting and the [`ReferenceColumns`] comparing its
+/// setting with the reference), `cumulated_interpenetration` (Fig. 2; mean over
+/// the replicas with its 95 % band), `iterations_vs_tolerance` and
+/// `settlement_ensemble` (mean settlement per cycle of each setting, 95 % band).
 ///
 /// # Errors
 /// [`Error::Scene`] for an unreadable sample, an invalid loading or option
@@ -325,38 +455,55 @@ pub struct ConvergenceSpec {
 /// the table instead; an output that cannot be written is an [`Error::Io`].
 pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
     crate::io::figures::require()?; // the stage ends with its figures
+    spec.replicas.check()?;
     let runs: Vec<(String, f64)> = if spec.policies.is_empty() {
         PAPER_POLICIES.iter().map(|&(p, t)| (p.to_string(), t)).collect()
     } else {
         spec.policies.clone()
     };
+    let reference = reference_of(&runs, spec.reference.as_ref())?;
     let sample_path = &spec.sample;
     let sample_scene = Scene::load(sample_path)?;
     let base = spec.loading.for_sample(&sample_scene)?;
-    let jobs: Vec<Job> = runs
+    let settings: Vec<Job> = runs
         .iter()
         .map(|(policy, tol)| Job {
             label: format!("{policy}_{}", label_number(*tol)),
             spec: LoadingSpec { criterion: policy.clone(), tolerance: *tol, ..base.clone() },
             sample: sample_path.to_path_buf(),
+            replica: 0,
+            perturbation: spec.replicas.perturbation,
         })
         .collect();
+    let jobs = replicate(settings, &spec.replicas);
     let mut failed = Vec::new();
     let outcomes = run_jobs(&jobs, study, display, &mut failed)?;
+    let r = spec.replicas.count as usize;
+    let seating = spec.replicas.seating_cycles.min(spec.loading.cycles);
+    let per_setting: Vec<Vec<&Outcome>> = outcomes.chunks(r).map(|c| c.iter().collect()).collect();
+    let summaries: Vec<Option<SettlementSummary>> =
+        per_setting.iter().map(|o| SettlementSummary::of(&cycles_of(o), seating)).collect();
+    let (rp, rt) = &runs[reference];
+    let reference_name = format!("{rp}:{rt:e}");
 
-    let rows: Vec<_> = runs
-        .iter()
-        .zip(&outcomes)
-        .map(|((policy, tol), o)| ((policy.clone(), *tol, base.min_iterations, base.max_iterations), run_columns(o)))
-        .collect();
+    let mut rows = Vec::new();
+    for (i, (policy, tol)) in runs.iter().enumerate() {
+        let ensemble = ensemble_columns(&per_setting[i], seating);
+        let versus = ReferenceColumns::of(&reference_name, summaries[i].as_ref(), summaries[reference].as_ref());
+        for (k, o) in per_setting[i].iter().enumerate() {
+            let key = (policy.clone(), *tol, base.min_iterations, base.max_iterations, k);
+            rows.push((key, run_columns(o), ensemble.clone(), versus.clone()));
+        }
+    }
     let out = &study.out;
-    let key = ["policy", "tolerance", "min_iterations", "max_iterations"];
-    write_table(&out.join("convergence.csv"), &key, &RUN_COLUMNS, &rows)?;
+    let key = ["policy", "tolerance", "min_iterations", "max_iterations", "replica"];
+    let rest: Vec<&str> = RUN_COLUMNS.iter().chain(&ENSEMBLE_COLUMNS).chain(&REFERENCE_COLUMNS).copied().collect();
+    write_table(&out.join("convergence.csv"), &key, &rest, &rows)?;
 
     let cumulated: Vec<Series> = runs
         .iter()
-        .zip(&outcomes)
-        .map(|((p, t), o)| curve(o, format!("{p} {t:e}"), |s| s.total_overlap_m, 1e6))
+        .zip(&per_setting)
+        .map(|((p, t), o)| mean_curve(o, format!("{p} {t:e}"), |s| s.total_overlap_m, 1e6))
         .collect();
     figures::line_chart(
         &out.join("cumulated_interpenetration"),
@@ -364,23 +511,34 @@ pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn R
         &cumulated,
     )?;
     let mut per_policy: Vec<Series> = Vec::new();
-    for ((p, t), o) in runs.iter().zip(&outcomes) {
-        let Some(r) = &o.report else { continue };
-        match per_policy.iter_mut().find(|s| &s.label == p) {
-            Some(s) => s.points.push((*t, r.mean_iterations.unwrap_or(f64::NAN))),
-            None => per_policy.push(Series {
-                label: p.clone(),
-                points: vec![(*t, r.mean_iterations.unwrap_or(f64::NAN))],
-                band: vec![],
-            }),
+    for ((p, t), o) in runs.iter().zip(&per_setting) {
+        let values: Vec<f64> =
+            o.iter().filter_map(|o| o.report.as_ref()).map(|r| r.mean_iterations.unwrap_or(f64::NAN)).collect();
+        let Some(e) = Estimate::of(&values) else { continue };
+        let s = match per_policy.iter_mut().find(|s| &s.label == p) {
+            Some(s) => s,
+            None => {
+                per_policy.push(Series { label: p.clone(), ..Series::default() });
+                per_policy.last_mut().expect("just pushed")
+            }
+        };
+        s.points.push((*t, e.mean));
+        if let Some((lo, hi)) = e.ci95 {
+            s.band.push((*t, lo, hi));
         }
     }
-    per_policy.iter_mut().for_each(|s| s.points.sort_by(|a, b| a.0.total_cmp(&b.0)));
+    for s in &mut per_policy {
+        s.points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        s.band.sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
     figures::line_chart(
         &out.join("iterations_vs_tolerance"),
         &axes("NLGS iterations per step vs tolerance", "tolerance", "mean sweeps per step", true, false),
         &per_policy,
     )?;
+    let labelled: Vec<(String, Vec<&Outcome>)> =
+        runs.iter().zip(per_setting).map(|((p, t), o)| (format!("{p} {t:e}"), o)).collect();
+    settlement_figure(out, "Settlement of the sleeper per convergence setting", &labelled, seating)?;
     report(out, "convergence.csv", failed)
 }
 
@@ -393,52 +551,73 @@ pub struct StepsSpec {
     pub dts: Vec<f64>,
     /// Inclinations of the load (degrees).
     pub inclinations: Vec<f64>,
+    /// The replicas of each setting ([`Replicas::default`]: one, today's single run).
+    pub replicas: Replicas,
     /// The loading of every run (its time step and inclination replaced by each run's).
     pub loading: Loading,
 }
 
 /// §3.3 (`ballast saussine steps`): one run per inclination and time step,
-/// labelled `incl_<a>_dt_<dt>`; `steps.csv`, `max_interpenetration_<a>deg`,
-/// `mean_interpenetration_<a>deg` and `interpenetration_vs_dt`.
+/// labelled `incl_<a>_dt_<dt>` (with `R` replicas, `R` runs labelled
+/// `incl_<a>_dt_<dt>/replica-<r>`, [`super::replicas`]); `steps.csv` (one row
+/// per run: the setting, `replica`, the [`RunColumns`] and the
+/// [`EnsembleColumns`] of its setting), `max_interpenetration_<a>deg`,
+/// `mean_interpenetration_<a>deg` (means over the replicas with their 95 %
+/// bands), `interpenetration_vs_dt` and `settlement_ensemble` (mean settlement
+/// per cycle of each setting, 95 % band).
 ///
 /// # Errors
 /// As [`convergence`]; a time step that is not positive is an [`Error::Scene`].
 pub fn steps(spec: &StepsSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
     crate::io::figures::require()?; // the stage ends with its figures
+    spec.replicas.check()?;
     let (dts, inclinations) = (&spec.dts, &spec.inclinations);
     if let Some(dt) = dts.iter().find(|dt| !(dt.is_finite() && **dt > 0.0)) {
         return Err(Error::Scene(format!("--dts: every time step must be positive, got {dt}")));
     }
     let sample_path = &spec.sample;
     let sample_scene = Scene::load(sample_path)?;
-    let mut jobs = Vec::new();
+    let mut settings = Vec::new();
     let mut keys = Vec::new();
     for &a in inclinations {
         let base = Loading { inclination_deg: a, ..spec.loading.clone() }.for_sample(&sample_scene)?;
         for &dt in dts {
-            jobs.push(Job {
+            settings.push(Job {
                 label: format!("incl_{}_dt_{}", label_number(a), label_number(dt)),
                 spec: LoadingSpec { dt, ..base.clone() },
                 sample: sample_path.to_path_buf(),
+                replica: 0,
+                perturbation: spec.replicas.perturbation,
             });
             keys.push((a, dt));
         }
     }
+    let jobs = replicate(settings, &spec.replicas);
     let mut failed = Vec::new();
     let outcomes = run_jobs(&jobs, study, display, &mut failed)?;
+    let r = spec.replicas.count as usize;
+    let seating = spec.replicas.seating_cycles.min(spec.loading.cycles);
+    let per_setting: Vec<Vec<&Outcome>> = outcomes.chunks(r).map(|c| c.iter().collect()).collect();
     let out = &study.out;
-    let rows: Vec<_> = keys.iter().zip(&outcomes).map(|(&(a, dt), o)| ((a, dt), run_columns(o))).collect();
-    write_table(&out.join("steps.csv"), &["inclination_deg", "dt_s"], &RUN_COLUMNS, &rows)?;
+    let mut rows = Vec::new();
+    for (&(a, dt), runs) in keys.iter().zip(&per_setting) {
+        let ensemble = ensemble_columns(runs, seating);
+        for (k, o) in runs.iter().enumerate() {
+            rows.push(((a, dt, k), run_columns(o), ensemble.clone()));
+        }
+    }
+    let rest: Vec<&str> = RUN_COLUMNS.iter().chain(&ENSEMBLE_COLUMNS).copied().collect();
+    write_table(&out.join("steps.csv"), &["inclination_deg", "dt_s", "replica"], &rest, &rows)?;
     let mut vs_dt = Vec::new();
     for &a in inclinations {
-        let runs: Vec<_> = keys.iter().zip(&outcomes).filter(|((b, _), _)| *b == a).collect();
+        let runs: Vec<_> = keys.iter().zip(&per_setting).filter(|((b, _), _)| *b == a).collect();
         let tag = format!("{a}").replace('.', "p").replace('-', "m");
         for (name, what, f) in [
             ("max", "Maximal", (|s: &SeriesRow| s.max_overlap_m) as fn(&SeriesRow) -> f64),
             ("mean", "Average", |s: &SeriesRow| s.mean_overlap_m),
         ] {
             let curves: Vec<Series> =
-                runs.iter().map(|((_, dt), o)| curve(o, format!("dt = {dt:e} s"), f, 1e6)).collect();
+                runs.iter().map(|((_, dt), o)| mean_curve(o, format!("dt = {dt:e} s"), f, 1e6)).collect();
             figures::line_chart(
                 &out.join(format!("{name}_interpenetration_{tag}deg")),
                 &axes(&format!("{what} interpenetration, load at {a}°"), "time (s)", "overlap (µm)", false, false),
@@ -449,8 +628,16 @@ pub fn steps(spec: &StepsSpec, study: &StudyOptions, display: &dyn RunDisplay) -
             ("mean", (|r: &RunReport| r.mean_overlap_m) as fn(&RunReport) -> f64),
             ("max", |r: &RunReport| r.max_overlap_m),
         ] {
-            let points = runs.iter().filter_map(|((_, dt), o)| o.report.as_ref().map(|r| (*dt, 1e6 * f(r)))).collect();
-            vs_dt.push(Series { label: format!("{name}, {a}°"), points, band: vec![] });
+            let mut series = Series { label: format!("{name}, {a}°"), ..Series::default() };
+            for ((_, dt), o) in &runs {
+                let values: Vec<f64> = o.iter().filter_map(|o| o.report.as_ref().map(|r| 1e6 * f(r))).collect();
+                let Some(e) = Estimate::of(&values) else { continue };
+                series.points.push((*dt, e.mean));
+                if let Some((lo, hi)) = e.ci95 {
+                    series.band.push((*dt, lo, hi));
+                }
+            }
+            vs_dt.push(series);
         }
     }
     figures::line_chart(
@@ -458,6 +645,9 @@ pub fn steps(spec: &StepsSpec, study: &StudyOptions, display: &dyn RunDisplay) -
         &axes("Interpenetration over the run vs time step", "dt (s)", "overlap (µm)", true, true),
         &vs_dt,
     )?;
+    let labelled: Vec<(String, Vec<&Outcome>)> =
+        keys.iter().zip(per_setting).map(|((a, dt), o)| (format!("{a}°, dt = {dt:e} s"), o)).collect();
+    settlement_figure(out, "Settlement of the sleeper per time step and inclination", &labelled, seating)?;
     report(out, "steps.csv", failed)
 }
 
@@ -567,6 +757,8 @@ pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisp
                 label: format!("seed_{seed}_k_{}", label_number(k)),
                 spec: loading.for_sample(&sample_scene)?,
                 sample: sample_path.clone(),
+                replica: 0,
+                perturbation: Perturbation::default(),
             });
             keys.push((seed, k));
         }
@@ -603,7 +795,12 @@ pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisp
             points.push((cycle as f64, 1e3 * s.mean));
             band.push((cycle as f64, 1e3 * (s.mean - s.std), 1e3 * (s.mean + s.std)));
         }
-        curves.push(Series { label: format!("k_N × {k} ({} samples, mean ± 1 sd)", runs.len()), points, band });
+        curves.push(Series {
+            label: format!("k_N × {k} ({} samples, mean ± 1 sd)", runs.len()),
+            points,
+            band,
+            thin: false,
+        });
     }
     io::table::write_all(&out.join("ensemble.csv"), &table)?;
     figures::line_chart(

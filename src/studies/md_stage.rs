@@ -149,5 +149,6 @@ pub(crate) fn curve(label: &str, x: &[f64], y: &[f64]) -> Series {
         label: label.into(),
         points: x.iter().zip(y).filter(|(a, b)| a.is_finite() && b.is_finite()).map(|(a, b)| (*a, *b)).collect(),
         band: Vec::new(),
+        thin: false,
     }
 }

@@ -17,7 +17,11 @@
 //!   Luding: isotropic compression, cycles (`loops.csv`, `strain.csv`), and the
 //!   comparison of several cycled runs (`compare.csv`);
 //! - [`md_stage`]: what the two-stage MD tests share (`spec.json`, where and how
-//!   a stage runs).
+//!   a stage runs);
+//! - [`replicas`]: replicas of a run from perturbed starts, and the statistics of
+//!   their ensemble (mean, standard deviation, 95 % confidence intervals of the
+//!   mean and of a difference of means; seating and accrued settlement), which
+//!   `saussine settle`, `convergence` and `steps` report with `--replicas`.
 //!
 //! Progress goes through a [`RunDisplay`]: one callback per run, and a word
 //! when each run ends ([`Quiet`] shows nothing). Invalid inputs are
@@ -39,6 +43,7 @@ mod display;
 pub mod karrech;
 pub mod luding;
 pub mod md_stage;
+pub mod replicas;
 pub mod saussine;
 
 pub use display::{run_scene, Quiet, RunDisplay};

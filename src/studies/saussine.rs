@@ -9,16 +9,22 @@
 //! - [`load`]: write the loaded scene (sleeper with bars, load, sublayer
 //!   stiffness, solver, time step, number of cycles) from a deposited sample;
 //! - [`settle`] (§4): load a sample and run its cycles: `cycles.csv`,
-//!   `summary.json`, VTK snapshots every few cycles, figures.
+//!   `summary.json`, VTK snapshots every few cycles, figures;
+//!   [`settle_replicas`] the same from several perturbed starts side by side
+//!   ([`super::replicas`]), with the ensemble's settlement per cycle and its
+//!   95 % confidence interval (`settlement_ensemble.csv`).
 //!
 //! The settings of the loaded stage are a [`Loading`] (the options of
 //! `ballast saussine load`); a sample scaled to fewer grains is loaded with the
 //! sleeper's width and the load scaled alike (same pressure,
 //! [`Loading::for_sample`]), unless the sleeper's width is given.
 
+use super::replicas::{perturb_scene, settlement_ensemble, Replicas, SettlementEnsembleRow, REPLICA_FILE};
 use super::{output_error, run_scene, write_file, RunDisplay};
 use crate::error::{Error, Result};
 use crate::io;
+use crate::io::cycles::NscdCycleRow;
+use crate::io::figures::Series;
 use crate::run::{default_threads, files, Prior, RunOptions, RunOutcome};
 use crate::scenarios::saussine::{
     loaded_scene, measure_sample, open_bank, sample_scene, Guide, LoadingSpec, SampleReport, SampleSpec, GRAIN_PREFIX,
@@ -251,7 +257,8 @@ pub struct SettleOptions {
 /// §4: loads the sample at `sample` and runs its cycles in `out` (the loaded
 /// scene written there as `loaded.toml`, kept on `resume`): per-cycle
 /// settlement, mean grain speed, contacts and iterations (`cycles.csv`), VTK
-/// snapshots, figures. The run is labelled `settle`.
+/// snapshots, figures. The run is labelled `settle`. This is replica 0 of
+/// [`settle_replicas`], the unperturbed start.
 ///
 /// # Errors
 /// [`Error::Scene`] for an unreadable sample, an invalid loading or
@@ -269,14 +276,186 @@ pub fn settle(
     if !opts.resume {
         write_scene(&path, &scene, &format!("loaded from {}", sample.display()))?;
     }
+    run_settle(&path, out, &spec, opts, default_threads(), opts.resume, display, "settle")
+}
+
+/// Runs the loaded scene at `path` into `out` as [`settle`] does.
+#[allow(clippy::too_many_arguments)]
+fn run_settle(
+    path: &Path,
+    out: &Path,
+    spec: &LoadingSpec,
+    opts: &SettleOptions,
+    threads: usize,
+    resume: bool,
+    display: &dyn RunDisplay,
+    label: &str,
+) -> Result<RunOutcome> {
     let steps_per_cycle = (1.0 / (spec.frequency * spec.dt)).round().max(1.0) as u64;
     let run = RunOptions {
         checkpoint_every_s: opts.checkpoint_every_s,
-        resume: opts.resume,
+        resume,
         vtk_every: opts.snapshot_every.saturating_mul(steps_per_cycle),
         figures: true,
-        threads: default_threads(),
+        threads,
         ..RunOptions::default()
     };
-    run_scene(&path, out, &run, display, "settle")
+    run_scene(path, out, &run, display, label)
+}
+
+/// What [`settle_replicas`] wrote.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SettleReplicas {
+    /// The folder of the replicas' runs, `OUT/runs` (each in `replica-<r>/`).
+    pub runs: PathBuf,
+    /// `OUT/settlement_ensemble.csv`.
+    pub table: PathBuf,
+    /// Its rows: the ensemble per cycle.
+    pub rows: Vec<SettlementEnsembleRow>,
+    /// `(label, error)` of each replica that failed in this invocation (its
+    /// cycles, if any, are still in the ensemble, which stops at the last
+    /// cycle every replica reached).
+    pub failed: Vec<(String, String)>,
+}
+
+/// The folder of replica `r` of a settlement run in `out`.
+pub fn replica_dir(out: &Path, r: u64) -> PathBuf {
+    out.join("runs").join(format!("replica-{r}"))
+}
+
+/// §4 with replicas: [`settle`] from `replicas.count` starts, replica 0 the
+/// sample as it is and replica `r ≥ 1` perturbed by
+/// [`super::replicas::perturb_scene`]; the runs go side by side, `jobs` at a
+/// time (`None`: one per core), each in `OUT/runs/replica-<r>/` with the
+/// outputs of [`settle`], its (perturbed) `loaded.toml` and
+/// [`super::replicas::REPLICA_FILE`]; `opts.resume` skips the finished
+/// replicas and resumes the checkpointed ones. Then `OUT/settlement_ensemble.csv`
+/// ([`SettlementEnsembleRow`]: per cycle, mean, standard deviation and 95 %
+/// interval of the settlement at the load minimum, and of the settlement
+/// accrued since cycle `replicas.seating_cycles`) and the figure
+/// `settlement_ensemble` (the replicas thin, their mean with its interval). The
+/// runs are labelled `replica-<r>`.
+///
+/// # Errors
+/// [`Error::Scene`] for an unreadable sample, an invalid loading, replicas,
+/// `jobs` or checkpoint (before any run); a replica that fails is reported in
+/// [`SettleReplicas::failed`]; an output that cannot be written is an
+/// [`Error::Io`].
+pub fn settle_replicas(
+    sample: &Path,
+    loading: &Loading,
+    out: &Path,
+    opts: &SettleOptions,
+    replicas: &Replicas,
+    jobs: Option<usize>,
+    display: &dyn RunDisplay,
+) -> Result<SettleReplicas> {
+    crate::io::figures::require()?; // the runs end with their figures
+    replicas.check()?;
+    let threads = match jobs.unwrap_or_else(crate::run::cores) {
+        0 => return Err(Error::Scene("--jobs: must be at least 1".into())),
+        n => n.min(replicas.count as usize),
+    };
+    let (scene, spec) = loaded(sample, loading)?;
+    io::create_output_dir(&out.join("runs"))?;
+    // Every replica's scene first, so that an invalid one stops before any run.
+    let mut priors = Vec::new();
+    for r in 0..replicas.count {
+        let dir = replica_dir(out, r);
+        let prior = Prior::of(&dir, files::SUMMARY, opts.resume);
+        if prior == Prior::Nothing {
+            io::create_output_dir(&dir)?;
+            let mut perturbed = scene.clone();
+            let record = perturb_scene(&mut perturbed, &replicas.perturbation, r)?;
+            let what = format!(
+                "loaded from {}, replica {r} (start perturbed by at most {} m, seed {})",
+                sample.display(),
+                if r == 0 { 0.0 } else { replicas.perturbation.distance_m },
+                replicas.perturbation.seed
+            );
+            write_scene(&dir.join("loaded.toml"), &perturbed, &what)?;
+            io::write_json(&dir.join(REPLICA_FILE), &record)?;
+        }
+        priors.push(prior);
+    }
+    let pool = super::campaigns::pool(threads)?;
+    let results: Vec<Result<()>> = pool.install(|| {
+        use rayon::prelude::*;
+        (0..replicas.count)
+            .into_par_iter()
+            .map(|r| {
+                let dir = replica_dir(out, r);
+                match priors[r as usize] {
+                    Prior::Finished => Ok(()),
+                    prior => {
+                        let threads = super::campaigns::run_threads(threads);
+                        let resume = prior == Prior::Checkpointed;
+                        let label = format!("replica-{r}");
+                        run_settle(&dir.join("loaded.toml"), &dir, &spec, opts, threads, resume, display, &label)
+                            .map(|_| ())
+                    }
+                }
+            })
+            .collect()
+    });
+    let mut failed = Vec::new();
+    let mut cycles = Vec::new();
+    for (r, result) in results.into_iter().enumerate() {
+        match result {
+            Ok(()) => {}
+            Err(e @ Error::Scene(_)) => return Err(e),
+            Err(e) => failed.push((format!("replica-{r}"), e.one_line())),
+        }
+        let path = replica_dir(out, r as u64).join(files::CYCLES);
+        cycles.push(if path.exists() { io::cycles::read_nscd(&path).map_err(output_error)? } else { vec![] });
+    }
+    let runs: Vec<&[NscdCycleRow]> = cycles.iter().map(Vec::as_slice).collect();
+    let rows = settlement_ensemble(&runs, replicas.seating_cycles.min(loading.cycles));
+    let table = out.join("settlement_ensemble.csv");
+    io::table::write_all(&table, &rows)?;
+    ensemble_figure(&out.join("settlement_ensemble"), "Settlement of the sleeper", &runs, &rows)?;
+    Ok(SettleReplicas { runs: out.join("runs"), table, rows, failed })
+}
+
+/// The figure of an ensemble of settlement runs at `stem`: each replica's
+/// settlement at the load minimum as a thin line, the mean of the total and of
+/// the accrued settlement with their 95 % intervals (mm vs cycles).
+pub(crate) fn ensemble_figure(
+    stem: &Path,
+    title: &str,
+    runs: &[&[NscdCycleRow]],
+    rows: &[SettlementEnsembleRow],
+) -> Result<()> {
+    let mm = |x: f64| 1e3 * x;
+    let mut curves: Vec<Series> = runs
+        .iter()
+        .map(|r| Series {
+            label: String::new(),
+            points: r.iter().map(|c| (c.cycle as f64, mm(c.settlement_at_min_load_m))).collect(),
+            band: vec![],
+            thin: true,
+        })
+        .collect();
+    if let Some(first) = curves.first_mut() {
+        first.label = "each replica".into();
+    }
+    let n = runs.len();
+    let band = |lo: fn(&SettlementEnsembleRow) -> Option<f64>, hi: fn(&SettlementEnsembleRow) -> Option<f64>| {
+        rows.iter().filter_map(|r| Some((r.cycle as f64, mm(lo(r)?), mm(hi(r)?)))).collect::<Vec<_>>()
+    };
+    curves.push(Series {
+        label: format!("mean of {n} replicas, 95 % CI"),
+        points: rows.iter().map(|r| (r.cycle as f64, mm(r.settlement_mean_m))).collect(),
+        band: band(|r| r.settlement_ci95_low_m, |r| r.settlement_ci95_high_m),
+        thin: false,
+    });
+    let s = rows.first().map_or(0, |r| r.seating_cycle);
+    curves.push(Series {
+        label: format!("accrued since cycle {s}: mean, 95 % CI"),
+        points: rows.iter().filter_map(|r| Some((r.cycle as f64, mm(r.accrued_mean_m?)))).collect(),
+        band: band(|r| r.accrued_ci95_low_m, |r| r.accrued_ci95_high_m),
+        thin: false,
+    });
+    let title = format!("{title}: {n} replicas (at the load minimum)");
+    crate::io::figures::line_chart(stem, &super::axes(&title, "cycles", "settlement (mm)", false, false), &curves)
 }

@@ -178,6 +178,25 @@ where
     Ok(())
 }
 
+/// Thin lines ([`Series::thin`]).
+const THIN: RGBColor = RGBColor(150, 150, 150);
+
+/// The colour of each series: the palette in turn for the others, [`THIN`] for thin lines.
+fn colours(series: &[Series]) -> Vec<RGBColor> {
+    let mut k = 0;
+    series
+        .iter()
+        .map(|s| {
+            if s.thin {
+                THIN
+            } else {
+                k += 1;
+                PALETTE[(k - 1) % PALETTE.len()]
+            }
+        })
+        .collect()
+}
+
 struct LineChart<'a> {
     axes: &'a Axes,
     series: &'a [Series],
@@ -229,8 +248,14 @@ impl LineChart<'_> {
             .light_line_style(RGBColor(235, 235, 235))
             .bold_line_style(RGBColor(200, 200, 200))
             .draw()?;
-        for (k, s) in self.series.iter().enumerate() {
-            let colour = PALETTE[k % PALETTE.len()];
+        let colours = colours(self.series);
+        // Thin lines first, behind the bands and the coloured curves.
+        for s in self.series.iter().filter(|s| s.thin) {
+            let points: Vec<_> = s.points.iter().copied().filter(|p| self.ok(p.0, p.1)).collect();
+            chart.draw_series(std::iter::once(PathElement::new(points, THIN.stroke_width(1))))?;
+        }
+        for (k, s) in self.series.iter().enumerate().filter(|(_, s)| !s.thin) {
+            let colour = colours[k];
             let band: Vec<_> = s.band.iter().filter(|b| self.ok(b.0, b.1) && self.ok(b.0, b.2)).collect();
             if band.len() >= 2 {
                 let outline = band.iter().map(|b| (b.0, b.1)).chain(band.iter().rev().map(|b| (b.0, b.2)));
@@ -296,10 +321,11 @@ impl Figure for LineChart<'_> {
         let (entries, rows) = self.legend_layout(root, w.saturating_sub(2 * MARGIN + Y_LABEL_AREA));
         let legend_h = if rows > 0 { rows * LEGEND_ROW + 10 } else { 0 };
         let (plot, legend) = root.split_vertically(h.saturating_sub(legend_h));
+        let colours = colours(self.series);
         for (k, x, row) in entries {
-            let colour = PALETTE[k % PALETTE.len()];
             let y = (row * LEGEND_ROW + LEGEND_ROW / 2) as i32;
-            legend.draw(&PathElement::new(vec![(left + x, y), (left + x + 28, y)], colour.stroke_width(3)))?;
+            let width = if self.series[k].thin { 1 } else { 3 };
+            legend.draw(&PathElement::new(vec![(left + x, y), (left + x + 28, y)], colours[k].stroke_width(width)))?;
             let style = font(20).pos(Pos::new(HPos::Left, VPos::Center));
             legend.draw(&Text::new(self.series[k].label.clone(), (left + x + 36, y), style))?;
         }

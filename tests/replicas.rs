@@ -1,0 +1,240 @@
+//! Replicas from perturbed starts (`ballast::studies::replicas`): the
+//! perturbation of a scene, and `saussine settle | convergence --replicas` on
+//! a 50-grain sample (flat sleeper, 2 cycles at dt = 1 ms), whose ensemble
+//! tables must be the statistics of the replicas' own `cycles.csv`.
+
+use ballast::scene::Scene;
+use ballast::studies::replicas::{perturb_scene, t_quantile_975, Perturbation};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn temp_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ballast-replicas-{}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn run(args: &[&str]) -> String {
+    let r = Command::new(env!("CARGO_BIN_EXE_ballast")).args(args).arg("--quiet").output().unwrap();
+    assert!(r.status.success(), "{args:?}\nstderr: {}", String::from_utf8_lossy(&r.stderr));
+    String::from_utf8_lossy(&r.stdout).into_owned()
+}
+
+/// Rows of a CSV file as maps from column name to text.
+fn csv(path: &Path) -> Vec<HashMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    lines.map(|l| header.iter().cloned().zip(l.split(',').map(String::from)).collect()).collect()
+}
+
+fn num(row: &HashMap<String, String>, col: &str) -> f64 {
+    row.get(col).unwrap_or_else(|| panic!("no column {col}")).parse().unwrap_or_else(|_| panic!("{col}: {row:?}"))
+}
+
+fn close(a: f64, b: f64, what: &str) {
+    assert!((a - b).abs() <= 1e-12 * b.abs().max(1e-6), "{what}: {a} vs {b}");
+}
+
+#[test]
+fn perturbation_moves_mobile_bodies_within_the_disc() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = Scene::load(root.join("examples/pentagon_deposit.toml")).unwrap();
+    let fixed = scene.bodies.iter().filter(|b| b.is_fixed()).count();
+    assert!(fixed > 0 && fixed < scene.bodies.len());
+    let p = Perturbation { distance_m: 1e-9, seed: 11 };
+    let perturbed = |r: u64| {
+        let mut s = scene.clone();
+        let record = perturb_scene(&mut s, &p, r).unwrap();
+        (s, record)
+    };
+    // Replica 0 is the start itself.
+    let (zero, record) = perturbed(0);
+    assert_eq!(zero, scene);
+    assert_eq!((record.replica, record.bodies_moved, record.perturb_seed), (0, 0, 11));
+    let (one, record) = perturbed(1);
+    assert_eq!(record.bodies_moved, scene.bodies.len() - fixed);
+    for (a, b) in scene.bodies.iter().zip(&one.bodies) {
+        let d = (b.position[0] - a.position[0]).hypot(b.position[1] - a.position[1]);
+        if a.is_fixed() {
+            assert_eq!(a, b, "a fixed body does not move");
+        } else {
+            // ≤ the radius (plus the rounding of a coordinate near 0.5 m).
+            assert!(d > 0.0 && d <= 1e-9 + 1e-15, "{}: moved {d:e}", a.name);
+            assert_eq!((a.angle, a.velocity), (b.angle, b.velocity));
+        }
+    }
+    assert!(record.largest_displacement_m <= 1e-9 && record.largest_displacement_m > 0.5e-9);
+    // Same seed and replica: the same scene; another replica or seed: another.
+    assert_eq!(perturbed(1).0, one);
+    assert_ne!(perturbed(2).0, one);
+    let mut other = scene.clone();
+    perturb_scene(&mut other, &Perturbation { seed: 12, ..p }, 1).unwrap();
+    assert_ne!(other, one);
+    // Invalid distances are refused, naming the option.
+    let e = perturb_scene(&mut scene.clone(), &Perturbation { distance_m: -1.0, seed: 0 }, 1).unwrap_err();
+    assert!(e.to_string().contains("--perturb"), "{e}");
+}
+
+/// A 50-grain sample (as the ensemble study's test deposits it).
+fn sample(dir: &Path) -> String {
+    let out = dir.join("sample");
+    run(&["saussine", "sample", "--grains", "50", "--dt", "5e-4", "--out", out.to_str().unwrap()]);
+    out.join("sample.toml").to_str().unwrap().to_string()
+}
+
+const SHORT: [&str; 6] = ["--cycles", "2", "--dt", "1e-3", "--bars", "0"];
+
+/// `saussine settle --replicas 3`: three runs side by side, each with its
+/// perturbed scene and `replica.json`; `settlement_ensemble.csv` is the mean,
+/// sd and Student-t interval of their own `cycles.csv`, seating and accrued
+/// per replica; `--resume` reruns nothing. With `--perturb 0` the replicas are
+/// the same run: identical settlements, sd exactly 0.
+#[test]
+fn settle_replicas_ensemble_is_that_of_the_replicas() {
+    let dir = temp_dir("settle");
+    let sample = sample(&dir);
+    let out = dir.join("settle");
+    let out_s = out.to_str().unwrap();
+    let args = [
+        &["saussine", "settle", "--sample", &sample, "--out", out_s, "--replicas", "3", "--seating-cycles", "1"][..],
+        &["--perturb-seed", "5", "--jobs", "2", "--snapshot-every", "0"],
+        &SHORT,
+    ]
+    .concat();
+    let stdout = run(&args);
+    assert!(stdout.contains("3 replicas, cycle 2"), "{stdout}");
+    let replica = |r: usize| out.join(format!("runs/replica-{r}"));
+    let cycles: Vec<Vec<HashMap<String, String>>> = (0..3).map(|r| csv(&replica(r).join("cycles.csv"))).collect();
+    for (r, c) in cycles.iter().enumerate() {
+        assert_eq!(c.len(), 2, "replica {r}");
+        let rec: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(replica(r).join("replica.json")).unwrap()).unwrap();
+        assert_eq!((rec["replica"].as_u64(), rec["perturb_seed"].as_u64()), (Some(r as u64), Some(5)));
+        assert_eq!(rec["perturb_m"].as_f64(), Some(1e-9));
+        for f in ["loaded.toml", "summary.json", "settlement.png", "scene.toml"] {
+            assert!(replica(r).join(f).is_file(), "replica {r}: {f}");
+        }
+    }
+    // The scene each replica ran is its perturbed start.
+    let loaded = |r: usize| Scene::load(replica(r).join("loaded.toml")).unwrap();
+    let plain = dir.join("plain.toml");
+    let r = Command::new(env!("CARGO_BIN_EXE_ballast"))
+        .args(["saussine", "load", "--sample", &sample, "--out", plain.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(r.status.success());
+    let plain = Scene::load(&plain).unwrap();
+    let positions = |s: &Scene| s.bodies.iter().map(|b| b.position).collect::<Vec<_>>();
+    assert_eq!(positions(&loaded(0)), positions(&plain), "replica 0 is the unperturbed start");
+    assert_ne!(positions(&loaded(1)), positions(&plain));
+    assert_ne!(positions(&loaded(1)), positions(&loaded(2)));
+
+    let rows = csv(&out.join("settlement_ensemble.csv"));
+    assert_eq!(rows.len(), 2);
+    let t2 = t_quantile_975(2.0);
+    assert!((t2 - 4.302_652_73).abs() < 1e-7);
+    for (c, row) in rows.iter().enumerate() {
+        assert_eq!((num(row, "cycle"), num(row, "replicas"), num(row, "seating_cycle")), ((c + 1) as f64, 3.0, 1.0));
+        let s: Vec<f64> = cycles.iter().map(|r| num(&r[c], "settlement_at_min_load_m")).collect();
+        let mean = s.iter().sum::<f64>() / 3.0;
+        let sd = (s.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 2.0).sqrt();
+        close(num(row, "settlement_mean_m"), mean, "mean");
+        close(num(row, "settlement_sd_m"), sd, "sd");
+        close(num(row, "settlement_ci95_high_m"), mean + t2 * sd / 3f64.sqrt(), "ci high");
+        close(num(row, "settlement_ci95_low_m"), mean - t2 * sd / 3f64.sqrt(), "ci low");
+        // Accrued since cycle 1, per replica then averaged.
+        let a: Vec<f64> = cycles
+            .iter()
+            .map(|r| num(&r[c], "settlement_at_min_load_m") - num(&r[0], "settlement_at_min_load_m"))
+            .collect();
+        close(num(row, "accrued_mean_m"), a.iter().sum::<f64>() / 3.0, "accrued");
+    }
+    // The sleeper goes down, and 1e-9 m at the start changes the settlement.
+    assert!(num(&rows[1], "settlement_mean_m") > 0.0 && num(&rows[1], "settlement_sd_m") > 0.0, "{rows:?}");
+    for stem in ["settlement_ensemble.png", "settlement_ensemble.svg"] {
+        assert!(std::fs::metadata(out.join(stem)).unwrap().len() > 1000);
+    }
+    // Resumed, the finished replicas are not rerun.
+    let summary = replica(2).join("summary.json");
+    let before = std::fs::read(&summary).unwrap();
+    run(&[&args[..], &["--resume"]].concat());
+    assert_eq!(std::fs::read(&summary).unwrap(), before);
+
+    // Determinism: unperturbed replicas are the same run, bit for bit.
+    let same = dir.join("same");
+    let args = [
+        &["saussine", "settle", "--sample", &sample, "--out", same.to_str().unwrap(), "--replicas", "2"][..],
+        &["--perturb", "0", "--snapshot-every", "0"],
+        &SHORT,
+    ]
+    .concat();
+    run(&args);
+    let (a, b) = (csv(&same.join("runs/replica-0/cycles.csv")), csv(&same.join("runs/replica-1/cycles.csv")));
+    assert_eq!(a, b);
+    let rows = csv(&same.join("settlement_ensemble.csv"));
+    for row in &rows {
+        assert_eq!(num(row, "settlement_sd_m"), 0.0, "{row:?}");
+        // S = 10 clipped to the 2 cycles run: no accrued settlement before cycle 2.
+        assert_eq!(num(row, "seating_cycle"), 2.0);
+    }
+    assert_eq!(rows[0]["accrued_mean_m"], "");
+    assert_eq!((num(&rows[1], "accrued_mean_m"), num(&rows[1], "accrued_sd_m")), (0.0, 0.0));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `saussine convergence --replicas 2`: one row per run, the ensemble columns
+/// of its setting, and the difference from the reference (by default the
+/// tightest tolerance when no strict run is there) with Welch's interval.
+#[test]
+fn convergence_replicas_compare_with_the_reference() {
+    let dir = temp_dir("conv");
+    let sample = sample(&dir);
+    let out = dir.join("conv");
+    let args = [
+        &["saussine", "convergence", "--sample", &sample, "--out", out.to_str().unwrap()][..],
+        &["--policies", "quad:1e-2,quad:1e-4", "--replicas", "2", "--seating-cycles", "1", "--jobs", "2"],
+        &SHORT,
+    ]
+    .concat();
+    run(&args);
+    let rows = csv(&out.join("convergence.csv"));
+    assert_eq!(rows.len(), 4);
+    for (row, (label, replica)) in
+        rows.iter().zip([("quad_1e-2", 0), ("quad_1e-2", 1), ("quad_1e-4", 0), ("quad_1e-4", 1)])
+    {
+        assert_eq!((row["replica"].as_str(), row["status"].as_str()), (replica.to_string().as_str(), "ok"));
+        assert_eq!(row["reference"], "quad:1e-4");
+        let c = csv(&out.join("runs").join(label).join(format!("replica-{replica}/cycles.csv")));
+        close(num(row, "settlement_at_min_load_m"), num(&c[1], "settlement_at_min_load_m"), "run's settlement");
+    }
+    let setting =
+        |k: usize| -> Vec<f64> { (0..2).map(|r| num(&rows[2 * k + r], "settlement_at_min_load_m")).collect() };
+    let (loose, tight) = (setting(0), setting(1));
+    let mean = |v: &[f64]| 0.5 * (v[0] + v[1]);
+    close(num(&rows[0], "settlement_ens_mean_m"), mean(&loose), "ensemble mean");
+    close(num(&rows[1], "settlement_ens_mean_m"), mean(&loose), "repeated on each run of the setting");
+    close(num(&rows[0], "settlement_diff_m"), mean(&loose) - mean(&tight), "difference");
+    // Welch with two values each: se² = (a₀ − a₁)²/4 + (b₀ − b₁)²/4.
+    let se = (((loose[0] - loose[1]).powi(2) + (tight[0] - tight[1]).powi(2)) / 4.0).sqrt();
+    let half = num(&rows[0], "settlement_diff_ci95_high_m") - num(&rows[0], "settlement_diff_m");
+    assert!(half >= t_quantile_975(2.0) * se * (1.0 - 1e-9) && half <= t_quantile_975(1.0) * se * (1.0 + 1e-9));
+    // The reference against itself: a zero difference, within its interval.
+    assert_eq!(num(&rows[2], "settlement_diff_m"), 0.0);
+    assert_eq!(rows[2]["settlement_same_as_reference"], "true");
+    for stem in ["settlement_ensemble", "cumulated_interpenetration", "iterations_vs_tolerance"] {
+        assert!(out.join(format!("{stem}.svg")).is_file(), "{stem}");
+    }
+    // A reference that is not among the runs is refused before any run.
+    let r = Command::new(env!("CARGO_BIN_EXE_ballast"))
+        .args(["saussine", "convergence", "--sample", &sample, "--policies", "quad:1e-2", "--reference", "strict:1e-4"])
+        .args(["--out", dir.join("bad").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("--reference"));
+    assert!(!dir.join("bad/runs").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
