@@ -286,7 +286,7 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
             return err(format!("nscd.measure: unknown value '{}', expected 'sweep' or 'check'", super::clip(m)))
         }
     };
-    if measure == Measure::Check && policy == Policy::Energy {
+    if ns.measure.as_deref() == Some("check") && policy == Policy::Energy {
         return err("nscd.measure: 'check' measures a residual (strict, quad, quad_max); the energy criterion \
                     is a change from sweep to sweep, measured during the sweeps: remove the key or use 'sweep'"
             .to_string());
