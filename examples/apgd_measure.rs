@@ -38,6 +38,8 @@ struct Row {
     criterion: f64,
     wall_s: f64,
     du_max: f64,
+    du_body: usize,
+    du_energy: f64,
     dpn_rel: f64,
     reference_converged: bool,
 }
@@ -152,11 +154,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let i = (j + turn) % methods.len();
                 let m = &methods[i];
                 let (x, report, wall_s) = run(m, &mut ws, &p);
-                let du_max =
-                    x.u.iter()
-                        .zip(&r.u)
-                        .flat_map(|(a, b)| (0..3).map(move |d| (a[d] - b[d]).abs()))
-                        .fold(0.0, f64::max);
+                let (mut du_max, mut du_body, mut e_diff, mut e_ref) = (0.0, 0, 0.0, 0.0);
+                for (b, ((a, c), im)) in x.u.iter().zip(&r.u).zip(&p.inv_m).enumerate() {
+                    for d in 0..3 {
+                        let du = (a[d] - c[d]).abs();
+                        if du > du_max {
+                            (du_max, du_body) = (du, b);
+                        }
+                        if im[d] > 0.0 {
+                            (e_diff, e_ref) = (e_diff + du * du / im[d], e_ref + c[d] * c[d] / im[d]);
+                        }
+                    }
+                }
+                let du_energy = if e_ref > 0.0 { (e_diff / e_ref).sqrt() } else { e_diff.sqrt() };
                 let d2: f64 = x.rows.iter().zip(&r.rows).map(|(a, b)| (a.p[0] - b.p[0]).powi(2)).sum();
                 let dpn_rel = if pn2 > 0.0 { (d2 / pn2).sqrt() } else { d2.sqrt() };
                 let t = &mut totals[i];
@@ -175,6 +185,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     criterion: report.criterion,
                     wall_s,
                     du_max,
+                    du_body,
+                    du_energy,
                     dpn_rel,
                     reference_converged: rr.converged,
                 })?;
