@@ -76,7 +76,12 @@ fn parse(text: &str, base: &NlgsSettings) -> Result<Method, String> {
             (_, _) if number("cap").is_some() => settings.max_iterations = number("cap").unwrap_or(1),
             (&"outer", Some(a)) => a.friction = FrictionBound::Outer,
             (&"plain", Some(a)) => a.precondition = false,
+            (&"norestart", Some(a)) => a.restart = false,
+            (_, Some(a)) if o.starts_with("decay") => {
+                a.l_decay = o["decay".len()..].parse().map_err(|e| format!("{o}: {e}"))?
+            }
             (_, Some(a)) if number("nlgs").is_some() => a.nlgs_first = number("nlgs").unwrap_or(0),
+            (_, Some(a)) if number("fallback").is_some() => a.fallback = number("fallback").unwrap_or(0),
             (_, Some(a)) if number("check").is_some() => a.check_every = number("check").unwrap_or(1),
             _ => return Err(format!("{o}: unknown option for {kind}")),
         }

@@ -43,7 +43,9 @@
 //! evaluated with the same policy ([`super::criterion::evaluate`]). The check is
 //! made when a cheap proxy (the policy's norms of the change of the iterate over
 //! one iteration) times the last measured check/proxy ratio meets the tolerance,
-//! at least every [`ApgdOptions::check_every`] iterations, and at the cap.
+//! at least every [`ApgdOptions::check_every`] iterations, and at the cap. The
+//! iterates are not monotone: a step that reaches the cap returns the best
+//! checked iterate (as Chrono returns the one of least residual).
 //!
 //! **Work** is counted in sweep-equivalents: a scatter or a gather over all rows
 //! is half a sweep (an NLGS sweep is one gather and one scatter per row), a check
@@ -57,7 +59,7 @@
 
 use super::contact::{dot3, ContactRow};
 use super::criterion::{evaluate, SweepNorms};
-use super::nlgs::{check, sweep, NlgsReport, NlgsSettings};
+use super::nlgs::{check, solve_nlgs, sweep, NlgsReport, NlgsSettings};
 use super::sublayer::SpringRow;
 
 /// How the friction bound `g_α` of the box is set.
@@ -87,11 +89,21 @@ pub struct ApgdOptions {
     pub nlgs_first: usize,
     /// A check is made at least every this many iterations, ≥ 1; default 25.
     pub check_every: usize,
+    /// Adaptive restart of the momentum (O'Donoghue and Candès' gradient test, as
+    /// in Mazhar et al.); default true.
+    pub restart: bool,
+    /// Factor applied to the Lipschitz estimate `L` after every iteration, in
+    /// (0, 1] (Chrono: 0.9); default 0.9.
+    pub l_decay: f64,
+    /// Fall back to plain NLGS (from the best checked iterate, for the rest of
+    /// the sweep budget) after this many checks in a row without improving on the
+    /// best; 0: never; default 0.
+    pub fallback: usize,
 }
 
 impl Default for ApgdOptions {
     fn default() -> Self {
-        Self { friction: FrictionBound::Iterate, precondition: true, nlgs_first: 0, check_every: 25 }
+        Self { friction: FrictionBound::Iterate, precondition: true, nlgs_first: 0, check_every: 25, restart: true, l_decay: 0.9, fallback: 0 }
     }
 }
 
@@ -118,6 +130,9 @@ pub struct ApgdWorkspace {
     xs_prev: Vec<f64>,
     gs: Vec<f64>,
     scale_s: Vec<f64>,
+    /// Best checked iterate (contacts, springs), returned if the cap is reached.
+    best: Vec<[f64; 2]>,
+    best_s: Vec<f64>,
 }
 
 #[inline(always)]
@@ -305,6 +320,9 @@ pub fn solve_apgd_with(
     let mut since_check = 0usize;
     let mut previous_wpp = 0.0;
     let mut last;
+    let mut best_value = f64::INFINITY;
+    let mut stagnant = 0usize;
+    let mut fall_back = false;
     loop {
         // Gradient at y: the local velocities (one gather).
         for (i, r) in rows.iter().enumerate() {
@@ -426,7 +444,7 @@ pub fn solve_apgd_with(
         }
 
         // Nesterov's extrapolation, or a restart.
-        if restart_dot > 0.0 {
+        if opts.restart && restart_dot > 0.0 {
             theta = 1.0;
             restart(ws, u, rows, springs);
         } else {
@@ -447,7 +465,7 @@ pub fn solve_apgd_with(
                 }
             }
         }
-        l *= 0.9;
+        l *= opts.l_decay;
 
         // Convergence, judged by NLGS's check.
         let (value, _) = evaluate(s.policy, s.tolerance, s.max_factor, &proxy, previous_wpp);
@@ -463,6 +481,19 @@ pub fn solve_apgd_with(
                 ratio = (last.0 / value).clamp(1e-3, 1e3);
             }
             if (last.1 && halves.div_ceil(2) >= s.min_iterations) || at_cap {
+                break;
+            }
+            stagnant += 1;
+            if last.0 < best_value {
+                stagnant = 0;
+                best_value = last.0;
+                ws.best.clear();
+                ws.best.extend(rows.iter().map(|r| r.p));
+                ws.best_s.clear();
+                ws.best_s.extend(springs.iter().map(|sp| sp.p));
+            }
+            if opts.fallback > 0 && stagnant >= opts.fallback {
+                fall_back = true;
                 break;
             }
             // Outer updates: threshold labels, Tresca bounds.
@@ -486,10 +517,26 @@ pub fn solve_apgd_with(
         }
     }
 
+    // APGD is not monotone: at the cap, the best checked iterate is returned.
+    if (fall_back || !last.1) && best_value < last.0 {
+        last.0 = best_value;
+        for (r, p) in rows.iter_mut().zip(&ws.best) {
+            r.p = *p;
+        }
+        for (sp, p) in springs.iter_mut().zip(&ws.best_s) {
+            sp.p = *p;
+        }
+    }
     // Velocities recomputed from the impulses (no drift of the increments).
     u.copy_from_slice(&ws.u_free);
     scatter(u, inv_m, rows, springs, None, 1.0);
     halves += 1;
+    if fall_back {
+        let done = halves.div_ceil(2);
+        let rest = NlgsSettings { max_iterations: s.max_iterations.saturating_sub(done).max(1), ..*s };
+        let r = solve_nlgs(&rest, u, inv_m, rows, springs);
+        return NlgsReport { iterations: done + r.iterations, ..r };
+    }
     report(halves, last.0, last.1)
 }
 
