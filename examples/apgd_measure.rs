@@ -149,7 +149,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut totals = vec![(0usize, 0.0f64, 0usize, 0.0f64, 0.0f64, 0usize); methods.len()];
     let mut turn = 0;
     for k in 1..=steps {
-        if k >= from && (k - from) % every == 0 {
+        if k >= from && (k - from).is_multiple_of(every) {
             let p = frozen_problem(&sys)?;
             let (r, rr, _) = run(&reference, &mut ws, &p);
             let pn2: f64 = r.rows.iter().map(|x| x.p[0] * x.p[0]).sum();

@@ -103,7 +103,15 @@ pub struct ApgdOptions {
 
 impl Default for ApgdOptions {
     fn default() -> Self {
-        Self { friction: FrictionBound::Iterate, precondition: true, nlgs_first: 0, check_every: 25, restart: true, l_decay: 0.9, fallback: 0 }
+        Self {
+            friction: FrictionBound::Iterate,
+            precondition: true,
+            nlgs_first: 0,
+            check_every: 25,
+            restart: true,
+            l_decay: 0.9,
+            fallback: 0,
+        }
     }
 }
 
@@ -297,7 +305,7 @@ pub fn solve_apgd_with(
             l = l.max(d);
         }
     }
-    if !(l > 0.0) {
+    if l.is_nan() || l <= 0.0 {
         l = 1.0;
     }
     ws.y.clear();
