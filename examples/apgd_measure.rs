@@ -8,8 +8,11 @@
 //! `cargo run --release --example apgd_measure -- SCENE STEPS EVERY METHOD...`
 //! with METHOD = `KIND:POLICY:TOLERANCE[:OPTION...]`, KIND `nlgs` (plain, unsplit
 //! [`ballast::nscd::nlgs::solve_nlgs`]) or `apgd`, OPTION (apgd) among `outer`
-//! (Tresca outer fixed point), `plain` (no diagonal preconditioning), `nlgsN` (N
-//! NLGS sweeps first), `checkN` (a check at least every N iterations), and for
+//! (Tresca outer fixed point), `plain` (no diagonal preconditioning), `nlgsN`
+//! (plain NLGS for at most N sweeps first; without it, none: `apgd` alone is the
+//! pure accelerated solver, whereas [`ApgdOptions::default`] has `nlgs50`),
+//! `norestart`, `decayX` (factor on `L` per iteration), `fallbackN` (plain NLGS
+//! after N checks without progress), `checkN` (a check at least every N iterations), and for
 //! both `capN` (`max_iterations`, default the scene's). The reference is
 //! `--reference METHOD` (default `apgd:quad:1e-8:cap20000`), given before SCENE.
 //! Sampled steps start at step `--from K` (default `EVERY`).
@@ -67,7 +70,7 @@ fn parse(text: &str, base: &NlgsSettings) -> Result<Method, String> {
     let mut settings = NlgsSettings { policy, tolerance, measure: Measure::Check, split_min_rows: 0, ..*base };
     let mut apgd = match *kind {
         "nlgs" => None,
-        "apgd" => Some(ApgdOptions::default()),
+        "apgd" => Some(ApgdOptions { nlgs_first: 0, ..ApgdOptions::default() }),
         k => return Err(format!("{k}: unknown kind (nlgs or apgd)")),
     };
     for o in options {
