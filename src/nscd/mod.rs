@@ -39,6 +39,7 @@
 //! # Ok::<(), ballast::Error>(())
 //! ```
 
+pub mod apgd;
 pub mod bodies;
 pub mod broad_phase;
 pub mod contact;
