@@ -60,24 +60,41 @@ fn quad_max_policy_prevents_the_interpenetration_that_quad_allows() {
     assert!(worst[2] * 5.0 < worst[0], "quad {:.3e} vs quad_max(1) {:.3e}", worst[0], worst[2]);
 }
 
-/// Warm start: a resting column converges in the minimum number of sweeps once
-/// its contact impulses are carried over from the previous step.
+/// Warm start: a resting column converges in a few sweeps once its contact
+/// impulses are carried over from the previous step, where a cold start needs
+/// many to carry the weight down 10 blocks.
+///
+/// How few depends on where the norm is measured. With the norm of the sweeps
+/// (1.6× the residual), every step stops at a residual well below the tolerance,
+/// and the next, warm-started, meets it at once (≤ 2 sweeps). With LMGC90's check
+/// (the default), a step stops as soon as the residual dips below the tolerance;
+/// the next starts just above it, and the column's slowest mode (two contact
+/// points per face, a hyperstatic stack) shaves the last per cent slowly: measured
+/// 350 sweeps, where the cold start stops at the 5000-sweep cap. Asserted: under
+/// half the cold start's.
 #[test]
 fn warm_start_makes_a_resting_column_converge_immediately() {
-    let mut s = system(1e-3, 0.5, 0.0);
-    s.params.nlgs.tolerance = 1e-6;
-    floor(&mut s);
-    for k in 0..10 {
-        rect(&mut s, 0.05, 0.05, 0.0, 0.05 * (k as f64 + 0.5), 0.0, false);
+    for measure in [ballast::nscd::Measure::Sweep, ballast::nscd::Measure::Check] {
+        let mut s = system(1e-3, 0.5, 0.0);
+        s.params.nlgs.tolerance = 1e-6;
+        s.params.nlgs.measure = measure;
+        floor(&mut s);
+        for k in 0..10 {
+            rect(&mut s, 0.05, 0.05, 0.0, 0.05 * (k as f64 + 0.5), 0.0, false);
+        }
+        let first = s.step().unwrap();
+        run(&mut s, 50);
+        let later = s.step().unwrap();
+        eprintln!("{measure:?}: cold {} sweeps, warm {}", first.iterations, later.iterations);
+        assert!(first.iterations > 10, "cold start took {} sweeps", first.iterations);
+        match measure {
+            ballast::nscd::Measure::Sweep => assert!(later.iterations <= 2, "warm start took {}", later.iterations),
+            ballast::nscd::Measure::Check => {
+                assert!(later.converged && 2 * later.iterations < first.iterations, "{later:?} vs {first:?}")
+            }
+        }
+        assert_eq!(later.contacts, 20, "two contact points per face");
     }
-    let first = s.step().unwrap();
-    run(&mut s, 50);
-    let later = s.step().unwrap();
-    // From zero impulses, Gauss–Seidel needs many sweeps to carry the weight down
-    // 10 blocks; with the previous impulses the first sweep already meets 1e-6.
-    assert!(first.iterations > 10, "cold start took {} sweeps", first.iterations);
-    assert!(later.iterations <= 2, "warm start took {} sweeps", later.iterations);
-    assert_eq!(later.contacts, 20, "two contact points per face");
 }
 
 /// Same system, same numbers: bitwise.

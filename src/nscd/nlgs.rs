@@ -49,6 +49,9 @@ pub struct NlgsSettings {
     /// (the energy policy is always measured over the sweeps).
     #[serde(default)]
     pub measure: Measure,
+    /// The solver of each step ([`Solver`]); default [`Solver::Nlgs`].
+    #[serde(default)]
+    pub solver: Solver,
     /// What a step does when `max_iterations` sweeps have not met the tolerance
     /// ([`OnStall`]); default [`OnStall::Accept`].
     #[serde(default)]
@@ -57,6 +60,29 @@ pub struct NlgsSettings {
     /// default 10 × the default `max_iterations`.
     #[serde(default = "default_stall_max_iterations")]
     pub stall_max_iterations: usize,
+}
+
+/// The solver of each step's problem.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Solver {
+    /// Nonlinear Gauss–Seidel (this module; the default).
+    #[default]
+    Nlgs,
+    /// Up to 50 NLGS sweeps, then, if the step has not converged, the accelerated
+    /// projected gradient of [`super::apgd`] with its default options; the same
+    /// stopping rule, `max_iterations` counted in sweep-equivalents; one thread.
+    Apgd,
+}
+
+impl Solver {
+    /// The name in scenes (`nlgs`, `apgd`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Solver::Nlgs => "nlgs",
+            Solver::Apgd => "apgd",
+        }
+    }
 }
 
 /// What a step does when its sweeps reach `max_iterations` without meeting the
@@ -113,6 +139,7 @@ impl Default for NlgsSettings {
             symmetric: false,
             split_min_rows: DEFAULT_SPLIT_MIN_ROWS,
             measure: Measure::default(),
+            solver: Solver::default(),
             on_stall: OnStall::default(),
             stall_max_iterations: DEFAULT_STALL_MAX_ITERATIONS,
         }

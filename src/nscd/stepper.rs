@@ -13,8 +13,9 @@
 //! than half the smaller inradius of the two bodies stops the run with an error
 //! naming the step and body, and the state goes back to the start of the step.
 
+use super::apgd::{solve_apgd_with, ApgdOptions};
 use super::contact::ContactRow;
-use super::nlgs::{apply_impulses, solve_nlgs_split};
+use super::nlgs::{apply_impulses, solve_nlgs_split, OnStall, Solver};
 use super::system::{StepStats, System};
 use crate::error::{Error, Result};
 use crate::geometry::Vec2;
@@ -108,18 +109,37 @@ impl System {
 
         // 4. NLGS.
         apply_impulses(&mut self.bodies.u, &self.bodies.inv_m, &ws.rows, &ws.spring_rows);
-        let report = solve_nlgs_split(
-            &self.params.nlgs,
-            &mut ws.split,
-            ws.threads,
-            &ws.q_m,
-            &mut self.bodies.u,
-            &self.bodies.inv_m,
-            &mut ws.rows,
-            &mut ws.spring_rows,
-        );
+        let settings = &self.params.nlgs;
+        let report = match settings.solver {
+            Solver::Nlgs => solve_nlgs_split(
+                settings,
+                &mut ws.split,
+                ws.threads,
+                &ws.q_m,
+                &mut self.bodies.u,
+                &self.bodies.inv_m,
+                &mut ws.rows,
+                &mut ws.spring_rows,
+            ),
+            Solver::Apgd => {
+                // The accelerated solver has one cap: an extended step gets the larger.
+                let mut s = *settings;
+                if s.on_stall == OnStall::Extend {
+                    s.max_iterations = s.stall_max_iterations.max(s.max_iterations);
+                }
+                solve_apgd_with(
+                    &s,
+                    &ApgdOptions::default(),
+                    &mut ws.apgd,
+                    &mut self.bodies.u,
+                    &self.bodies.inv_m,
+                    &mut ws.rows,
+                    &mut ws.spring_rows,
+                )
+            }
+        };
 
-        if !report.converged && self.params.nlgs.on_stall == super::nlgs::OnStall::Stop {
+        if !report.converged && self.params.nlgs.on_stall == OnStall::Stop {
             self.bodies.q.clone_from(&ws.q_i);
             self.bodies.u.clone_from(&ws.u_i);
             self.ws = ws;

@@ -141,6 +141,8 @@ pub(crate) struct Workspace {
     pub spring_rows: Vec<SpringRow>,
     pub detector: Detector,
     pub split: super::split::SplitWorkspace,
+    /// Buffers of the accelerated solver ([`super::apgd`]).
+    pub apgd: super::apgd::ApgdWorkspace,
     /// Threads of the NLGS sweeps (0 or 1: one); not part of the state.
     pub threads: usize,
 }

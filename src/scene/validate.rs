@@ -7,7 +7,7 @@
 use super::format::{BodySpec, Drive, NscdSection, Scene};
 use crate::error::{Error, Result};
 use crate::geometry::{rotate, Compound, ConvexPolygon, GeometryError, Shape, Vec2};
-use crate::nscd::nlgs::OnStall;
+use crate::nscd::nlgs::{OnStall, Solver};
 use crate::nscd::{Measure, NlgsSettings, NscdParams, Policy};
 use std::collections::HashMap;
 
@@ -291,6 +291,17 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
                     is a change from sweep to sweep, measured during the sweeps: remove the key or use 'sweep'"
             .to_string());
     }
+    let solver = match ns.solver.as_deref() {
+        None => defaults.nlgs.solver,
+        Some("nlgs") => Solver::Nlgs,
+        Some("apgd") => Solver::Apgd,
+        Some(m) => return err(format!("nscd.solver: unknown solver '{}', expected 'nlgs' or 'apgd'", super::clip(m))),
+    };
+    if solver == Solver::Apgd && policy == Policy::Energy {
+        return err(
+            "nscd.solver: 'apgd' stops on a residual (strict, quad, quad_max), not on the energy criterion".to_string()
+        );
+    }
     let on_stall = match ns.on_stall.as_deref() {
         None => defaults.nlgs.on_stall,
         Some("accept") => OnStall::Accept,
@@ -328,6 +339,7 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
         symmetric: ns.symmetric.unwrap_or(false),
         split_min_rows: defaults.nlgs.split_min_rows,
         measure,
+        solver,
         on_stall,
         stall_max_iterations,
     };
