@@ -424,20 +424,7 @@ pub fn solve_apgd_with(
             if st > 0.0 {
                 restart_dot += (yt - qt) * dt / st;
             }
-            let (dun, dut) = (w.nn * dn + w.nt * dt, w.nt * dn + w.tt * dt);
-            let (wpn, wpt) = (w.nn * pn + w.nt * pt, w.nt * pn + w.tt * pt);
-            let (wqn, wqt) = (w.nn * qn + w.nt * qt, w.nt * qn + w.tt * qt);
-            let (mn, mt) = (0.5 * (pn + qn), 0.5 * (pt + qt));
-            let wqq = qn * wqn + qt * wqt;
-            proxy.add(
-                dun * dun + dut * dut,
-                mn * mn + mt * mt,
-                mn * dun + mt * dut,
-                0.5 * (pn * wpn + pt * wpt + wqq),
-                0.5 * (wpn * wpn + wpt * wpt + wqn * wqn + wqt * wqt),
-                wqq,
-                dn != 0.0 || dt != 0.0,
-            );
+            proxy.add_contact(w, [pn, pt], [qn, qt], dn != 0.0 || dt != 0.0);
         }
         for (j, sp) in springs.iter().enumerate() {
             let (p_old, p, sj) = (ws.xs_prev[j], sp.p, ws.scale_s[j]);

@@ -300,20 +300,7 @@ fn sweep_in<'r, 's, const UPDATE: bool>(
             apply(&mut u[a], &inv_m[a], &r.hn_a, dn, &r.ht_a, dt, 1.0);
             apply(&mut u[b], &inv_m[b], &r.hn_b, dn, &r.ht_b, dt, -1.0);
         }
-        let (dun, dut) = (w.nn * dn + w.nt * dt, w.nt * dn + w.tt * dt);
-        let (wpn, wpt) = (w.nn * pn + w.nt * pt, w.nt * pn + w.tt * pt);
-        let (wqn, wqt) = (w.nn * qn + w.nt * qt, w.nt * qn + w.tt * qt);
-        let (mn, mt) = (0.5 * (pn + qn), 0.5 * (pt + qt));
-        let wqq = qn * wqn + qt * wqt;
-        norms.add(
-            dun * dun + dut * dut,
-            mn * mn + mt * mt,
-            mn * dun + mt * dut,
-            0.5 * (pn * wpn + pt * wpt + wqq),
-            0.5 * (wpn * wpn + wpt * wpt + wqn * wqn + wqt * wqt),
-            wqq,
-            changed,
-        );
+        norms.add_contact(w, [pn, pt], [qn, qt], changed);
     }
     norms
 }
