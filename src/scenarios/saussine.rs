@@ -426,7 +426,10 @@ impl LoadingSpec {
     /// a 250 × 40 mm aluminium sleeper with two 10 mm bars; dt = 2e-4 s, `energy`
     /// 1.66e-5, at most 2000 sweeps: the cheapest setting measured to keep the max
     /// interpenetration below 1 % of the smallest grain over 1000 cycles of the
-    /// full sample (71.5 µm; `energy` 1.66e-4 reached 661 µm, BENCHMARKS.md). The width is argued in
+    /// full sample (71.5 µm; `energy` 1.66e-4 reached 661 µm, BENCHMARKS.md). Its stated
+    /// settlement error against a `strict` reference, on a 50-grain sample: the total within the
+    /// replicas' noise, the settlement accrued after the seating about half the reference's
+    /// (BENCHMARKS.md, "Settlement against the stopping rule"). The width is argued in
     /// `data/saussine2006/README.md` (a 100 mm block punches into the layer).
     pub fn saussine(cycles: u64) -> Self {
         Self {
