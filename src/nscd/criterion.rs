@@ -57,6 +57,14 @@ pub enum Policy {
 }
 
 impl Policy {
+    /// Every policy, in the order scenes list them.
+    pub const ALL: [Policy; 4] = [Policy::Strict, Policy::Quad, Policy::QuadMax, Policy::Energy];
+
+    /// The policy named `name` (as [`Policy::name`] writes it).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|p| p.name() == name)
+    }
+
     /// The policy's name in scenes and reports (`strict`, `quad`, `quad_max`, `energy`),
     /// as serde writes it.
     pub fn name(self) -> &'static str {
@@ -83,6 +91,21 @@ pub enum Measure {
     /// tolerance, and at the sweep cap: 1–3 passes per step.
     #[default]
     Check,
+}
+
+impl Measure {
+    /// The name in scenes (`sweep`, `check`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Measure::Sweep => "sweep",
+            Measure::Check => "check",
+        }
+    }
+
+    /// The measure named `name` (as [`Measure::name`] writes it).
+    pub fn from_name(name: &str) -> Option<Self> {
+        [Measure::Sweep, Measure::Check].into_iter().find(|m| m.name() == name)
+    }
 }
 
 /// Running sums over one sweep.

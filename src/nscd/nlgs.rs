@@ -83,6 +83,11 @@ impl Solver {
             Solver::Apgd => "apgd",
         }
     }
+
+    /// The solver named `name` (as [`Solver::name`] writes it).
+    pub fn from_name(name: &str) -> Option<Self> {
+        [Solver::Nlgs, Solver::Apgd].into_iter().find(|s| s.name() == name)
+    }
 }
 
 /// What a step does when its sweeps reach `max_iterations` without meeting the
@@ -111,6 +116,11 @@ impl OnStall {
             OnStall::Stop => "stop",
         }
     }
+
+    /// The choice named `name` (as [`OnStall::name`] writes it).
+    pub fn from_name(name: &str) -> Option<Self> {
+        [OnStall::Accept, OnStall::Extend, OnStall::Stop].into_iter().find(|o| o.name() == name)
+    }
 }
 
 /// Default of [`NlgsSettings::stall_max_iterations`].
@@ -126,6 +136,17 @@ pub const DEFAULT_SPLIT_MIN_ROWS: usize = 512;
 
 fn default_split_min_rows() -> usize {
     DEFAULT_SPLIT_MIN_ROWS
+}
+
+impl NlgsSettings {
+    /// Sweeps a step may make: `max_iterations`, or under [`OnStall::Extend`] the
+    /// larger of it and `stall_max_iterations`.
+    pub fn sweep_cap(&self) -> usize {
+        match self.on_stall {
+            OnStall::Extend => self.stall_max_iterations.max(self.max_iterations),
+            _ => self.max_iterations,
+        }
+    }
 }
 
 impl Default for NlgsSettings {
@@ -355,8 +376,7 @@ fn iterate(settings: &NlgsSettings, mut pass: impl FnMut(Pass) -> SweepNorms) ->
     let mut ratio = FIRST_CHECK_RATIO;
     let mut previous_wpp = 0.0;
     let mut report = NlgsReport::default();
-    let cap =
-        if s.on_stall == OnStall::Extend { s.stall_max_iterations.max(s.max_iterations) } else { s.max_iterations };
+    let cap = s.sweep_cap();
     for it in 1..=cap {
         let kind = if s.symmetric && it % 2 == 0 { Pass::Backward } else { Pass::Forward };
         let norms = pass(kind);

@@ -15,7 +15,7 @@
 
 use super::apgd::{solve_apgd_with, ApgdOptions};
 use super::contact::ContactRow;
-use super::nlgs::{apply_impulses, solve_nlgs_split, OnStall, Solver};
+use super::nlgs::{apply_impulses, solve_nlgs_split, NlgsSettings, OnStall, Solver};
 use super::system::{StepStats, System};
 use crate::error::{Error, Result};
 use crate::geometry::Vec2;
@@ -123,10 +123,7 @@ impl System {
             ),
             Solver::Apgd => {
                 // The accelerated solver has one cap: an extended step gets the larger.
-                let mut s = *settings;
-                if s.on_stall == OnStall::Extend {
-                    s.max_iterations = s.stall_max_iterations.max(s.max_iterations);
-                }
+                let s = NlgsSettings { max_iterations: settings.sweep_cap(), ..*settings };
                 solve_apgd_with(
                     &s,
                     &ApgdOptions::default(),
@@ -140,9 +137,7 @@ impl System {
         };
 
         if !report.converged && self.params.nlgs.on_stall == OnStall::Stop {
-            self.bodies.q.clone_from(&ws.q_i);
-            self.bodies.u.clone_from(&ws.u_i);
-            self.ws = ws;
+            self.restore_start(ws);
             return Err(Error::Stalled {
                 step: self.step + 1,
                 iterations: report.iterations,
@@ -229,11 +224,16 @@ impl System {
         Ok(stats)
     }
 
-    /// Restores the state of the start of the failed step and names the culprit.
-    fn roll_back(&mut self, ws: super::system::Workspace, body: usize, what: String) -> Error {
+    /// Puts the bodies back at the start of the step and the workspace in place.
+    fn restore_start(&mut self, ws: super::system::Workspace) {
         self.bodies.q.clone_from(&ws.q_i);
         self.bodies.u.clone_from(&ws.u_i);
         self.ws = ws;
+    }
+
+    /// Restores the state of the start of the failed step and names the culprit.
+    fn roll_back(&mut self, ws: super::system::Workspace, body: usize, what: String) -> Error {
+        self.restore_start(ws);
         Error::Diverged { step: self.step + 1, body, name: self.bodies.info[body].name.clone(), what }
     }
 }

@@ -514,7 +514,7 @@ impl LoadingSpec {
             return refuse("loaded_scene: cycles must be at least 1, got 0".into());
         }
         positive("loaded_scene: dt (s)", self.dt)?;
-        if ![Policy::Strict, Policy::Quad, Policy::QuadMax, Policy::Energy].iter().any(|p| p.name() == self.criterion) {
+        if Policy::from_name(&self.criterion).is_none() {
             return refuse(format!(
                 "loaded_scene: criterion '{}' is not one of 'strict', 'quad', 'quad_max', 'energy'",
                 self.criterion

@@ -213,9 +213,22 @@ pub(crate) fn steps_of(dt: f64, duration: f64) -> u64 {
     }
 }
 
-/// The policy named `name`.
-fn policy(name: &str) -> Option<Policy> {
-    [Policy::Strict, Policy::Quad, Policy::QuadMax, Policy::Energy].into_iter().find(|p| p.name() == name)
+/// The value of an optional named key of `[nscd]`: `default` when absent, else
+/// the value `from_name` finds, or the error "`key`: unknown `what` '…', expected
+/// `expected`".
+fn named<T>(
+    key: &str,
+    what: &str,
+    given: Option<&str>,
+    default: T,
+    from_name: fn(&str) -> Option<T>,
+    expected: &str,
+) -> Result<T> {
+    match given {
+        None => Ok(default),
+        Some(name) => from_name(name)
+            .map_or_else(|| err(format!("{key}: unknown {what} '{}', expected {expected}", super::clip(name))), Ok),
+    }
 }
 
 fn check_drive(ctx: &str, d: Drive) -> Result<()> {
@@ -253,13 +266,14 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
     if !(0.5..=1.0).contains(&theta) {
         return err(format!("nscd.theta: must be in [0.5, 1], got {}", num(theta)));
     }
-    let criterion = ns.criterion.as_deref().unwrap_or(defaults.nlgs.policy.name());
-    let Some(policy) = policy(criterion) else {
-        return err(format!(
-            "nscd.criterion: unknown criterion '{}', expected one of 'strict', 'quad', 'quad_max', 'energy'",
-            super::clip(criterion)
-        ));
-    };
+    let policy = named(
+        "nscd.criterion",
+        "criterion",
+        ns.criterion.as_deref(),
+        defaults.nlgs.policy,
+        Policy::from_name,
+        "one of 'strict', 'quad', 'quad_max', 'energy'",
+    )?;
     let tolerance = ns.tolerance.unwrap_or(defaults.nlgs.tolerance);
     if !(tolerance > 0.0 && tolerance < 1.0) {
         return err(format!("nscd.tolerance: must be in (0, 1), got {}", num(tolerance)));
@@ -278,42 +292,40 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
     if !(max_factor.is_finite() && max_factor >= 1.0) {
         return err(format!("nscd.max_factor: must be finite and at least 1, got {}", num(max_factor)));
     }
-    let measure = match ns.measure.as_deref() {
-        None => defaults.nlgs.measure,
-        Some("sweep") => Measure::Sweep,
-        Some("check") => Measure::Check,
-        Some(m) => {
-            return err(format!("nscd.measure: unknown value '{}', expected 'sweep' or 'check'", super::clip(m)))
-        }
-    };
-    if ns.measure.as_deref() == Some("check") && policy == Policy::Energy {
+    let measure = named(
+        "nscd.measure",
+        "value",
+        ns.measure.as_deref(),
+        defaults.nlgs.measure,
+        Measure::from_name,
+        "'sweep' or 'check'",
+    )?;
+    if ns.measure.is_some() && measure == Measure::Check && policy == Policy::Energy {
         return err("nscd.measure: 'check' measures a residual (strict, quad, quad_max); the energy criterion \
                     is a change from sweep to sweep, measured during the sweeps: remove the key or use 'sweep'"
             .to_string());
     }
-    let solver = match ns.solver.as_deref() {
-        None => defaults.nlgs.solver,
-        Some("nlgs") => Solver::Nlgs,
-        Some("apgd") => Solver::Apgd,
-        Some(m) => return err(format!("nscd.solver: unknown solver '{}', expected 'nlgs' or 'apgd'", super::clip(m))),
-    };
+    let solver = named(
+        "nscd.solver",
+        "solver",
+        ns.solver.as_deref(),
+        defaults.nlgs.solver,
+        Solver::from_name,
+        "'nlgs' or 'apgd'",
+    )?;
     if solver == Solver::Apgd && policy == Policy::Energy {
         return err(
             "nscd.solver: 'apgd' stops on a residual (strict, quad, quad_max), not on the energy criterion".to_string()
         );
     }
-    let on_stall = match ns.on_stall.as_deref() {
-        None => defaults.nlgs.on_stall,
-        Some("accept") => OnStall::Accept,
-        Some("extend") => OnStall::Extend,
-        Some("stop") => OnStall::Stop,
-        Some(m) => {
-            return err(format!(
-                "nscd.on_stall: unknown value '{}', expected 'accept', 'extend' or 'stop'",
-                super::clip(m)
-            ))
-        }
-    };
+    let on_stall = named(
+        "nscd.on_stall",
+        "value",
+        ns.on_stall.as_deref(),
+        defaults.nlgs.on_stall,
+        OnStall::from_name,
+        "'accept', 'extend' or 'stop'",
+    )?;
     let stall_max_iterations =
         ns.stall_max_iterations.unwrap_or(defaults.nlgs.stall_max_iterations.max(max_iterations));
     if stall_max_iterations < max_iterations {

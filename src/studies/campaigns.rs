@@ -667,12 +667,10 @@ pub struct Spread {
 impl Spread {
     /// Mean, sample standard deviation (0 for one value), min and max of `xs` (not empty).
     pub fn of(xs: &[f64]) -> Self {
-        let n = xs.len() as f64;
-        let mean = xs.iter().sum::<f64>() / n;
-        let var = if xs.len() > 1 { xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) } else { 0.0 };
+        let e = super::replicas::Estimate::of(xs);
         Self {
-            mean,
-            std: var.sqrt(),
+            mean: e.map_or(f64::NAN, |e| e.mean),
+            std: e.and_then(|e| e.sd).unwrap_or(0.0),
             min: xs.iter().copied().fold(f64::INFINITY, f64::min),
             max: xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         }
