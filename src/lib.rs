@@ -66,6 +66,7 @@ pub mod nscd;
 pub mod run;
 pub mod scenarios;
 pub mod scene;
+pub mod settlement;
 pub mod studies;
 pub mod team;
 

@@ -237,4 +237,8 @@ impl Engine for MdSystem {
     fn set_configuration(&mut self, c: &Configuration) -> Result<()> {
         MdSystem::set_configuration(self, c)
     }
+
+    fn relax(&mut self, settings: &crate::settlement::RelaxSettings) -> Result<crate::settlement::RelaxReport> {
+        MdSystem::relax(self, settings)
+    }
 }

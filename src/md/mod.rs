@@ -55,6 +55,7 @@ pub mod law;
 pub mod measure;
 pub mod neighbours;
 pub mod particles;
+pub mod relax;
 pub mod system;
 pub mod walls;
 

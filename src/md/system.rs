@@ -299,6 +299,10 @@ pub struct MdSystem {
     /// the contact list ([`MdSystem::contact_forces`]).
     #[serde(default)]
     pub(super) force_x: Vec<V3>,
+    /// Set while a relaxation evaluates trial configurations
+    /// ([`super::relax`]): a runaway overlap is then a large energy, not an error.
+    #[serde(skip)]
+    pub(super) relaxing: bool,
     #[serde(skip)]
     threads: usize,
     #[serde(skip)]
@@ -361,6 +365,7 @@ impl MdSystem {
             gravity_reference: 0.0,
             wall_hist: Vec::new(),
             force_x: Vec::new(),
+            relaxing: false,
             threads: 1,
             team: Team::default(),
             work: Vec::new(),
@@ -892,7 +897,7 @@ impl MdSystem {
     /// the step (second half kick or corrector). Returns the statistics, the
     /// kinetic energy after the step (J) and `Σ m (x · up)` (kg·m; both 0
     /// without `integrate`).
-    fn forces(&mut self, dt: f64, measure: bool, integrate: bool) -> Result<(MdStepStats, f64, f64)> {
+    pub(super) fn forces(&mut self, dt: f64, measure: bool, integrate: bool) -> Result<(MdStepStats, f64, f64)> {
         let n = self.particles.len();
         let nw = self.walls.len();
         self.work.resize_with(CHUNKS, Workspace::default);
@@ -975,7 +980,7 @@ impl MdSystem {
         let wall_contacts = self.walls.iter().map(|w| w.contacts).sum::<usize>();
         self.virial = tally.virial;
         let (worst, worst_i) = tally.worst;
-        if worst > 0.5 || !tally.energy.is_finite() {
+        if (worst > 0.5 && !self.relaxing) || !tally.energy.is_finite() {
             let r = self.particles.r[worst_i];
             return Err(self.diverged(
                 worst_i,

@@ -232,4 +232,8 @@ impl Engine for System {
     fn set_configuration(&mut self, c: &Configuration) -> Result<()> {
         System::set_configuration(self, c)
     }
+
+    fn relax(&mut self, settings: &crate::settlement::RelaxSettings) -> Result<crate::settlement::RelaxReport> {
+        System::relax(self, settings)
+    }
 }

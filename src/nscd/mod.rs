@@ -51,6 +51,7 @@ pub mod loads;
 pub mod measure;
 pub mod narrow_phase;
 pub mod nlgs;
+pub mod relax;
 pub mod shadow_overlap;
 pub mod split;
 pub mod stepper;

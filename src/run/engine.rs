@@ -19,6 +19,7 @@ use crate::io::run_figures::RunFigures;
 use crate::io::summary::StepSummary;
 use crate::io::vtk::PvdCollection;
 use crate::io::FinalState;
+use crate::settlement::relax::{RelaxReport, RelaxSettings};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -223,4 +224,17 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// [`crate::Error::Scene`] if `c` does not fit the engine (coordinates per
     /// body, unknown or fixed body, non-finite value); the engine is then unchanged.
     fn set_configuration(&mut self, c: &Configuration) -> Result<()>;
+
+    /// Relaxes the overlaps of the current configuration until the largest is at
+    /// most `settings.tolerance` (Karrech et al. 2007, §4; the settlement
+    /// driver's step after an extrapolation), moving the mobile bodies not in
+    /// `settings.held`, then writes the result back as
+    /// [`Engine::set_configuration`] does. NSCD: the projection that moves the
+    /// rigid bodies least ([`crate::nscd::relax`]); MD: the minimum of the
+    /// potential energy, eq. (29) ([`crate::md::relax`]).
+    ///
+    /// # Errors
+    /// [`crate::Error::Scene`] for settings out of range; an engine error if a
+    /// configuration tried cannot be evaluated. The positions are then unchanged.
+    fn relax(&mut self, settings: &RelaxSettings) -> Result<RelaxReport>;
 }

@@ -1,0 +1,131 @@
+//! Laws of the residual displacement of one coordinate against the cycle
+//! number, fitted on the computed cycles and extrapolated (Karrech et al. 2007,
+//! §3.1–3.2).
+//!
+//! A law is a trend `ũ(N)` with two coefficients `c`, fitted on the training data
+//! `(N_p, u_p)`, `p = 0 … k` (the displacement of one coordinate of one body at
+//! the end of the computed cycles `N_0 < N_1 < … < N_k`, counted from the start of
+//! the loading; `p = 0` is the start of the window). The extrapolated value `h`
+//! cycles after the last computed one is anchored at the last computed value:
+//! `û(N_k + h) = u(N_k) + ũ(N_k + h) − ũ(N_k)`.
+//!
+//! - [`Linear`], eq. (16): `ũ(N) = u_0 + s (N − N_0)` with the mean increment per
+//!   cycle `s = (u_k − u_0)/(N_k − N_0)`, so that `û(N_k + h) = u_k + h s`
+//!   (`(h/k) Σ_p [u_p − u_{p−1}]` when the window has unit steps).
+//! - [`Shenton`], eqs. (17)–(21): Shenton's law `ũ(N) = a ln N + b N` fitted by
+//!   least squares on `p = 1 … k`. The paper writes it in time `t_p = t + pT`;
+//!   here `N` is the number of loading cycles since the load started (dimensionless,
+//!   `ln 1 = 0`): in time, `a ln t` would add a constant `a ln T` that a law
+//!   without intercept cannot absorb, so the fit would depend on the unit of time.
+//!
+//! More laws are added by implementing [`ResidualLaw`].
+
+use crate::error::{Error, Result};
+
+/// Coefficients of a fitted trend (their meaning is the law's).
+pub type Coefficients = [f64; 2];
+
+/// A law of residual displacement against the cycle number.
+pub trait ResidualLaw: Send + Sync + std::fmt::Debug {
+    /// The law's name in scenes and outputs.
+    fn name(&self) -> &'static str;
+
+    /// Fits the law to the displacements `u` (m or rad) at the cycle numbers `n`
+    /// (`n[0]` the start of the window, strictly increasing, all ≥ 1 for a
+    /// logarithmic law); `n` and `u` have the same length, at least 2.
+    fn fit(&self, n: &[f64], u: &[f64]) -> Coefficients;
+
+    /// The trend's value at cycle number `n` (m or rad).
+    fn trend(&self, c: &Coefficients, n: f64) -> f64;
+
+    /// The first training point the fit uses (the residuals ξ_p are measured from it on).
+    fn first_fitted(&self) -> usize;
+
+    /// The extrapolation `h` cycles after the last point: `u_k + ũ(N_k + h) − ũ(N_k)`.
+    fn extrapolate(&self, c: &Coefficients, n_last: f64, u_last: f64, h: f64) -> f64 {
+        u_last + self.trend(c, n_last + h) - self.trend(c, n_last)
+    }
+}
+
+/// The linear estimation of eq. (16): the mean increment per cycle over the window.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Linear;
+
+impl ResidualLaw for Linear {
+    fn name(&self) -> &'static str {
+        "linear"
+    }
+
+    /// `c = [u_0 − s N_0, s]`, `s = (u_k − u_0)/(N_k − N_0)`.
+    fn fit(&self, n: &[f64], u: &[f64]) -> Coefficients {
+        let (n0, nk) = (n[0], n[n.len() - 1]);
+        let (u0, uk) = (u[0], u[u.len() - 1]);
+        let s = (uk - u0) / (nk - n0);
+        [u0 - s * n0, s]
+    }
+
+    fn trend(&self, c: &Coefficients, n: f64) -> f64 {
+        c[0] + c[1] * n
+    }
+
+    fn first_fitted(&self) -> usize {
+        0
+    }
+}
+
+/// Shenton's logarithmic law `a ln N + b N`, fitted by least squares (eqs. 18–21).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Shenton;
+
+impl ResidualLaw for Shenton {
+    fn name(&self) -> &'static str {
+        "shenton"
+    }
+
+    /// `c = [a, b]` of eqs. (20)–(21) on the points `p = 1 … k` (the start of the
+    /// window, `p = 0`, is not a training datum of the paper's sums). With a
+    /// single fitted point or a singular system (all `N` equal), the law
+    /// degenerates to the line through the origin `b N` (`a = 0`).
+    fn fit(&self, n: &[f64], u: &[f64]) -> Coefficients {
+        let (mut sll, mut stt, mut stl, mut sul, mut sut) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for (&t, &v) in n.iter().zip(u).skip(1) {
+            let l = t.ln();
+            sll += l * l;
+            stt += t * t;
+            stl += t * l;
+            sul += v * l;
+            sut += v * t;
+        }
+        let det = sll * stt - stl * stl;
+        // Relative to its terms, a determinant this small is a cancellation.
+        if det.abs() <= 1e-12 * sll * stt || stt == 0.0 {
+            return [0.0, if stt > 0.0 { sut / stt } else { 0.0 }];
+        }
+        let a = (stt * sul - stl * sut) / det;
+        let b = (sll * sut - stl * sul) / det;
+        [a, b]
+    }
+
+    fn trend(&self, c: &Coefficients, n: f64) -> f64 {
+        c[0] * n.ln() + c[1] * n
+    }
+
+    fn first_fitted(&self) -> usize {
+        1
+    }
+}
+
+/// The law named `name` in a scene or on the command line: `"linear"` or `"shenton"`.
+///
+/// # Errors
+/// [`Error::Scene`] naming the accepted values.
+pub fn law_named(name: &str) -> Result<&'static dyn ResidualLaw> {
+    match name {
+        "linear" => Ok(&Linear),
+        "shenton" => Ok(&Shenton),
+        _ => Err(Error::Scene(format!(
+            "settlement.law: unknown law '{}' (expected \"linear\" or \"shenton\")",
+            crate::scene::clip(name)
+        ))),
+    }
+}

@@ -1,0 +1,22 @@
+//! The settlement-acceleration procedure of Karrech et al. 2007 (§3–5, Fig. 10)
+//! over either engine: compute k loading cycles, fit each mobile body's residual
+//! displacement, extrapolate h cycles, write the positions back, relax the
+//! overlaps, repeat.
+//!
+//! - [`law`]: the residual-displacement laws (linear, eq. 16; Shenton's
+//!   logarithmic law, eqs. 17–21) behind one trait;
+//! - [`estimate`]: the fit of a window of computed cycles, the extrapolation, the
+//!   accuracy measures `g_u` and `f_ξ` (eqs. 13–14), the Chernoff bound (eq. 15)
+//!   and the relative configuration error `E_r` (eq. 22);
+//! - [`relax`]: the minimisation of an engine's relaxation functional (L-BFGS,
+//!   or the paper's steepest descent as a baseline) until the largest overlap
+//!   is below a tolerance; the functionals are the engines' (MD: eq. 29,
+//!   `crate::md::relax`; NSCD: `crate::nscd::relax`).
+
+pub mod estimate;
+pub mod law;
+pub mod relax;
+
+pub use estimate::{chernoff_cycles, chernoff_probability, configuration_error, extrapolate, fit, Fit, Training};
+pub use law::{law_named, Linear, ResidualLaw, Shenton};
+pub use relax::{minimise, Functional, Method, RelaxReport, RelaxSettings};

@@ -1,0 +1,168 @@
+//! The estimators of the settlement driver against closed forms (Karrech et al.
+//! 2007, §3): Shenton's least squares (eqs. 20–21) recovers `a` and `b` from
+//! `a ln N + b N` data, the linear estimation (eq. 16) extrapolates a line, the
+//! accuracy measures (eqs. 13–14) and the configuration error (eq. 22) match
+//! their hand-computed values, and the Chernoff bound (eq. 15) its closed form.
+
+use ballast::run::Configuration;
+use ballast::settlement::{
+    chernoff_cycles, chernoff_probability, configuration_error, extrapolate, fit, law_named, Linear, Shenton, Training,
+};
+
+/// A configuration of `bodies` bodies with 3 coordinates (x, y, θ) from `f(body, coordinate)`.
+fn config(bodies: usize, f: impl Fn(usize, usize) -> f64) -> Configuration {
+    let q = (0..bodies).flat_map(|b| (0..3).map(move |d| (b, d))).map(|(b, d)| f(b, d)).collect();
+    Configuration { dof: 3, bodies: (0..bodies).collect(), q }
+}
+
+/// Body `b`'s coordinate `d` follows `a ln N + b N` with its own coefficients.
+fn shenton_coefficients(b: usize, d: usize) -> (f64, f64) {
+    (-1e-4 * (1.0 + b as f64) + 2e-5 * d as f64, 3e-7 * (d as f64 - 1.0) + 1e-8 * b as f64)
+}
+
+/// A window of cycles `n0 ..= n0 + k` on top of an origin, each coordinate
+/// following `law(b, d, N)` (m or rad) from the origin.
+fn window(bodies: usize, n0: u64, k: u64, law: impl Fn(usize, usize, f64) -> f64) -> Training {
+    let origin = config(bodies, |b, d| 0.1 * b as f64 + 0.01 * d as f64);
+    let mut t = Training::new(origin.clone());
+    for n in n0..=n0 + k {
+        let nf = n as f64;
+        t.push(nf, config(bodies, |b, d| origin.q[3 * b + d] + law(b, d, nf)));
+    }
+    t
+}
+
+#[test]
+fn shenton_least_squares_recovers_a_and_b_and_extrapolates_the_law() {
+    // k_i = 10 initial cycles, then a window of k = 20.
+    let t = window(4, 10, 20, |b, d, n| {
+        let (a, bb) = shenton_coefficients(b, d);
+        a * n.ln() + bb * n
+    });
+    let f = fit(&Shenton, &t, 3, 2).unwrap();
+    for b in 0..4 {
+        for d in 0..3 {
+            let (a, bb) = shenton_coefficients(b, d);
+            let c = f.coefficients[b * 3 + d];
+            // Eqs. (20)-(21) are exact on exact data: rounding only (the normal
+            // equations' condition number here is ~1e4, so 1e-9 relative is loose).
+            assert!((c[0] - a).abs() <= 1e-9 * a.abs().max(1e-12), "a: {} vs {a}", c[0]);
+            assert!((c[1] - bb).abs() <= 1e-9 * bb.abs().max(1e-10), "b: {} vs {bb}", c[1]);
+        }
+    }
+    // Exact data: no error term.
+    assert!(f.f_xi < 1e-15, "f_xi = {}", f.f_xi);
+    assert!(f.xi_range < 1e-15);
+    // The extrapolation 20 cycles on is the law's value at N = 50 (eq. 17).
+    let h = 20.0;
+    let e = extrapolate(&Shenton, &t, &f, h);
+    for b in 0..4 {
+        for d in 0..3 {
+            let (a, bb) = shenton_coefficients(b, d);
+            let want = t.origin.q[3 * b + d] + a * 50f64.ln() + bb * 50.0;
+            assert!((e.q[3 * b + d] - want).abs() < 1e-15, "body {b} coordinate {d}");
+        }
+    }
+}
+
+#[test]
+fn linear_estimation_is_the_mean_increment_of_eq_16() {
+    // A line: exact; the trend's increments give g_u = (1/k)(k Σ_{b,d} s²)^½.
+    let slope = |b: usize, d: usize| 1e-6 * (b as f64 + 1.0) * (1.0 - d as f64);
+    let t = window(3, 10, 20, |b, d, n| slope(b, d) * n);
+    let f = fit(&Linear, &t, 3, 2).unwrap();
+    let e = extrapolate(&Linear, &t, &f, 15.0);
+    let last = t.configurations.last().unwrap();
+    for b in 0..3 {
+        for d in 0..3 {
+            let want = last.q[3 * b + d] + 15.0 * slope(b, d);
+            assert!((e.q[3 * b + d] - want).abs() < 1e-15);
+        }
+    }
+    let sum_s2: f64 = (0..3).flat_map(|b| (0..2).map(move |d| slope(b, d).powi(2))).sum();
+    let g_u = (20.0 * sum_s2).sqrt() / 20.0;
+    assert!((f.g_u - g_u).abs() < 1e-12 * g_u, "g_u {} vs {g_u}", f.g_u);
+    // Rounding only: coordinates of 0.1-0.3 m carry ~3e-17 m of it per point.
+    assert!(f.f_xi < 1e-15, "f_xi = {}", f.f_xi);
+
+    // Scattered data: eq. (16) uses the end points only, u_k + (h/k) Σ [u_p − u_{p−1}].
+    let noise = |n: f64| 1e-6 * (1.7 * n).sin();
+    let t = window(1, 0, 10, |_, d, n| if d == 1 { -2e-6 * n + noise(n) } else { 0.0 });
+    let f = fit(&Linear, &t, 3, 2).unwrap();
+    let u: Vec<f64> = t.configurations.iter().map(|c| c.q[1] - t.origin.q[1]).collect();
+    let increments: f64 = u.windows(2).map(|w| w[1] - w[0]).sum();
+    let want = u[10] + 7.0 / 10.0 * increments;
+    let e = extrapolate(&Linear, &t, &f, 7.0);
+    assert!((e.q[1] - t.origin.q[1] - want).abs() < 1e-16);
+    // f_ξ of eq. (14) by hand: the error terms about the chord through the ends.
+    let xi2: f64 = (0..=10).map(|p| (u[p] - (u[0] + (u[10] - u[0]) * p as f64 / 10.0)).powi(2)).sum();
+    assert!((f.f_xi - xi2.sqrt() / 10.0).abs() < 1e-16);
+}
+
+#[test]
+fn rotations_are_extrapolated_but_not_measured() {
+    // Only θ moves: the measures (translations) see nothing.
+    let t = window(2, 5, 10, |_, d, n| if d == 2 { 1e-3 * n } else { 0.0 });
+    let f = fit(&Linear, &t, 3, 2).unwrap();
+    assert_eq!(f.g_u, 0.0);
+    let e = extrapolate(&Linear, &t, &f, 10.0);
+    assert!((e.q[2] - t.configurations.last().unwrap().q[2] - 1e-2).abs() < 1e-15);
+    // Fitting only the translations keeps θ at its last value (an MD sphere's orientation).
+    let f = fit(&Linear, &t, 2, 2).unwrap();
+    let e = extrapolate(&Linear, &t, &f, 10.0);
+    assert_eq!(e.q[2], t.configurations.last().unwrap().q[2]);
+}
+
+#[test]
+fn chernoff_bound_matches_its_closed_form() {
+    // k ≥ (b − a)²/(2ε²) ln(2/p): range 20 µm, ε = 1 µm, p = 5 %:
+    // 200 ln 40 = 737.78 → 738.
+    let k = chernoff_cycles(1e-6, 0.05, 2e-5).unwrap();
+    assert_eq!(k, 738);
+    assert!(chernoff_probability(738, 1e-6, 2e-5) <= 0.05);
+    assert!(chernoff_probability(737, 1e-6, 2e-5) > 0.05);
+    // 2 exp(−2 k ε²/range²) at k = 1000: 2 e^{-5}; at k = 100 the bound exceeds 1 and says nothing.
+    assert!((chernoff_probability(1000, 1e-6, 2e-5) - 2.0 * (-5.0f64).exp()).abs() < 1e-15);
+    assert_eq!(chernoff_probability(100, 1e-6, 2e-5), 1.0);
+    // Bad inputs are errors naming the field.
+    assert!(chernoff_cycles(0.0, 0.05, 1.0).unwrap_err().to_string().contains("settlement.error"));
+    assert!(chernoff_cycles(1e-6, 1.0, 1.0).unwrap_err().to_string().contains("settlement.probability"));
+}
+
+#[test]
+fn configuration_error_of_eq_22() {
+    let origin = config(2, |_, _| 0.0);
+    let computed = config(2, |b, d| {
+        if d == 0 {
+            3.0 * (b as f64 + 1.0)
+        } else if d == 1 {
+            4.0
+        } else {
+            9.0
+        }
+    });
+    let estimated = config(2, |b, d| {
+        if d == 0 {
+            3.0 * (b as f64 + 1.0)
+        } else if d == 1 {
+            4.0 + 1.0
+        } else {
+            0.0
+        }
+    });
+    // u = [(3,4), (6,4)]: ‖u‖² = 9 + 16 + 36 + 16 = 77; u − û = [(0,−1),(0,−1)]: 2. θ not counted.
+    let e = configuration_error(&origin, &computed, &estimated, 2);
+    assert!((e - (2.0f64 / 77.0).sqrt()).abs() < 1e-15);
+    assert_eq!(configuration_error(&origin, &computed, &computed, 2), 0.0);
+}
+
+#[test]
+fn laws_are_named_and_bad_windows_refused() {
+    assert_eq!(law_named("shenton").unwrap().name(), "shenton");
+    assert_eq!(law_named("linear").unwrap().name(), "linear");
+    let e = law_named("power").unwrap_err().to_string();
+    assert!(e.contains("settlement.law") && e.contains("power"), "{e}");
+    let mut t = window(1, 3, 1, |_, _, _| 0.0);
+    t.cycles[1] = 3.0;
+    assert!(fit(&Linear, &t, 3, 2).unwrap_err().to_string().contains("increasing"));
+}
