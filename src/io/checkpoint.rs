@@ -94,56 +94,86 @@ fn invalid(path: &Path, msg: impl std::fmt::Display) -> Error {
     Error::Scene(format!("{}: not a valid checkpoint: {short}", path.display()))
 }
 
+/// Writes `value` as `DIR/checkpoint.json`, atomically: a first line
+/// `ballast-checkpoint crc32=XXXXXXXX` (the CRC-32 of the rest), then its JSON.
+///
+/// # Errors
+/// [`Error::Io`] naming the file.
+pub fn write_checked<T: Serialize>(dir: &Path, value: &T) -> Result<PathBuf> {
+    let path = dir.join(CHECKPOINT_FILE);
+    let json = serde_json::to_string(value).map_err(|e| io_error(&path, "serialize", std::io::Error::other(e)))?;
+    let text = format!("{MAGIC} crc32={:08x}\n{json}", crc32(json.as_bytes()));
+    super::write_atomic(&path, &text)?;
+    Ok(path)
+}
+
+/// Reads `DIR/checkpoint.json` written by [`write_checked`], checking its first
+/// line and checksum; returns its path and value.
+///
+/// # Errors
+/// [`Error::Io`] if it cannot be read; [`Error::Scene`] `PATH: not a valid
+/// checkpoint: …` if it is not one.
+pub fn read_checked<T: DeserializeOwned>(dir: &Path) -> Result<(PathBuf, T)> {
+    let path = dir.join(CHECKPOINT_FILE);
+    let bytes = std::fs::read(&path).map_err(|e| io_error(&path, "read checkpoint", e))?;
+    let text = String::from_utf8(bytes).map_err(|_| invalid(&path, "not UTF-8 text"))?;
+    let (first, json) = text.split_once('\n').ok_or_else(|| invalid(&path, "no header line"))?;
+    // The header exactly as written: 8 lower-case hex digits, nothing else.
+    let crc = first
+        .strip_prefix(MAGIC)
+        .and_then(|s| s.strip_prefix(" crc32="))
+        .filter(|s| s.len() == 8 && s.bytes().all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)))
+        .and_then(|s| u32::from_str_radix(s, 16).ok())
+        .ok_or_else(|| invalid(&path, format!("the first line is not '{MAGIC} crc32=XXXXXXXX'")))?;
+    if crc32(json.as_bytes()) != crc {
+        return Err(invalid(&path, "checksum mismatch (the file was edited or cut short)"));
+    }
+    let value = serde_json::from_str(json).map_err(|e| invalid(&path, e))?;
+    Ok((path, value))
+}
+
+/// Checks the engine and version a checkpoint at `path` was written by, and
+/// the CRC-32 of the scene it belongs to.
+///
+/// # Errors
+/// [`Error::Scene`] naming what differs.
+pub fn check_origin(path: &Path, (engine, version, source_crc32): (&str, &str, u32), want: (&str, u32)) -> Result<()> {
+    if engine != want.0 {
+        return Err(invalid(
+            path,
+            format!("written by the {} engine, the scene is for {}", crate::scene::clip(engine), want.0),
+        ));
+    }
+    let this = env!("CARGO_PKG_VERSION");
+    if version != this {
+        return Err(invalid(
+            path,
+            format!(
+                "written by ballast {}, this is {this}; run without --resume to start again",
+                crate::scene::clip(version)
+            ),
+        ));
+    }
+    if source_crc32 != want.1 {
+        return Err(Error::Scene(format!(
+            "{}: the checkpoint was written for another scene; run without --resume to start again",
+            path.display()
+        )));
+    }
+    Ok(())
+}
+
 impl<S: Serialize + DeserializeOwned, C: Serialize + DeserializeOwned> Checkpoint<S, C> {
     /// Writes `DIR/checkpoint.json` atomically.
     pub fn write(&self, dir: &Path) -> Result<PathBuf> {
-        let path = dir.join(CHECKPOINT_FILE);
-        let json = serde_json::to_string(self).map_err(|e| io_error(&path, "serialize", std::io::Error::other(e)))?;
-        let text = format!("{MAGIC} crc32={:08x}\n{json}", crc32(json.as_bytes()));
-        super::write_atomic(&path, &text)?;
-        Ok(path)
+        write_checked(dir, self)
     }
 
     /// Reads `DIR/checkpoint.json` and checks its checksum, its engine `engine`,
     /// its version and that it belongs to the scene whose text has CRC-32 `source_crc32`.
     pub fn load(dir: &Path, engine: &str, source_crc32: u32) -> Result<Self> {
-        let path = dir.join(CHECKPOINT_FILE);
-        let bytes = std::fs::read(&path).map_err(|e| io_error(&path, "read checkpoint", e))?;
-        let text = String::from_utf8(bytes).map_err(|_| invalid(&path, "not UTF-8 text"))?;
-        let (first, json) = text.split_once('\n').ok_or_else(|| invalid(&path, "no header line"))?;
-        // The header exactly as written: 8 lower-case hex digits, nothing else.
-        let crc = first
-            .strip_prefix(MAGIC)
-            .and_then(|s| s.strip_prefix(" crc32="))
-            .filter(|s| s.len() == 8 && s.bytes().all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)))
-            .and_then(|s| u32::from_str_radix(s, 16).ok())
-            .ok_or_else(|| invalid(&path, format!("the first line is not '{MAGIC} crc32=XXXXXXXX'")))?;
-        if crc32(json.as_bytes()) != crc {
-            return Err(invalid(&path, "checksum mismatch (the file was edited or cut short)"));
-        }
-        let cp: Self = serde_json::from_str(json).map_err(|e| invalid(&path, e))?;
-        if cp.engine != engine {
-            return Err(invalid(
-                &path,
-                format!("written by the {} engine, the scene is for {engine}", crate::scene::clip(&cp.engine)),
-            ));
-        }
-        let version = env!("CARGO_PKG_VERSION");
-        if cp.version != version {
-            return Err(invalid(
-                &path,
-                format!(
-                    "written by ballast {}, this is {version}; run without --resume to start again",
-                    crate::scene::clip(&cp.version)
-                ),
-            ));
-        }
-        if cp.source_crc32 != source_crc32 {
-            return Err(Error::Scene(format!(
-                "{}: the checkpoint was written for another scene; run without --resume to start again",
-                path.display()
-            )));
-        }
+        let (path, cp): (PathBuf, Self) = read_checked(dir)?;
+        check_origin(&path, (&cp.engine, &cp.version, cp.source_crc32), (engine, source_crc32))?;
         Ok(cp)
     }
 }

@@ -32,6 +32,8 @@ impl MdSystem {
 impl Engine for MdSystem {
     const NAME: &'static str = "md";
     const DOF: usize = 6;
+    const DIM: usize = 3;
+    const EXTRAPOLATED: usize = 3;
     const ITERATIVE: bool = false;
     type Stats = MdStepStats;
     type Row = MdSeriesRow;
@@ -218,6 +220,10 @@ impl Engine for MdSystem {
         let mut h: Vec<String> = MD_CYCLE_COLUMNS.iter().map(|s| s.to_string()).collect();
         h.extend(self.servo_walls().map(|w| format!("{}_position_m", w.name)));
         h
+    }
+
+    fn coordination(&self) -> f64 {
+        self.last.coordination
     }
 
     fn mobile_bodies(&self) -> Vec<usize> {

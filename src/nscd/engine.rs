@@ -19,6 +19,8 @@ use std::path::Path;
 impl Engine for System {
     const NAME: &'static str = "nscd";
     const DOF: usize = 3;
+    const DIM: usize = 2;
+    const EXTRAPOLATED: usize = 3;
     const ITERATIVE: bool = true;
     type Stats = StepStats;
     type Row = NscdSeriesRow;
@@ -218,6 +220,11 @@ impl Engine for System {
     fn figures(&self, dir: &Path, cycles: Option<&NscdCycleState>) -> Result<RunFigures> {
         let first = cycles.and_then(|c| c.first_cycle_q.as_deref());
         crate::io::run_figures::nscd_figures(dir, first)
+    }
+
+    fn coordination(&self) -> f64 {
+        let grains: Vec<usize> = (0..self.bodies.len()).filter(|&i| !self.bodies.info[i].fixed).collect();
+        super::measure::coordination(self, &grains, 0.0).z
     }
 
     fn mobile_bodies(&self) -> Vec<usize> {

@@ -99,6 +99,13 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     const NAME: &'static str;
     /// Generalised coordinates per body in a [`Configuration`].
     const DOF: usize;
+    /// Degrees of translation: the first `DIM` coordinates of a body (m); the
+    /// last of them is the vertical (y in 2D, z in 3D), along which gravity pulls.
+    const DIM: usize;
+    /// The leading coordinates of a body a settlement driver extrapolates: NSCD
+    /// 3 (x, y, θ: a polygon's rotation matters to its contacts), MD 3 (x, y, z:
+    /// a sphere's orientation does not).
+    const EXTRAPOLATED: usize;
     /// Whether a step solves an iterative problem (NSCD: NLGS sweeps), whose
     /// iterations and unconverged steps the summary reports.
     const ITERATIVE: bool;
@@ -201,6 +208,12 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     fn figures(&self, dir: &Path, _cycles: Option<&Self::CycleState>) -> Result<RunFigures> {
         crate::io::run_figures::draw_run_figures(dir)
     }
+
+    /// The coordination number of the current state, as the engine measures it
+    /// (NSCD: force-carrying neighbours per non-rattler grain,
+    /// [`crate::nscd::measure::coordination`]; MD: `(2 N_c + N_w)/N` of the last
+    /// force evaluation).
+    fn coordination(&self) -> f64;
 
     /// The bodies a driver may move: every body that is not fixed (NSCD) or
     /// every sphere (MD).

@@ -19,7 +19,7 @@ use crate::run::Configuration;
 /// The training data of one window: the configurations at the ends of the
 /// computed cycles `N_0 < N_1 < … < N_k` (`N_0` the start of the window), and the
 /// configuration at the start of the loading they are measured from.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Training {
     /// The configuration at cycle 0 (the start of the loading).
     pub origin: Configuration,

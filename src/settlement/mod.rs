@@ -8,15 +8,23 @@
 //! - [`estimate`]: the fit of a window of computed cycles, the extrapolation, the
 //!   accuracy measures `g_u` and `f_ξ` (eqs. 13–14), the Chernoff bound (eq. 15)
 //!   and the relative configuration error `E_r` (eq. 22);
+//! - [`driver`]: the procedure of Fig. 10 over any [`crate::run::Engine`]
+//!   ([`Accelerated`]), its tables (`settlement.csv`, `jumps.csv`), summary and
+//!   checkpoints;
 //! - [`relax`]: the minimisation of an engine's relaxation functional (L-BFGS,
 //!   or the paper's steepest descent as a baseline) until the largest overlap
 //!   is below a tolerance; the functionals are the engines' (MD: eq. 29,
 //!   `crate::md::relax`; NSCD: `crate::nscd::relax`).
 
+pub mod driver;
 pub mod estimate;
 pub mod law;
 pub mod relax;
 
+pub use driver::{
+    Accelerated, Acceleration, AccelerationOutcome, AccelerationProgress, AccelerationSummary, Adaptive, JumpRow, Law,
+    SettlementRow,
+};
 pub use estimate::{chernoff_cycles, chernoff_probability, configuration_error, extrapolate, fit, Fit, Training};
 pub use law::{law_named, Linear, ResidualLaw, Shenton};
 pub use relax::{minimise, Functional, Method, RelaxReport, RelaxSettings};

@@ -1,0 +1,683 @@
+//! The procedure of Karrech et al. 2007, Fig. 10, over any [`Engine`]: from the
+//! start state, `k_i` initial cycles, then repeat {`k` computed cycles → fit of
+//! every mobile body's residual displacement → extrapolation by `h` cycles →
+//! positions written back → relaxation} until the target number of cycles.
+//!
+//! - A cycle is computed by stepping the engine until its exact clock closes a
+//!   loading cycle ([`crate::clock::cycles_at`]); an extrapolation happens at a
+//!   cycle's end, at the load phase every cycle starts with. The engine's clock
+//!   counts the computed time only: the loads are periodic, so skipping `h`
+//!   periods changes nothing the next step sees.
+//! - The window of a fit is the configuration at its start and at the end of
+//!   each of its `k` computed cycles (the first window starts after the initial
+//!   cycles), measured from the configuration at the start of the loading.
+//! - `h` is multiplied by `growth` after each jump (the paper suggests letting
+//!   it grow) and cut so that the run ends at the target. With `adaptive`, `k`
+//!   grows past `computed_cycles` until the Chernoff bound (eq. 15) of the
+//!   window's error range is met, at most 10 × `computed_cycles`.
+//! - The settlement of a configuration is the vertical displacement (positive
+//!   downwards) of `settlement_body` from the start of the loading, or by default
+//!   the mean over the mobile bodies. Over extrapolated cycles it follows the
+//!   law fitted to the window's settlement (the same fit as the bodies': a least
+//!   squares fit is linear in the data), and at the jump's end it is the
+//!   relaxed configuration's.
+//!
+//! Outputs (`OUT/`): `settlement.csv` (one row per cycle, computed or
+//! extrapolated), `jumps.csv` (one row per jump: the fit's `g_u`, `f_ξ` and
+//! error range, the Chernoff cycles, the relaxation), `summary.json`
+//! (`computed_cycles`, `total_cycles`, `gained` = total/computed), `final.json`,
+//! the record of the input (`scene.toml` or `initial_state.json`, `run.json`),
+//! and `checkpoint.json` every `checkpoint_every_s` (at a cycle's end) for
+//! `--resume`.
+
+use super::estimate::{chernoff_cycles, extrapolate, fit, Training};
+use super::law::{Linear, ResidualLaw, Shenton};
+use super::relax::{RelaxReport, RelaxSettings};
+use crate::clock::cycles_at;
+use crate::error::{Error, Result};
+use crate::io::checkpoint::{check_origin, crc32, read_checked, write_checked, CHECKPOINT_FILE};
+use crate::io::table::TableWriter;
+use crate::io::{self, RunInfo};
+use crate::run::{files, Configuration, Engine, RunOptions};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The per-cycle table of an accelerated run.
+pub const SETTLEMENT_FILE: &str = "settlement.csv";
+/// The per-jump table of an accelerated run.
+pub const JUMPS_FILE: &str = "jumps.csv";
+
+/// The residual-displacement law of a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Law {
+    /// Eq. (16).
+    Linear,
+    /// Shenton's `a ln N + b N`, eqs. (17)–(21) (the paper's choice for the procedure).
+    #[default]
+    Shenton,
+}
+
+impl Law {
+    /// The law's estimator.
+    pub fn estimator(self) -> &'static dyn ResidualLaw {
+        match self {
+            Law::Linear => &Linear,
+            Law::Shenton => &Shenton,
+        }
+    }
+
+    /// The law named `name` (`"linear"`, `"shenton"`); `field` names the option in the error.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming `field` and the accepted values.
+    pub fn from_name(name: &str, field: &str) -> Result<Self> {
+        match name {
+            "linear" => Ok(Law::Linear),
+            "shenton" => Ok(Law::Shenton),
+            _ => Err(Error::Scene(format!(
+                "{field}: unknown law '{}' (expected \"linear\" or \"shenton\")",
+                crate::scene::clip(name)
+            ))),
+        }
+    }
+}
+
+/// The number of computed cycles chosen by the Chernoff bound (eq. 15).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Adaptive {
+    /// Error `ε` on a coordinate's mean residual (m), > 0.
+    pub error: f64,
+    /// Probability `p` of exceeding it, in (0, 1).
+    pub probability: f64,
+}
+
+/// What the accelerated procedure is asked to do (a scene's `[settlement]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Acceleration {
+    /// `k_i`: cycles computed before the first window.
+    pub initial_cycles: u64,
+    /// `k`: computed cycles per window, ≥ 2.
+    pub computed_cycles: u64,
+    /// `h`: cycles extrapolated by the first jump, ≥ 1.
+    pub extrapolated_cycles: u64,
+    /// Factor on `h` after each jump, ≥ 1.
+    pub growth: f64,
+    /// The law fitted.
+    pub law: Law,
+    /// The relaxation after each jump.
+    pub relax: RelaxSettings,
+    /// `k` from the Chernoff bound, if asked.
+    pub adaptive: Option<Adaptive>,
+    /// The body whose vertical displacement is the settlement (index in the
+    /// engine); `None`: the mean over the mobile bodies.
+    pub settlement_body: Option<usize>,
+}
+
+impl Acceleration {
+    /// `k_i`, `k`, `h` with the defaults: Shenton's law, no growth, relaxation to
+    /// `relax_tolerance` (m) in at most 10 000 iterations.
+    pub fn new(initial_cycles: u64, computed_cycles: u64, extrapolated_cycles: u64, relax_tolerance: f64) -> Self {
+        Self {
+            initial_cycles,
+            computed_cycles,
+            extrapolated_cycles,
+            growth: 1.0,
+            law: Law::Shenton,
+            relax: RelaxSettings::new(relax_tolerance),
+            adaptive: None,
+            settlement_body: None,
+        }
+    }
+
+    /// Checks the ranges; the message names the `[settlement]` key.
+    pub fn check(&self) -> Result<()> {
+        let bad = |msg: String| Err(Error::Scene(format!("settlement.{msg}")));
+        if self.computed_cycles < 2 {
+            return bad(format!("computed_cycles: a fit needs at least 2 cycles, got {}", self.computed_cycles));
+        }
+        if self.extrapolated_cycles == 0 {
+            return bad("extrapolated_cycles: must be at least 1, got 0".into());
+        }
+        if !(self.growth >= 1.0 && self.growth.is_finite()) {
+            return bad(format!("growth: must be a finite factor of at least 1, got {}", self.growth));
+        }
+        if let Some(a) = &self.adaptive {
+            chernoff_cycles(a.error, a.probability, 1.0)?;
+        }
+        self.relax.check()
+    }
+}
+
+/// One row of `settlement.csv`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SettlementRow {
+    /// Cycles since the start of the loading, computed and extrapolated.
+    pub cycle: u64,
+    /// 1 for a computed cycle, 0 for an extrapolated one.
+    pub computed: u8,
+    /// Settlement at the cycle's end (m, positive downwards; module doc).
+    pub settlement_m: f64,
+    /// Coordination number at the cycle's end (computed cycles only).
+    pub coordination: Option<f64>,
+    /// Largest overlap of the extrapolated configuration (m; the last cycle of a jump).
+    pub max_overlap_before_relax_m: Option<f64>,
+    /// Largest overlap after its relaxation (m; the last cycle of a jump).
+    pub max_overlap_after_relax_m: Option<f64>,
+    /// Wall time since the start of the run (s).
+    pub wall_time_s: f64,
+}
+
+impl SettlementRow {
+    /// The header of `settlement.csv`: the fields, in order.
+    pub const COLUMNS: &'static [&'static str] = &[
+        "cycle",
+        "computed",
+        "settlement_m",
+        "coordination",
+        "max_overlap_before_relax_m",
+        "max_overlap_after_relax_m",
+        "wall_time_s",
+    ];
+}
+
+/// One row of `jumps.csv`: a fit, its extrapolation and the relaxation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct JumpRow {
+    /// Jump number (1, 2, …).
+    pub jump: u64,
+    /// The last computed cycle of the window.
+    pub from_cycle: u64,
+    /// The cycle the jump lands on.
+    pub to_cycle: u64,
+    /// `k`: computed cycles of the window.
+    pub computed_cycles: u64,
+    /// `h`: cycles extrapolated.
+    pub extrapolated_cycles: u64,
+    /// The computed cycles the Chernoff bound asked for (adaptive runs).
+    pub chernoff_cycles: Option<u64>,
+    /// Eq. (13) on the window (m).
+    pub g_u_m: f64,
+    /// Eq. (14) on the window (m).
+    pub f_xi_m: f64,
+    /// Widest range of one coordinate's error terms (m).
+    pub xi_range_m: f64,
+    /// Iterations of the relaxation.
+    pub relax_iterations: u64,
+    /// Evaluations of its functional.
+    pub relax_evaluations: u64,
+    /// Whether it reached the tolerance.
+    pub relax_converged: bool,
+    /// Largest overlap before (m).
+    pub max_overlap_before_relax_m: f64,
+    /// Largest overlap after (m).
+    pub max_overlap_after_relax_m: f64,
+    /// Largest move of a coordinate in the relaxation (m or rad).
+    pub relax_largest_move: f64,
+    /// Wall time of the relaxation (s).
+    pub relax_wall_time_s: f64,
+}
+
+impl JumpRow {
+    /// The header of `jumps.csv`: the fields, in order.
+    pub const COLUMNS: &'static [&'static str] = &[
+        "jump",
+        "from_cycle",
+        "to_cycle",
+        "computed_cycles",
+        "extrapolated_cycles",
+        "chernoff_cycles",
+        "g_u_m",
+        "f_xi_m",
+        "xi_range_m",
+        "relax_iterations",
+        "relax_evaluations",
+        "relax_converged",
+        "max_overlap_before_relax_m",
+        "max_overlap_after_relax_m",
+        "relax_largest_move",
+        "relax_wall_time_s",
+    ];
+}
+
+/// `summary.json` of an accelerated run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AccelerationSummary {
+    /// `"nscd"` or `"md"`.
+    pub engine: String,
+    /// `"finished"`, `"stopped"` (to resume) or `"diverged"`.
+    pub end: String,
+    /// The law fitted.
+    pub law: Law,
+    /// Cycles computed by the engine.
+    pub computed_cycles: u64,
+    /// Cycles reached, computed and extrapolated.
+    pub total_cycles: u64,
+    /// `total_cycles / computed_cycles`.
+    pub gained: f64,
+    /// Jumps made.
+    pub jumps: u64,
+    /// Settlement at the last cycle (m).
+    pub settlement_m: f64,
+    /// Wall time (s).
+    pub wall_time_s: f64,
+    /// Steps the engine made.
+    pub steps: u64,
+}
+
+/// What the progress callback sees after each cycle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AccelerationProgress {
+    /// Cycles reached (computed and extrapolated).
+    pub cycle: u64,
+    /// The target.
+    pub target: u64,
+    /// Cycles computed.
+    pub computed: u64,
+    /// Settlement (m).
+    pub settlement: f64,
+}
+
+/// What a call of [`Accelerated::run`] did.
+#[derive(Debug, Clone)]
+pub struct AccelerationOutcome<E> {
+    /// The summary (also in `summary.json`).
+    pub summary: AccelerationSummary,
+    /// The system at the end.
+    pub system: E,
+    /// The output folder.
+    pub out: PathBuf,
+}
+
+/// Where the procedure stands: all of it is the checkpoint.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct State<E> {
+    version: String,
+    engine: String,
+    source_crc32: u32,
+    sys: E,
+    origin: Configuration,
+    /// Slot of the settlement body in the configurations.
+    slot: Option<usize>,
+    cycle: u64,
+    computed: u64,
+    jumps: u64,
+    /// The next jump's length before rounding and cutting.
+    h: f64,
+    window: Training,
+    /// Settlement at each point of the window (m).
+    window_settlement: Vec<f64>,
+    last_settlement: f64,
+    wall_time_s: f64,
+    /// Bytes, rows and CRC-32 of `settlement.csv` and `jumps.csv`.
+    tables: [(u64, u64, u32); 2],
+}
+
+/// Where the system of a run comes from (for its record and `--resume`).
+enum Origin {
+    Scene { text: String },
+    Code { json: String },
+}
+
+/// An accelerated run of an engine: its start state, the procedure's settings,
+/// the loading frequency and the target number of cycles.
+pub struct Accelerated<E: Engine> {
+    system: E,
+    spec: Acceleration,
+    frequency: f64,
+    target: u64,
+    seed: u64,
+    origin: Origin,
+}
+
+impl<E: Engine> Accelerated<E> {
+    /// A run of `system` loaded at `frequency` (Hz) to `target` cycles, from the
+    /// scene whose text is `text` (recorded as `scene.toml`, its CRC-32 checked on `--resume`).
+    pub fn from_scene(system: E, spec: Acceleration, frequency: f64, target: u64, seed: u64, text: String) -> Self {
+        Self { system, spec, frequency, target, seed, origin: Origin::Scene { text } }
+    }
+
+    /// A run of a system built in code (its serde form and the settings are recorded).
+    ///
+    /// # Errors
+    /// [`Error::Io`] if the system cannot be serialised.
+    pub fn from_system(system: E, spec: Acceleration, frequency: f64, target: u64) -> Result<Self> {
+        let json = serde_json::to_string(&(&spec, frequency, target, &system))
+            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        Ok(Self { system, spec, frequency, target, seed: 0, origin: Origin::Code { json } })
+    }
+
+    fn source_crc32(&self) -> u32 {
+        match &self.origin {
+            Origin::Scene { text } => crc32(text.as_bytes()),
+            Origin::Code { json } => crc32(json.as_bytes()),
+        }
+    }
+
+    fn check(&self) -> Result<()> {
+        self.spec.check()?;
+        if !(self.frequency > 0.0 && self.frequency.is_finite()) {
+            return Err(Error::Scene(format!(
+                "settlement: the loading frequency must be positive, got {} (output.cycles.frequency)",
+                self.frequency
+            )));
+        }
+        if self.target == 0 {
+            return Err(Error::Scene("settlement: the run has no loading cycle (simulation.duration × output.cycles.frequency < 1)".into()));
+        }
+        Ok(())
+    }
+
+    /// Runs the procedure into `out` (module doc), calling `progress` after each
+    /// cycle. `opts.resume` continues from `OUT/checkpoint.json`; `opts.stop_after`
+    /// stops (with a checkpoint) at the first cycle's end after that many steps.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] for invalid settings or checkpoint; [`Error::Io`] naming a
+    /// file; the engine's error if a step or a relaxation fails, after the tables
+    /// and `summary.json` (`end: "diverged"`) are written.
+    pub fn run(
+        &self,
+        out: &Path,
+        opts: &RunOptions,
+        progress: &mut dyn FnMut(&AccelerationProgress),
+    ) -> Result<AccelerationOutcome<E>> {
+        self.check()?;
+        crate::run::check_options(opts)?;
+        let (mut st, mut rows, mut jumps) = if opts.resume { self.resume(out)? } else { self.start(out)? };
+        st.sys.set_threads(opts.threads.max(1));
+        let law = self.spec.law.estimator();
+        let started = Instant::now();
+        let wall0 = st.wall_time_s;
+        let steps0 = st.sys.steps_done();
+        let mut checkpointed = Instant::now();
+        let mut end = "finished";
+        let mut failure = None;
+        let vertical = E::DIM - 1;
+        let per_cycle = (1.0 / (self.frequency * st.sys.dt())).ceil() as u64 + 2;
+        while st.cycle < self.target {
+            // One computed cycle.
+            let before = cycles_at(st.sys.time(), self.frequency, st.sys.dt());
+            let mut made = 0;
+            while cycles_at(st.sys.time(), self.frequency, st.sys.dt()) == before {
+                if let Err(e) = st.sys.step() {
+                    failure = Some(e);
+                    break;
+                }
+                made += 1;
+                if made > per_cycle {
+                    failure = Some(Error::Scene(format!(
+                        "settlement: {made} steps did not close cycle {} (frequency {} Hz, dt {} s)",
+                        before + 1,
+                        self.frequency,
+                        st.sys.dt()
+                    )));
+                    break;
+                }
+            }
+            if failure.is_some() {
+                end = "diverged";
+                break;
+            }
+            st.cycle += 1;
+            st.computed += 1;
+            let c = st.sys.configuration();
+            let s = settlement(&st.origin, &c, st.slot, vertical);
+            st.last_settlement = s;
+            rows.write(&SettlementRow {
+                cycle: st.cycle,
+                computed: 1,
+                settlement_m: s,
+                coordination: Some(st.sys.coordination()),
+                max_overlap_before_relax_m: None,
+                max_overlap_after_relax_m: None,
+                wall_time_s: wall0 + started.elapsed().as_secs_f64(),
+            })?;
+            if st.cycle == self.spec.initial_cycles {
+                st.window = Training::new(st.origin.clone());
+                st.window_settlement.clear();
+            }
+            if st.cycle >= self.spec.initial_cycles {
+                st.window.push(st.cycle as f64, c);
+                st.window_settlement.push(s);
+            }
+            // A jump when the window is long enough and cycles are left.
+            let left = self.target - st.cycle;
+            let k = st.window.k() as u64;
+            if left > 0 && k >= self.spec.computed_cycles {
+                match self.jump(&mut st, law, k, left, &mut rows, &mut jumps, wall0, &started) {
+                    Ok(()) => {}
+                    Err(e) => {
+                        failure = Some(e);
+                        end = "diverged";
+                        break;
+                    }
+                }
+            }
+            progress(&AccelerationProgress {
+                cycle: st.cycle,
+                target: self.target,
+                computed: st.computed,
+                settlement: st.last_settlement,
+            });
+            let stop = opts.stop_after.is_some_and(|n| st.sys.steps_done() - steps0 >= n);
+            if st.cycle < self.target
+                && (stop || (opts.checkpoint_every_s > 0.0 && checkpointed.elapsed().as_secs_f64() >= opts.checkpoint_every_s))
+            {
+                st.wall_time_s = wall0 + started.elapsed().as_secs_f64();
+                checkpoint(out, &mut st, &mut rows, &mut jumps)?;
+                checkpointed = Instant::now();
+                if stop {
+                    end = "stopped";
+                    break;
+                }
+            }
+        }
+        st.wall_time_s = wall0 + started.elapsed().as_secs_f64();
+        rows.finish()?;
+        jumps.finish()?;
+        let summary = AccelerationSummary {
+            engine: E::NAME.to_string(),
+            end: end.to_string(),
+            law: self.spec.law,
+            computed_cycles: st.computed,
+            total_cycles: st.cycle,
+            gained: if st.computed > 0 { st.cycle as f64 / st.computed as f64 } else { 0.0 },
+            jumps: st.jumps,
+            settlement_m: st.last_settlement,
+            wall_time_s: st.wall_time_s,
+            steps: st.sys.steps_done(),
+        };
+        io::write_json(&out.join(files::SUMMARY), &summary)?;
+        if end != "stopped" {
+            st.sys.final_state().write(&out.join(files::FINAL))?;
+            io::remove_stale(out, CHECKPOINT_FILE)?;
+        }
+        if let Some(e) = failure {
+            return Err(e);
+        }
+        Ok(AccelerationOutcome { summary, system: st.sys, out: out.to_path_buf() })
+    }
+
+    /// Fits the window, extrapolates, writes back and relaxes; the rows of the
+    /// extrapolated cycles and the jump's row. Leaves the window as it is when
+    /// the adaptive bound asks for more computed cycles.
+    #[allow(clippy::too_many_arguments)]
+    fn jump(
+        &self,
+        st: &mut State<E>,
+        law: &dyn ResidualLaw,
+        k: u64,
+        left: u64,
+        rows: &mut TableWriter,
+        jumps: &mut TableWriter,
+        wall0: f64,
+        started: &Instant,
+    ) -> Result<()> {
+        let f = fit(law, &st.window, E::EXTRAPOLATED, E::DIM)?;
+        let chernoff = match &self.spec.adaptive {
+            Some(a) => {
+                let need = chernoff_cycles(a.error, a.probability, f.xi_range)?;
+                let cap = 10 * self.spec.computed_cycles;
+                if k < need.min(cap) && left > need.min(cap) - k {
+                    return Ok(());
+                }
+                Some(need)
+            }
+            None => None,
+        };
+        let h = (st.h.round() as u64).clamp(1, left);
+        let n = &st.window.cycles;
+        let n_last = *n.last().expect("a window has points");
+        let sc = law.fit(n, &st.window_settlement);
+        for j in 1..h {
+            rows.write(&SettlementRow {
+                cycle: st.cycle + j,
+                computed: 0,
+                settlement_m: law.extrapolate(&sc, n_last, st.last_settlement, j as f64),
+                coordination: None,
+                max_overlap_before_relax_m: None,
+                max_overlap_after_relax_m: None,
+                wall_time_s: wall0 + started.elapsed().as_secs_f64(),
+            })?;
+        }
+        let target = extrapolate(law, &st.window, &f, h as f64);
+        st.sys.set_configuration(&target)?;
+        let t0 = Instant::now();
+        let report: RelaxReport = st.sys.relax(&self.spec.relax)?;
+        let relax_wall = t0.elapsed().as_secs_f64();
+        let from = st.cycle;
+        st.cycle += h;
+        st.jumps += 1;
+        st.h *= self.spec.growth;
+        let c = st.sys.configuration();
+        let s = settlement(&st.origin, &c, st.slot, E::DIM - 1);
+        st.last_settlement = s;
+        rows.write(&SettlementRow {
+            cycle: st.cycle,
+            computed: 0,
+            settlement_m: s,
+            coordination: None,
+            max_overlap_before_relax_m: Some(report.max_overlap_before),
+            max_overlap_after_relax_m: Some(report.max_overlap_after),
+            wall_time_s: wall0 + started.elapsed().as_secs_f64(),
+        })?;
+        jumps.write(&JumpRow {
+            jump: st.jumps,
+            from_cycle: from,
+            to_cycle: st.cycle,
+            computed_cycles: k,
+            extrapolated_cycles: h,
+            chernoff_cycles: chernoff,
+            g_u_m: f.g_u,
+            f_xi_m: f.f_xi,
+            xi_range_m: f.xi_range,
+            relax_iterations: report.iterations,
+            relax_evaluations: report.evaluations,
+            relax_converged: report.converged,
+            max_overlap_before_relax_m: report.max_overlap_before,
+            max_overlap_after_relax_m: report.max_overlap_after,
+            relax_largest_move: report.largest_move,
+            relax_wall_time_s: relax_wall,
+        })?;
+        // The next window starts at the relaxed configuration.
+        st.window = Training::new(st.origin.clone());
+        st.window.push(st.cycle as f64, c);
+        st.window_settlement = vec![s];
+        Ok(())
+    }
+
+    /// A fresh run: the folder prepared, the records and table headers written.
+    fn start(&self, out: &Path) -> Result<(State<E>, TableWriter, TableWriter)> {
+        io::create_output_dir(out)?;
+        for stale in [CHECKPOINT_FILE, files::SUMMARY, files::FINAL, files::SCENE, files::INITIAL_STATE] {
+            io::remove_stale(out, stale)?;
+        }
+        match &self.origin {
+            Origin::Scene { text } => io::write_text(out, files::SCENE, text)?,
+            Origin::Code { json } => io::write_text(out, files::INITIAL_STATE, json)?,
+        };
+        let steps = (self.target as f64 / (self.frequency * self.system.dt())).round() as u64;
+        RunInfo { seed: self.seed, engine: E::NAME.into(), version: env!("CARGO_PKG_VERSION").into(), steps, dt: self.system.dt() }
+            .write(out)?;
+        let origin = self.system.configuration();
+        let slot = match self.spec.settlement_body {
+            Some(b) => Some(origin.bodies.iter().position(|&i| i == b).ok_or_else(|| {
+                Error::Scene(format!("settlement.settlement_body: body {b} is not a mobile body of the scene"))
+            })?),
+            None => None,
+        };
+        let mut window = Training::new(origin.clone());
+        if self.spec.initial_cycles == 0 {
+            window.push(0.0, origin.clone());
+        }
+        let st = State {
+            version: env!("CARGO_PKG_VERSION").into(),
+            engine: E::NAME.into(),
+            source_crc32: self.source_crc32(),
+            sys: self.system.clone(),
+            slot,
+            cycle: 0,
+            computed: 0,
+            jumps: 0,
+            h: self.spec.extrapolated_cycles as f64,
+            window_settlement: if self.spec.initial_cycles == 0 { vec![0.0] } else { Vec::new() },
+            window,
+            origin,
+            last_settlement: 0.0,
+            wall_time_s: 0.0,
+            tables: [(0, 0, 0); 2],
+        };
+        let rows = TableWriter::create(&out.join(SETTLEMENT_FILE), SettlementRow::COLUMNS)?;
+        let jumps = TableWriter::create(&out.join(JUMPS_FILE), JumpRow::COLUMNS)?;
+        Ok((st, rows, jumps))
+    }
+
+    /// The run continued from `OUT/checkpoint.json`.
+    fn resume(&self, out: &Path) -> Result<(State<E>, TableWriter, TableWriter)> {
+        if !out.join(CHECKPOINT_FILE).is_file() {
+            return Err(Error::Scene(format!(
+                "--resume: no {CHECKPOINT_FILE} in '{}' (nothing to continue: run without --resume)",
+                out.display()
+            )));
+        }
+        let (path, st): (PathBuf, State<E>) = read_checked(out)?;
+        check_origin(&path, (&st.engine, &st.version, st.source_crc32), (E::NAME, self.source_crc32()))?;
+        let bad = |msg: String| Error::Scene(format!("{}: not a valid checkpoint: {msg}", path.display()));
+        st.sys.check_state().map_err(|e| bad(e.to_string()))?;
+        st.sys.check_same_model(&self.system).map_err(|e| bad(e.to_string()))?;
+        if st.origin != self.system.configuration() {
+            return Err(bad("its start configuration is not the scene's".into()));
+        }
+        if st.computed > st.cycle || st.cycle > self.target || st.window.configurations.len() != st.window_settlement.len() {
+            return Err(bad(format!("{} computed of {} cycles, target {}", st.computed, st.cycle, self.target)));
+        }
+        let [(rb, rr, rc), (jb, jr, jc)] = st.tables;
+        if rr != st.cycle || jr != st.jumps {
+            return Err(bad(format!("{rr} rows of {SETTLEMENT_FILE} for {} cycles, {jr} of {JUMPS_FILE} for {} jumps", st.cycle, st.jumps)));
+        }
+        let rows = TableWriter::resume(&out.join(SETTLEMENT_FILE), rb, rr, rc)?;
+        let jumps = TableWriter::resume(&out.join(JUMPS_FILE), jb, jr, jc)?;
+        io::remove_stale(out, files::SUMMARY)?;
+        Ok((st, rows, jumps))
+    }
+}
+
+/// Writes the checkpoint of the run in progress.
+fn checkpoint<E: Engine>(out: &Path, st: &mut State<E>, rows: &mut TableWriter, jumps: &mut TableWriter) -> Result<()> {
+    st.tables = [(rows.sync()?, rows.rows(), rows.crc32()), (jumps.sync()?, jumps.rows(), jumps.crc32())];
+    write_checked(out, st)?;
+    Ok(())
+}
+
+/// The settlement of `c` (m, positive downwards) from `origin` along axis `vertical`:
+/// of the body at `slot`, or the mean over every body of the configuration.
+pub fn settlement(origin: &Configuration, c: &Configuration, slot: Option<usize>, vertical: usize) -> f64 {
+    match slot {
+        Some(k) => origin.body(k)[vertical] - c.body(k)[vertical],
+        None if c.is_empty() => 0.0,
+        None => (0..c.len()).map(|k| origin.body(k)[vertical] - c.body(k)[vertical]).sum::<f64>() / c.len() as f64,
+    }
+}
