@@ -6,7 +6,8 @@
 
 use ballast::run::Configuration;
 use ballast::settlement::{
-    chernoff_cycles, chernoff_probability, configuration_error, extrapolate, fit, law_named, Linear, Shenton, Training,
+    chernoff_cycles, chernoff_probability, configuration_error, extrapolate, fit, law_named, Linear, ResidualLaw,
+    Shenton, ShentonOrigin, Training,
 };
 
 /// A configuration of `bodies` bodies with 3 coordinates (x, y, θ) from `f(body, coordinate)`.
@@ -39,30 +40,49 @@ fn shenton_least_squares_recovers_a_and_b_and_extrapolates_the_law() {
         let (a, bb) = shenton_coefficients(b, d);
         a * n.ln() + bb * n
     });
-    let f = fit(&Shenton, &t, 3, 2).unwrap();
-    for b in 0..4 {
-        for d in 0..3 {
-            let (a, bb) = shenton_coefficients(b, d);
-            let c = f.coefficients[b * 3 + d];
-            // Eqs. (20)-(21) are exact on exact data: rounding only (the normal
-            // equations' condition number here is ~1e4, so 1e-9 relative is loose).
-            assert!((c[0] - a).abs() <= 1e-9 * a.abs().max(1e-12), "a: {} vs {a}", c[0]);
-            assert!((c[1] - bb).abs() <= 1e-9 * bb.abs().max(1e-10), "b: {} vs {bb}", c[1]);
+    // Eqs. (20)-(21) as printed, and the law with a constant (which must find 0).
+    // Exact data: rounding only. The closed forms are exact to 1e-9 relative (the
+    // normal equations' condition number is ~1e4 here); the singular-value
+    // solution of the 3-column design carries the design's condition number
+    // (~1e5 for N in 10..30) times the data's rounding (~1e-16 of 0.3 m
+    // coordinates, ~1e-17 m): ~1e-12 m of `c`, ~1e-9 relative of `a`, `b`.
+    for (law, tol) in [(&ShentonOrigin as &dyn ResidualLaw, 1e-9), (&Shenton, 1e-7)] {
+        let f = fit(law, &t, 3, 2).unwrap();
+        for b in 0..4 {
+            for d in 0..3 {
+                let (a, bb) = shenton_coefficients(b, d);
+                let c = f.coefficients[b * 3 + d];
+                assert!(c[0].abs() < 1e-10, "{}: constant {}", law.name(), c[0]);
+                assert!((c[1] - a).abs() <= tol * a.abs().max(1e-12), "{}: a: {} vs {a}", law.name(), c[1]);
+                assert!((c[2] - bb).abs() <= tol * bb.abs().max(1e-10), "{}: b: {} vs {bb}", law.name(), c[2]);
+            }
+        }
+        // Exact data: the error terms are rounding.
+        assert!(f.f_xi < 1e-12, "{}: f_xi = {}", law.name(), f.f_xi);
+        // The extrapolation 20 cycles on is the law's value at N = 50 (eq. 17).
+        let e = extrapolate(law, &t, &f, 20.0);
+        for b in 0..4 {
+            for d in 0..3 {
+                let (a, bb) = shenton_coefficients(b, d);
+                let want = t.origin.q[3 * b + d] + a * 50f64.ln() + bb * 50.0;
+                assert!((e.q[3 * b + d] - want).abs() < 1e-11, "{}: body {b} coordinate {d}", law.name());
+            }
         }
     }
-    // Exact data: no error term.
-    assert!(f.f_xi < 1e-15, "f_xi = {}", f.f_xi);
-    assert!(f.xi_range < 1e-15);
-    // The extrapolation 20 cycles on is the law's value at N = 50 (eq. 17).
-    let h = 20.0;
-    let e = extrapolate(&Shenton, &t, &f, h);
-    for b in 0..4 {
-        for d in 0..3 {
-            let (a, bb) = shenton_coefficients(b, d);
-            let want = t.origin.q[3 * b + d] + a * 50f64.ln() + bb * 50.0;
-            assert!((e.q[3 * b + d] - want).abs() < 1e-15, "body {b} coordinate {d}");
-        }
-    }
+}
+
+#[test]
+fn shenton_with_a_constant_follows_a_seated_sample_where_the_law_through_the_origin_cannot() {
+    // A seating of 10 mm, then 0.1 µm per cycle: a window from cycle 10 to 30.
+    let t = window(1, 10, 20, |_, d, n| if d == 1 { -(1e-2 + 1e-7 * n) } else { 0.0 });
+    let last = t.configurations.last().unwrap().q[1];
+    let with = extrapolate(&Shenton, &t, &fit(&Shenton, &t, 3, 2).unwrap(), 20.0).q[1];
+    let origin = extrapolate(&ShentonOrigin, &t, &fit(&ShentonOrigin, &t, 3, 2).unwrap(), 20.0).q[1];
+    // The data are a line: the law with a constant continues it (to the rounding
+    // of a 1e-2 m offset through a design of condition ~1e5: 1e-12 m).
+    assert!((with - (last - 20.0 * 1e-7)).abs() < 1e-11, "with a constant: {:e}", with - last);
+    // Through the origin, the fit bends: it predicts the sleeper rising.
+    assert!(origin - last > 1e-5, "through the origin: {:e}", origin - last);
 }
 
 #[test]
@@ -160,6 +180,7 @@ fn configuration_error_of_eq_22() {
 fn laws_are_named_and_bad_windows_refused() {
     assert_eq!(law_named("shenton").unwrap().name(), "shenton");
     assert_eq!(law_named("linear").unwrap().name(), "linear");
+    assert_eq!(law_named("shenton_origin").unwrap().name(), "shenton_origin");
     let e = law_named("power").unwrap_err().to_string();
     assert!(e.contains("settlement.law") && e.contains("power"), "{e}");
     let mut t = window(1, 3, 1, |_, _, _| 0.0);

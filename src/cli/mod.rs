@@ -191,6 +191,46 @@ impl Drop for Bar {
     }
 }
 
+/// The bar of an accelerated run (hidden with `quiet`): cycles reached of the
+/// target, computed cycles, settlement, ETA.
+pub(crate) fn cycle_bar(quiet: bool) -> ProgressBar {
+    let pb =
+        if quiet { ProgressBar::hidden() } else { ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr()) };
+    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} cycles, {msg} [{elapsed_precise} < {eta}]") {
+        pb.set_style(style);
+    }
+    pb
+}
+
+/// Shows an accelerated run's progress on its bar.
+pub(crate) fn show_cycles(pb: &ProgressBar, p: &ballast::settlement::AccelerationProgress) {
+    if pb.length() != Some(p.target) {
+        pb.set_length(p.target);
+    }
+    pb.set_position(p.cycle);
+    pb.set_message(format!("{} computed, settlement {:.4} mm", p.computed, 1e3 * p.settlement));
+}
+
+/// The last line of an accelerated run.
+pub(crate) fn print_acceleration(s: &ballast::settlement::AccelerationSummary, out: &std::path::Path) {
+    println!(
+        "{} cycles ({} computed, {:.2}x) in {:.2} s with {} jumps ({} law): settlement {:.4e} m; end: {}; outputs in {}",
+        s.total_cycles,
+        s.computed_cycles,
+        s.gained,
+        s.wall_time_s,
+        s.jumps,
+        match s.law {
+            ballast::settlement::Law::Linear => "linear",
+            ballast::settlement::Law::Shenton => "shenton",
+            ballast::settlement::Law::ShentonOrigin => "shenton_origin",
+        },
+        s.settlement_m,
+        s.end,
+        out.display()
+    );
+}
+
 /// The last line of a run.
 pub(crate) fn print_outcome(o: &RunOutcome) {
     let r = &o.report;

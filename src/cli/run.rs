@@ -1,8 +1,11 @@
 //! `ballast run SCENE --out DIR`: one scene file of either engine through the
-//! library's run loop ([`ballast::run::run_file`]).
+//! library's run loop ([`ballast::run::run_file`]), or, if it has a
+//! `[settlement]` table, through the settlement-acceleration procedure
+//! ([`ballast::settlement::run_file`]).
 
 use super::{Bars, Failure};
 use ballast::run::{default_threads, RunLength, RunOptions};
+use ballast::settlement::AccelerationProgress;
 use ballast::studies::run_scene;
 use std::path::PathBuf;
 
@@ -66,6 +69,15 @@ pub fn main(a: RunArgs) -> Result<(), Failure> {
             (None, None) => None,
         },
     };
+    // A scene with `[settlement]` runs the settlement-acceleration procedure.
+    let bar = super::cycle_bar(a.quiet);
+    let mut show = |p: &AccelerationProgress| super::show_cycles(&bar, p);
+    if let Some(s) = ballast::settlement::run_file(&a.scene, &a.out, &opts, &mut show)? {
+        bar.finish_and_clear();
+        super::print_acceleration(&s, &a.out);
+        return Ok(());
+    }
+    bar.finish_and_clear();
     run_scene(&a.scene, &a.out, &opts, &Bars::single(a.quiet), "run")?;
     Ok(())
 }

@@ -172,6 +172,7 @@ pub fn pentagon_deposit(spec: &DepositSpec) -> Result<Scene> {
             ..NscdSection::default()
         }),
         output: Some(OutputSection { every: Some(50), cycles: None }),
+        settlement: None,
         materials: vec![
             Material { name: "grain".into(), density: spec.density },
             Material { name: "wall".into(), density: 2700.0 },

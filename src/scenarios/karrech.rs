@@ -250,6 +250,7 @@ fn common(spec: &KarrechSpec, duration: f64, equilibrium: bool, every: u64) -> M
             ..MdSection::default()
         }),
         output: Some(OutputSection { every: Some(every), cycles: None }),
+        settlement: None,
         symmetry: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
             .into_iter()
             .map(|normal| SymmetrySpec { point: [0.0; 3], normal })

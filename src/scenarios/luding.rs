@@ -159,6 +159,7 @@ fn common(spec: &LudingSpec, duration: f64, every: u64, lo: V3, hi: V3, sx: Serv
             ..MdSection::default()
         }),
         output: Some(OutputSection { every: Some(every), cycles: None }),
+        settlement: None,
         symmetry: Vec::new(),
         materials: vec![md_material("grain", 2000.0, 1e8, 0.3), md_material("wall", 2000.0, 1e8, 0.3)],
         contacts: vec![contact("grain", spec.friction), contact("wall", 0.0)],

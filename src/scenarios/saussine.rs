@@ -340,6 +340,7 @@ pub fn sample_scene(spec: &SampleSpec) -> Result<Scene> {
             ..NscdSection::default()
         }),
         output: Some(OutputSection { every: Some(50), cycles: None }),
+        settlement: None,
         materials: [("ballast", spec.density), ("elastomer", 1100.0), ("frame", 2400.0)]
             .into_iter()
             .map(|(name, density)| Material { name: name.into(), density })

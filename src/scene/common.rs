@@ -241,3 +241,125 @@ pub(crate) fn inline(entries: &[(&str, Option<String>)]) -> String {
         format!("{{ {} }}", parts.join(", "))
     }
 }
+
+/// `[settlement]`: the settlement-acceleration procedure of Karrech et al. 2007
+/// (Fig. 10; [`crate::settlement::driver`]) instead of a plain run, in a cyclic
+/// scene of either engine (one with `[output] cycles`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SettlementSection {
+    /// `k_i`: cycles computed before the first fit, ≥ 0.
+    pub initial_cycles: u64,
+    /// `k`: computed cycles per fit, ≥ 2.
+    pub computed_cycles: u64,
+    /// `h`: cycles extrapolated by the first jump, ≥ 1.
+    pub extrapolated_cycles: u64,
+    /// Factor on `h` after each jump, ≥ 1; default 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub growth: Option<f64>,
+    /// `"shenton"` (default) or `"linear"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub law: Option<String>,
+    /// Largest overlap left by the relaxation (m), > 0.
+    pub relax_tolerance: f64,
+    /// Iterations of the relaxation at most, ≥ 1; default 10 000.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relax_max_iterations: Option<u64>,
+    /// `"lbfgs"` (default) or `"gradient_descent"` (the paper's method).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relax_method: Option<String>,
+    /// Adaptive `k`: the error `ε` (m) of eq. (15); with `probability`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<f64>,
+    /// Adaptive `k`: the probability `p` of eq. (15), in (0, 1); with `error`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probability: Option<f64>,
+    /// The body whose vertical displacement is the settlement (the sleeper, the
+    /// plate); default: the mean over the mobile bodies.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settlement_body: Option<String>,
+}
+
+/// A validated `[settlement]`: the procedure's settings, the loading frequency
+/// (Hz) and the cycles to reach (`round(duration × frequency)`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AccelerationPlan {
+    /// The procedure's settings.
+    pub spec: crate::settlement::Acceleration,
+    /// Loading frequency (Hz), from `[output] cycles`.
+    pub frequency: f64,
+    /// Cycles to reach.
+    pub cycles: u64,
+}
+
+/// Checks `[settlement]` against the scene's `[output] cycles` and duration;
+/// `mobile_body` resolves the settlement body's name to a mobile body (or says
+/// why not).
+pub(crate) fn check_settlement(
+    s: Option<&SettlementSection>,
+    cycles: Option<&CyclePlan>,
+    sim: &Simulation,
+    mobile_body: impl Fn(&str) -> std::result::Result<usize, String>,
+) -> Result<Option<AccelerationPlan>> {
+    use crate::settlement::{relax::Method, Acceleration, Adaptive, Law};
+    let Some(s) = s else { return Ok(None) };
+    let Some(c) = cycles else {
+        return err("settlement: needs the loading frequency of [output] cycles = { frequency = … }".into());
+    };
+    let mut spec = Acceleration::new(s.initial_cycles, s.computed_cycles, s.extrapolated_cycles, s.relax_tolerance);
+    if let Some(g) = s.growth {
+        spec.growth = g;
+    }
+    if let Some(l) = &s.law {
+        spec.law = Law::from_name(l, "settlement.law")?;
+    }
+    if let Some(n) = s.relax_max_iterations {
+        spec.relax.max_iterations = n;
+    }
+    spec.relax.method = match s.relax_method.as_deref() {
+        None | Some("lbfgs") => Method::Lbfgs,
+        Some("gradient_descent") => Method::GradientDescent,
+        Some(m) => {
+            return err(format!(
+                "settlement.relax_method: unknown method '{}' (expected \"lbfgs\" or \"gradient_descent\")",
+                super::clip(m)
+            ))
+        }
+    };
+    spec.adaptive = match (s.error, s.probability) {
+        (Some(error), Some(probability)) => Some(Adaptive { error, probability }),
+        (None, None) => None,
+        (Some(_), None) => return err("settlement.probability: needed with settlement.error (adaptive k)".into()),
+        (None, Some(_)) => return err("settlement.error: needed with settlement.probability (adaptive k)".into()),
+    };
+    if let Some(name) = &s.settlement_body {
+        spec.settlement_body =
+            Some(mobile_body(name).map_err(|why| crate::Error::Scene(format!("settlement.settlement_body: {why}")))?);
+    }
+    spec.check()?;
+    let total = (sim.duration * c.frequency).round();
+    if !(total >= 1.0 && total < 1e12) {
+        return err(format!(
+            "settlement: simulation.duration × output.cycles.frequency = {} cycles; at least 1 is needed",
+            sim.duration * c.frequency
+        ));
+    }
+    Ok(Some(AccelerationPlan { spec, frequency: c.frequency, cycles: total as u64 }))
+}
+
+/// Appends `[settlement]` as TOML (only the keys the scene has).
+pub(crate) fn write_settlement(out: &mut String, s: Option<&SettlementSection>) {
+    let Some(s) = s else { return };
+    out.push_str("\n[settlement]\n");
+    let _ = writeln!(out, "initial_cycles = {}", s.initial_cycles);
+    let _ = writeln!(out, "computed_cycles = {}", s.computed_cycles);
+    let _ = writeln!(out, "extrapolated_cycles = {}", s.extrapolated_cycles);
+    opt(out, "growth", s.growth, float);
+    opt(out, "law", s.law.as_deref(), string);
+    let _ = writeln!(out, "relax_tolerance = {}", float(s.relax_tolerance));
+    opt(out, "relax_max_iterations", s.relax_max_iterations, |n| n.to_string());
+    opt(out, "relax_method", s.relax_method.as_deref(), string);
+    opt(out, "error", s.error, float);
+    opt(out, "probability", s.probability, float);
+    opt(out, "settlement_body", s.settlement_body.as_deref(), string);
+}

@@ -28,6 +28,9 @@ pub struct Scene {
     /// `[output]`: output settings (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output: Option<OutputSection>,
+    /// `[settlement]`: the settlement-acceleration procedure instead of a plain run (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settlement: Option<crate::scene::common::SettlementSection>,
     /// `[[material]]` entries; a material's index is its position here.
     #[serde(default, rename = "material", skip_serializing_if = "Vec::is_empty")]
     pub materials: Vec<Material>,

@@ -148,6 +148,21 @@ impl Scene {
         let cycles = common::check_output(self.output.as_ref(), true, body)?;
         Ok(common::run_plan(&self.simulation, self.output.as_ref(), cycles))
     }
+
+    /// The settlement-acceleration procedure the scene asks for (`[settlement]`), if any.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if the scene is invalid.
+    pub fn acceleration(&self) -> Result<Option<common::AccelerationPlan>> {
+        let plan = self.plan()?;
+        common::check_settlement(self.settlement.as_ref(), plan.cycles.as_ref(), &self.simulation, |name| {
+            match self.bodies.iter().position(|b| b.name == name && !name.is_empty()) {
+                Some(i) if self.bodies[i].is_fixed() => Err(format!("body '{}' is fixed", clip(name))),
+                Some(i) => Ok(i),
+                None => Err(format!("unknown body '{}'", clip(name))),
+            }
+        })
+    }
 }
 
 /// A user's string for an error message: at most 64 characters (longer ones cut

@@ -256,6 +256,9 @@ pub(crate) fn check(scene: &Scene) -> Result<Checked> {
     let springs = check_springs(scene, &names)?;
     let alert_distance = alert_distance(scene, &ns, &bodies);
     super::common::check_output(scene.output.as_ref(), true, |name| names.get(name).copied())?;
+    if scene.settlement.is_some() {
+        scene.acceleration()?;
+    }
     Ok(Checked { nlgs, theta, alert_distance, bodies, springs })
 }
 

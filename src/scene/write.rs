@@ -130,6 +130,7 @@ pub(crate) fn to_toml(scene: &Scene) -> String {
         opt(&mut out, "alert_distance", n.alert_distance, float);
     }
     super::common::write_output(&mut out, scene.output.as_ref());
+    crate::scene::common::write_settlement(&mut out, scene.settlement.as_ref());
     for m in &scene.materials {
         out.push_str("\n[[material]]\n");
         let _ = writeln!(out, "name = {}", string(&m.name));

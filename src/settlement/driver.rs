@@ -31,7 +31,7 @@
 //! `--resume`.
 
 use super::estimate::{chernoff_cycles, extrapolate, fit, Training};
-use super::law::{Linear, ResidualLaw, Shenton};
+use super::law::{Linear, ResidualLaw, Shenton, ShentonOrigin};
 use super::relax::{RelaxReport, RelaxSettings};
 use crate::clock::cycles_at;
 use crate::error::{Error, Result};
@@ -54,9 +54,12 @@ pub const JUMPS_FILE: &str = "jumps.csv";
 pub enum Law {
     /// Eq. (16).
     Linear,
-    /// Shenton's `a ln N + b N`, eqs. (17)–(21) (the paper's choice for the procedure).
+    /// Shenton's law with a constant, `c + a ln N + b N` (the paper's choice of
+    /// law for the procedure; [`super::law`] says why the constant).
     #[default]
     Shenton,
+    /// Shenton's law through the origin, eqs. (17)–(21) as printed.
+    ShentonOrigin,
 }
 
 impl Law {
@@ -65,6 +68,7 @@ impl Law {
         match self {
             Law::Linear => &Linear,
             Law::Shenton => &Shenton,
+            Law::ShentonOrigin => &ShentonOrigin,
         }
     }
 
@@ -76,8 +80,9 @@ impl Law {
         match name {
             "linear" => Ok(Law::Linear),
             "shenton" => Ok(Law::Shenton),
+            "shenton_origin" => Ok(Law::ShentonOrigin),
             _ => Err(Error::Scene(format!(
-                "{field}: unknown law '{}' (expected \"linear\" or \"shenton\")",
+                "{field}: unknown law '{}' (expected \"linear\", \"shenton\" or \"shenton_origin\")",
                 crate::scene::clip(name)
             ))),
         }
@@ -365,7 +370,9 @@ impl<E: Engine> Accelerated<E> {
             )));
         }
         if self.target == 0 {
-            return Err(Error::Scene("settlement: the run has no loading cycle (simulation.duration × output.cycles.frequency < 1)".into()));
+            return Err(Error::Scene(
+                "settlement: the run has no loading cycle (simulation.duration × output.cycles.frequency < 1)".into(),
+            ));
         }
         Ok(())
     }
@@ -464,7 +471,9 @@ impl<E: Engine> Accelerated<E> {
             });
             let stop = opts.stop_after.is_some_and(|n| st.sys.steps_done() - steps0 >= n);
             if st.cycle < self.target
-                && (stop || (opts.checkpoint_every_s > 0.0 && checkpointed.elapsed().as_secs_f64() >= opts.checkpoint_every_s))
+                && (stop
+                    || (opts.checkpoint_every_s > 0.0
+                        && checkpointed.elapsed().as_secs_f64() >= opts.checkpoint_every_s))
             {
                 st.wall_time_s = wall0 + started.elapsed().as_secs_f64();
                 checkpoint(out, &mut st, &mut rows, &mut jumps)?;
@@ -600,8 +609,14 @@ impl<E: Engine> Accelerated<E> {
             Origin::Code { json } => io::write_text(out, files::INITIAL_STATE, json)?,
         };
         let steps = (self.target as f64 / (self.frequency * self.system.dt())).round() as u64;
-        RunInfo { seed: self.seed, engine: E::NAME.into(), version: env!("CARGO_PKG_VERSION").into(), steps, dt: self.system.dt() }
-            .write(out)?;
+        RunInfo {
+            seed: self.seed,
+            engine: E::NAME.into(),
+            version: env!("CARGO_PKG_VERSION").into(),
+            steps,
+            dt: self.system.dt(),
+        }
+        .write(out)?;
         let origin = self.system.configuration();
         let slot = match self.spec.settlement_body {
             Some(b) => Some(origin.bodies.iter().position(|&i| i == b).ok_or_else(|| {
@@ -651,12 +666,18 @@ impl<E: Engine> Accelerated<E> {
         if st.origin != self.system.configuration() {
             return Err(bad("its start configuration is not the scene's".into()));
         }
-        if st.computed > st.cycle || st.cycle > self.target || st.window.configurations.len() != st.window_settlement.len() {
+        if st.computed > st.cycle
+            || st.cycle > self.target
+            || st.window.configurations.len() != st.window_settlement.len()
+        {
             return Err(bad(format!("{} computed of {} cycles, target {}", st.computed, st.cycle, self.target)));
         }
         let [(rb, rr, rc), (jb, jr, jc)] = st.tables;
         if rr != st.cycle || jr != st.jumps {
-            return Err(bad(format!("{rr} rows of {SETTLEMENT_FILE} for {} cycles, {jr} of {JUMPS_FILE} for {} jumps", st.cycle, st.jumps)));
+            return Err(bad(format!(
+                "{rr} rows of {SETTLEMENT_FILE} for {} cycles, {jr} of {JUMPS_FILE} for {} jumps",
+                st.cycle, st.jumps
+            )));
         }
         let rows = TableWriter::resume(&out.join(SETTLEMENT_FILE), rb, rr, rc)?;
         let jumps = TableWriter::resume(&out.join(JUMPS_FILE), jb, jr, jc)?;

@@ -4,13 +4,15 @@
 //! overlaps, repeat.
 //!
 //! - [`law`]: the residual-displacement laws (linear, eq. 16; Shenton's
-//!   logarithmic law, eqs. 17–21) behind one trait;
+//!   logarithmic law, eqs. 17–21, through the origin or with a constant) behind
+//!   one trait;
 //! - [`estimate`]: the fit of a window of computed cycles, the extrapolation, the
 //!   accuracy measures `g_u` and `f_ξ` (eqs. 13–14), the Chernoff bound (eq. 15)
 //!   and the relative configuration error `E_r` (eq. 22);
 //! - [`driver`]: the procedure of Fig. 10 over any [`crate::run::Engine`]
 //!   ([`Accelerated`]), its tables (`settlement.csv`, `jumps.csv`), summary and
 //!   checkpoints;
+//! - [`file`]: a scene file's `[settlement]` run through it (`ballast run`);
 //! - [`relax`]: the minimisation of an engine's relaxation functional (L-BFGS,
 //!   or the paper's steepest descent as a baseline) until the largest overlap
 //!   is below a tolerance; the functionals are the engines' (MD: eq. 29,
@@ -18,6 +20,7 @@
 
 pub mod driver;
 pub mod estimate;
+pub mod file;
 pub mod law;
 pub mod relax;
 
@@ -26,5 +29,6 @@ pub use driver::{
     SettlementRow,
 };
 pub use estimate::{chernoff_cycles, chernoff_probability, configuration_error, extrapolate, fit, Fit, Training};
-pub use law::{law_named, Linear, ResidualLaw, Shenton};
+pub use file::run_file;
+pub use law::{law_named, Linear, ResidualLaw, Shenton, ShentonOrigin};
 pub use relax::{minimise, Functional, Method, RelaxReport, RelaxSettings};

@@ -39,6 +39,9 @@ pub struct MdScene {
     /// `[output]` (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output: Option<OutputSection>,
+    /// `[settlement]`: the settlement-acceleration procedure instead of a plain run (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settlement: Option<crate::scene::common::SettlementSection>,
     /// `[[symmetry]]` planes: 0, 1 or 2 (perpendicular).
     #[serde(default, rename = "symmetry", skip_serializing_if = "Vec::is_empty")]
     pub symmetry: Vec<SymmetrySpec>,

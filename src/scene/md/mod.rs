@@ -109,6 +109,21 @@ impl MdScene {
         Ok(crate::scene::common::run_plan(&self.simulation, self.output.as_ref(), cycles))
     }
 
+    /// The settlement-acceleration procedure the scene asks for (`[settlement]`), if any.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if the scene is invalid.
+    pub fn acceleration(&self) -> Result<Option<crate::scene::common::AccelerationPlan>> {
+        let plan = self.plan()?;
+        let sim = &self.simulation;
+        crate::scene::common::check_settlement(self.settlement.as_ref(), plan.cycles.as_ref(), sim, |name| {
+            self.bodies
+                .iter()
+                .position(|b| b.name == name && !name.is_empty())
+                .ok_or_else(|| format!("unknown sphere '{}'", crate::scene::clip(name)))
+        })
+    }
+
     /// Force-evaluation threads the scene asks for (`md.threads`), if any.
     pub fn threads(&self) -> Option<usize> {
         self.md.as_ref().and_then(|m| m.threads)

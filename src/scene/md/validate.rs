@@ -125,6 +125,9 @@ pub(crate) fn check(scene: &MdScene) -> Result<CheckedMd> {
     let ms = scene.md.clone().unwrap_or_default();
     let (integrator, background_damping, background_rotational_damping) = check_md(&ms, &defaults)?;
     crate::scene::common::check_output(scene.output.as_ref(), false, |_| None)?;
+    if scene.settlement.is_some() {
+        scene.acceleration()?;
+    }
     let planes = check_symmetry(scene)?;
     let (names, materials) = check_materials(scene)?;
     let (pairs, laws) = check_contacts(scene, &names)?;

@@ -93,6 +93,7 @@ pub(crate) fn to_toml(scene: &MdScene) -> String {
         opt(&mut out, "threads", m.threads, |t| t.to_string());
     }
     crate::scene::common::write_output(&mut out, scene.output.as_ref());
+    crate::scene::common::write_settlement(&mut out, scene.settlement.as_ref());
     for s in &scene.symmetry {
         out.push_str("\n[[symmetry]]\n");
         let _ = writeln!(out, "point = {}", triple(s.point));

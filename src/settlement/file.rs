@@ -1,0 +1,64 @@
+//! A scene file's `[settlement]` table run through the procedure
+//! ([`super::driver::Accelerated`]), for either engine: what `ballast run` does
+//! with a scene that has one.
+
+use super::driver::{Accelerated, AccelerationProgress, AccelerationSummary};
+use crate::error::Result;
+use crate::run::RunOptions;
+use crate::scene::{MdScene, Scene};
+use std::path::Path;
+
+/// Runs the settlement-acceleration procedure of the scene file at `path` into
+/// `out`, calling `progress` after each cycle; `None` (nothing run) if the scene
+/// has no `[settlement]`. `opts.length` replaces the scene's duration (and so the
+/// cycles to reach), as for a plain run; an MD scene's `md.threads` wins.
+///
+/// # Errors
+/// [`crate::Error::Scene`] (one line naming the key) for an invalid scene or
+/// options; else as [`Accelerated::run`].
+pub fn run_file(
+    path: &Path,
+    out: &Path,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(&AccelerationProgress),
+) -> Result<Option<AccelerationSummary>> {
+    let text = Scene::read_text(path)?;
+    let name = path.display().to_string();
+    match crate::scene::engine_of_named(&text, &name)?.as_str() {
+        "md" => {
+            let mut scene = MdScene::from_toml_str_named(&text, &name)?;
+            if scene.settlement.is_none() {
+                return Ok(None);
+            }
+            let text = match opts.length {
+                Some(length) => {
+                    scene.simulation.set_length(length)?;
+                    scene.to_toml_string()?
+                }
+                None => text,
+            };
+            let Some(plan) = scene.acceleration()? else { return Ok(None) };
+            let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts.clone() };
+            let run =
+                Accelerated::from_scene(scene.build()?, plan.spec, plan.frequency, plan.cycles, scene.seed(), text);
+            Ok(Some(run.run(out, &opts, progress)?.summary))
+        }
+        _ => {
+            let mut scene = Scene::from_toml_str_named(&text, &name)?;
+            if scene.settlement.is_none() {
+                return Ok(None);
+            }
+            let text = match opts.length {
+                Some(length) => {
+                    scene.simulation.set_length(length)?;
+                    scene.to_toml_string()?
+                }
+                None => text,
+            };
+            let Some(plan) = scene.acceleration()? else { return Ok(None) };
+            let run =
+                Accelerated::from_scene(scene.build()?, plan.spec, plan.frequency, plan.cycles, scene.seed(), text);
+            Ok(Some(run.run(out, opts, progress)?.summary))
+        }
+    }
+}
