@@ -95,6 +95,8 @@ pub enum SaussineCommand {
         /// Replicas run at once, each on one core (default: the number of cores).
         #[arg(long)]
         jobs: Option<usize>,
+        #[command(flatten)]
+        accelerate: AccelerateArgs,
         #[arg(long)]
         quiet: bool,
     },
@@ -302,6 +304,44 @@ fn policy(option: &str, p: &str) -> Result<(String, f64), Failure> {
     Ok((name.to_string(), tol))
 }
 
+/// The settlement-acceleration procedure on a settlement run.
+#[derive(Debug, clap::Args)]
+pub(crate) struct AccelerateArgs {
+    /// Accelerate the run (Karrech et al. 2007, Fig. 10): K_I initial cycles, then
+    /// windows of K computed cycles each followed by H extrapolated ones;
+    /// settlement.csv (one row per cycle, computed or not), jumps.csv, summary.json.
+    #[arg(long, value_name = "K_I,K,H")]
+    accelerate: Option<String>,
+    /// Law of the residual displacement: shenton (c + a ln N + b N), linear (eq. 16),
+    /// shenton_origin (a ln N + b N, eqs. 20-21).
+    #[arg(long, default_value = "shenton", requires = "accelerate")]
+    law: String,
+    /// Factor on H after each jump.
+    #[arg(long, default_value_t = 1.0, requires = "accelerate")]
+    growth: f64,
+    /// Largest overlap left by the relaxation after a jump (m); default 1 % of the
+    /// smallest grain's inradius.
+    #[arg(long, value_name = "M", requires = "accelerate")]
+    relax_tolerance: Option<f64>,
+}
+
+impl AccelerateArgs {
+    fn accelerate(&self) -> Result<Option<saussine::Accelerate>, Failure> {
+        let Some(text) = &self.accelerate else { return Ok(None) };
+        let parts: Vec<Option<u64>> = text.split(',').map(|p| p.trim().parse().ok()).collect();
+        let cycles = match parts.as_slice() {
+            [Some(a), Some(b), Some(c)] => [*a, *b, *c],
+            _ => return Err(input(format!("--accelerate: expected K_I,K,H (three whole numbers), got '{text}'"))),
+        };
+        Ok(Some(saussine::Accelerate {
+            cycles,
+            law: self.law.clone(),
+            growth: self.growth,
+            relax_tolerance: self.relax_tolerance,
+        }))
+    }
+}
+
 /// The line of an ensemble of settlement runs.
 fn print_replicas(r: &SettleReplicas) {
     for (label, e) in &r.failed {
@@ -356,11 +396,24 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
             resume,
             replicas,
             jobs,
+            accelerate,
             quiet,
         } => {
             let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume };
             let replicas = replicas.replicas();
-            if replicas.count == 1 {
+            if let Some(acc) = accelerate.accelerate()? {
+                if replicas.count > 1 {
+                    return Err(input(
+                        "--accelerate with --replicas: not built yet (run the replicas one by one with --perturb-seed)"
+                            .into(),
+                    ));
+                }
+                let bar = super::cycle_bar(quiet);
+                let mut show = |p: &ballast::settlement::AccelerationProgress| super::show_cycles(&bar, p);
+                let s = saussine::settle_accelerated(&sample, &loading.loading()?, &acc, &out, &opts, &mut show)?;
+                bar.finish_and_clear();
+                super::print_acceleration(&s, &out);
+            } else if replicas.count == 1 {
                 replicas.check()?;
                 saussine::settle(&sample, &loading.loading()?, &out, &opts, &Bars::single(quiet))?;
             } else {

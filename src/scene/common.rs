@@ -338,7 +338,7 @@ pub(crate) fn check_settlement(
     }
     spec.check()?;
     let total = (sim.duration * c.frequency).round();
-    if !(total >= 1.0 && total < 1e12) {
+    if !(1.0..1e12).contains(&total) {
         return err(format!(
             "settlement: simulation.duration × output.cycles.frequency = {} cycles; at least 1 is needed",
             sim.duration * c.frequency

@@ -279,6 +279,66 @@ pub fn settle(
     run_settle(&path, out, &spec, opts, default_threads(), opts.resume, display, "settle")
 }
 
+/// The settlement-acceleration procedure of `[settlement]` (Karrech et al.
+/// 2007, Fig. 10) on a Saussine run: the loaded scene's cycles, `k_i` of them
+/// first, then windows of `k` computed and `h` extrapolated cycles.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Accelerate {
+    /// `k_i`, `k`, `h`.
+    pub cycles: [u64; 3],
+    /// `"shenton"` (default), `"linear"` or `"shenton_origin"`.
+    pub law: String,
+    /// Factor on `h` after each jump (≥ 1).
+    pub growth: f64,
+    /// Largest overlap left by the relaxation (m); `None`: 1 % of the smallest
+    /// grain's inradius (the overlap the default NLGS setting keeps below).
+    pub relax_tolerance: Option<f64>,
+}
+
+/// §4 accelerated: [`settle`]'s loaded scene (written as `OUT/loaded.toml`, with
+/// its `[settlement]` table, the sleeper as the settlement body) run through
+/// [`crate::settlement::run_file`]: `settlement.csv`, `jumps.csv`, `summary.json`.
+///
+/// # Errors
+/// [`Error::Scene`] for an unreadable sample, an invalid loading or settings;
+/// else as [`crate::settlement::Accelerated::run`].
+pub fn settle_accelerated(
+    sample: &Path,
+    loading: &Loading,
+    accelerate: &Accelerate,
+    out: &Path,
+    opts: &SettleOptions,
+    progress: &mut dyn FnMut(&crate::settlement::AccelerationProgress),
+) -> Result<crate::settlement::AccelerationSummary> {
+    let (mut scene, _) = loaded(sample, loading)?;
+    let sys = scene.build()?;
+    let smallest = (0..sys.bodies.len())
+        .filter(|&i| !sys.bodies.info[i].fixed)
+        .map(|i| sys.bodies.info[i].shape.inner_radius())
+        .fold(f64::INFINITY, f64::min);
+    let sleeper = scene.output.as_ref().and_then(|o| o.cycles.as_ref()).and_then(|c| c.body.clone());
+    let [initial_cycles, computed_cycles, extrapolated_cycles] = accelerate.cycles;
+    scene.settlement = Some(crate::scene::common::SettlementSection {
+        initial_cycles,
+        computed_cycles,
+        extrapolated_cycles,
+        growth: Some(accelerate.growth),
+        law: Some(accelerate.law.clone()),
+        relax_tolerance: accelerate.relax_tolerance.unwrap_or(0.01 * smallest),
+        settlement_body: sleeper,
+        ..Default::default()
+    });
+    scene.validate()?;
+    io::create_output_dir(out)?;
+    let path = out.join("loaded.toml");
+    if !opts.resume {
+        write_scene(&path, &scene, &format!("loaded from {}, accelerated", sample.display()))?;
+    }
+    let run = RunOptions { checkpoint_every_s: opts.checkpoint_every_s, resume: opts.resume, ..RunOptions::default() };
+    crate::settlement::run_file(&path, out, &run, progress)?
+        .ok_or_else(|| Error::Scene(format!("{}: no [settlement] table", path.display())))
+}
+
 /// Runs the loaded scene at `path` into `out` as [`settle`] does.
 #[allow(clippy::too_many_arguments)]
 fn run_settle(
