@@ -244,6 +244,23 @@ impl Engine for MdSystem {
         MdSystem::set_configuration(self, c)
     }
 
+    fn boundaries(&self) -> Vec<crate::run::Boundary> {
+        let up = self.up();
+        self.walls
+            .iter()
+            .filter(|w| matches!(w.motion, super::Motion::Servo { .. }))
+            .map(|w| crate::run::Boundary {
+                name: w.name.clone(),
+                s: w.s,
+                down: w.normal().map_or(0.0, |n| -n.dot(&up)),
+            })
+            .collect()
+    }
+
+    fn set_boundaries(&mut self, s: &[f64]) -> Result<()> {
+        MdSystem::set_servo_positions(self, s)
+    }
+
     fn relax(&mut self, settings: &crate::settlement::RelaxSettings) -> Result<crate::settlement::RelaxReport> {
         MdSystem::relax(self, settings)
     }

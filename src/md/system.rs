@@ -621,6 +621,33 @@ impl MdSystem {
         Ok(())
     }
 
+    /// Moves the servo walls, in scene order, to the displacements `s` (m along
+    /// their normals), at rest, and rebuilds the derived state as
+    /// [`MdSystem::set_configuration`] does.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if `s` has not one finite value per servo wall; the system
+    /// is then unchanged.
+    pub fn set_servo_positions(&mut self, s: &[f64]) -> Result<()> {
+        let servo: Vec<usize> =
+            (0..self.walls.len()).filter(|&k| matches!(self.walls[k].motion, walls::Motion::Servo { .. })).collect();
+        if s.len() != servo.len() {
+            return Err(Error::Scene(format!("boundaries: {} coordinates for {} servo walls", s.len(), servo.len())));
+        }
+        if let Some(k) = s.iter().position(|v| !v.is_finite()) {
+            return Err(Error::Scene(format!(
+                "boundaries: wall '{}': {} is not finite",
+                self.walls[servo[k]].name, s[k]
+            )));
+        }
+        for (&k, &v) in servo.iter().zip(s) {
+            self.walls[k].s = v;
+            self.walls[k].s_dot = 0.0;
+        }
+        self.reset_derived();
+        Ok(())
+    }
+
     /// Checks that the state holds together (a state read from a checkpoint):
     /// array lengths, material and partner indices, the neighbour rows, finite
     /// positions and velocities, the clock, the Gear positions, and the state

@@ -93,6 +93,18 @@ impl Configuration {
     }
 }
 
+/// A boundary body that moves under its own dynamics, outside the
+/// [`Configuration`] of the bodies (MD: a servo wall, e.g. the loading plate).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Boundary {
+    /// Its name in the scene.
+    pub name: String,
+    /// Its coordinate (m): a servo wall's displacement along its normal since the start.
+    pub s: f64,
+    /// How far it goes down (along gravity) per unit of `s` (dimensionless: `−n·up`).
+    pub down: f64,
+}
+
 /// A time-stepping engine driven by the run loop and by cyclic drivers.
 pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// The engine's name in scenes and outputs (`"nscd"`, `"md"`).
@@ -237,6 +249,26 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// [`crate::Error::Scene`] if `c` does not fit the engine (coordinates per
     /// body, unknown or fixed body, non-finite value); the engine is then unchanged.
     fn set_configuration(&mut self, c: &Configuration) -> Result<()>;
+
+    /// The boundary bodies that move under their own dynamics ([`Boundary`]);
+    /// none by default (NSCD: every moving body is in the configuration).
+    fn boundaries(&self) -> Vec<Boundary> {
+        Vec::new()
+    }
+
+    /// Moves the boundaries of [`Engine::boundaries`] to the coordinates `s` (m), at
+    /// rest, and rebuilds the derived state as [`Engine::set_configuration`] does.
+    ///
+    /// # Errors
+    /// [`crate::Error::Scene`] if `s` does not have one finite value per boundary;
+    /// the engine is then unchanged.
+    fn set_boundaries(&mut self, s: &[f64]) -> Result<()> {
+        if s.is_empty() {
+            Ok(())
+        } else {
+            Err(crate::Error::Scene(format!("boundaries: {} coordinates, the engine has none", s.len())))
+        }
+    }
 
     /// Relaxes the overlaps of the current configuration until the largest is at
     /// most `settings.tolerance` (Karrech et al. 2007, §4; the settlement

@@ -17,7 +17,7 @@ mod engine;
 mod equilibrium;
 mod runner;
 
-pub use engine::{Configuration, Energies, Engine};
+pub use engine::{Boundary, Configuration, Energies, Engine};
 pub use equilibrium::{Equilibrium, EquilibriumWatch, DEFAULT_EQUILIBRIUM_STEPS};
 pub use runner::{
     check_options, cores, default_threads, files, CyclePlan, Prior, Progress, Restart, RunLength, RunOptions,

@@ -292,6 +292,14 @@ pub struct AccelerationPlan {
     pub cycles: u64,
 }
 
+/// What `settlement.settlement_body` names: a mobile body (its index), or a
+/// boundary that moves under its own dynamics (an MD servo wall: its index
+/// among them).
+pub(crate) enum SettlementRef {
+    Body(usize),
+    Boundary(usize),
+}
+
 /// Checks `[settlement]` against the scene's `[output] cycles` and duration;
 /// `mobile_body` resolves the settlement body's name to a mobile body (or says
 /// why not).
@@ -299,7 +307,7 @@ pub(crate) fn check_settlement(
     s: Option<&SettlementSection>,
     cycles: Option<&CyclePlan>,
     sim: &Simulation,
-    mobile_body: impl Fn(&str) -> std::result::Result<usize, String>,
+    mobile_body: impl Fn(&str) -> std::result::Result<SettlementRef, String>,
 ) -> Result<Option<AccelerationPlan>> {
     use crate::settlement::{relax::Method, Acceleration, Adaptive, Law};
     let Some(s) = s else { return Ok(None) };
@@ -333,8 +341,10 @@ pub(crate) fn check_settlement(
         (None, Some(_)) => return err("settlement.error: needed with settlement.probability (adaptive k)".into()),
     };
     if let Some(name) = &s.settlement_body {
-        spec.settlement_body =
-            Some(mobile_body(name).map_err(|why| crate::Error::Scene(format!("settlement.settlement_body: {why}")))?);
+        match mobile_body(name).map_err(|why| crate::Error::Scene(format!("settlement.settlement_body: {why}")))? {
+            SettlementRef::Body(i) => spec.settlement_body = Some(i),
+            SettlementRef::Boundary(j) => spec.settlement_boundary = Some(j),
+        }
     }
     spec.check()?;
     let total = (sim.duration * c.frequency).round();

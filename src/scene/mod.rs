@@ -158,7 +158,7 @@ impl Scene {
         common::check_settlement(self.settlement.as_ref(), plan.cycles.as_ref(), &self.simulation, |name| {
             match self.bodies.iter().position(|b| b.name == name && !name.is_empty()) {
                 Some(i) if self.bodies[i].is_fixed() => Err(format!("body '{}' is fixed", clip(name))),
-                Some(i) => Ok(i),
+                Some(i) => Ok(common::SettlementRef::Body(i)),
                 None => Err(format!("unknown body '{}'", clip(name))),
             }
         })

@@ -118,6 +118,10 @@ pub struct Acceleration {
     /// The body whose vertical displacement is the settlement (index in the
     /// engine); `None`: the mean over the mobile bodies.
     pub settlement_body: Option<usize>,
+    /// A boundary ([`Engine::boundaries`], index among them: the MD loading
+    /// plate) whose downward displacement is the settlement, instead of a body.
+    #[serde(default)]
+    pub settlement_boundary: Option<usize>,
 }
 
 impl Acceleration {
@@ -133,6 +137,7 @@ impl Acceleration {
             relax: RelaxSettings::new(relax_tolerance),
             adaptive: None,
             settlement_body: None,
+            settlement_boundary: None,
         }
     }
 
@@ -314,6 +319,9 @@ struct State<E> {
     window: Training,
     /// Settlement at each point of the window (m).
     window_settlement: Vec<f64>,
+    /// The boundaries' coordinates at the start of the loading, and at each point of the window.
+    boundary_origin: Vec<f64>,
+    window_boundaries: Vec<Vec<f64>>,
     last_settlement: f64,
     wall_time_s: f64,
     /// Bytes, rows and CRC-32 of `settlement.csv` and `jumps.csv`.
@@ -431,7 +439,8 @@ impl<E: Engine> Accelerated<E> {
             st.cycle += 1;
             st.computed += 1;
             let c = st.sys.configuration();
-            let s = settlement(&st.origin, &c, st.slot, vertical);
+            let b = boundary_coordinates(&st.sys);
+            let s = st.settlement(&c, &b, vertical, self.spec.settlement_boundary);
             st.last_settlement = s;
             rows.write(&SettlementRow {
                 cycle: st.cycle,
@@ -445,10 +454,12 @@ impl<E: Engine> Accelerated<E> {
             if st.cycle == self.spec.initial_cycles {
                 st.window = Training::new(st.origin.clone());
                 st.window_settlement.clear();
+                st.window_boundaries.clear();
             }
             if st.cycle >= self.spec.initial_cycles {
                 st.window.push(st.cycle as f64, c);
                 st.window_settlement.push(s);
+                st.window_boundaries.push(b);
             }
             // A jump when the window is long enough and cycles are left.
             let left = self.target - st.cycle;
@@ -553,6 +564,16 @@ impl<E: Engine> Accelerated<E> {
             })?;
         }
         let target = extrapolate(law, &st.window, &f, h as f64);
+        // The boundaries (the MD plate) follow the same law.
+        let mut series = vec![0.0; n.len()];
+        let boundaries: Vec<f64> = (0..st.boundary_origin.len())
+            .map(|j| {
+                series.iter_mut().zip(&st.window_boundaries).for_each(|(v, b)| *v = b[j] - st.boundary_origin[j]);
+                let c = law.fit(n, &series);
+                st.boundary_origin[j] + law.extrapolate(&c, n_last, series[series.len() - 1], h as f64)
+            })
+            .collect();
+        st.sys.set_boundaries(&boundaries)?;
         st.sys.set_configuration(&target)?;
         let t0 = Instant::now();
         let report: RelaxReport = st.sys.relax(&self.spec.relax)?;
@@ -562,7 +583,8 @@ impl<E: Engine> Accelerated<E> {
         st.jumps += 1;
         st.h *= self.spec.growth;
         let c = st.sys.configuration();
-        let s = settlement(&st.origin, &c, st.slot, E::DIM - 1);
+        let b = boundary_coordinates(&st.sys);
+        let s = st.settlement(&c, &b, E::DIM - 1, self.spec.settlement_boundary);
         st.last_settlement = s;
         rows.write(&SettlementRow {
             cycle: st.cycle,
@@ -595,6 +617,7 @@ impl<E: Engine> Accelerated<E> {
         st.window = Training::new(st.origin.clone());
         st.window.push(st.cycle as f64, c);
         st.window_settlement = vec![s];
+        st.window_boundaries = vec![b];
         Ok(())
     }
 
@@ -624,6 +647,13 @@ impl<E: Engine> Accelerated<E> {
             })?),
             None => None,
         };
+        let boundary_origin = boundary_coordinates(&self.system);
+        if let Some(j) = self.spec.settlement_boundary.filter(|&j| j >= boundary_origin.len()) {
+            return Err(Error::Scene(format!(
+                "settlement.settlement_body: boundary {j} does not exist ({} boundaries)",
+                boundary_origin.len()
+            )));
+        }
         let mut window = Training::new(origin.clone());
         if self.spec.initial_cycles == 0 {
             window.push(0.0, origin.clone());
@@ -639,6 +669,8 @@ impl<E: Engine> Accelerated<E> {
             jumps: 0,
             h: self.spec.extrapolated_cycles as f64,
             window_settlement: if self.spec.initial_cycles == 0 { vec![0.0] } else { Vec::new() },
+            window_boundaries: if self.spec.initial_cycles == 0 { vec![boundary_origin.clone()] } else { Vec::new() },
+            boundary_origin,
             window,
             origin,
             last_settlement: 0.0,
@@ -691,6 +723,26 @@ fn checkpoint<E: Engine>(out: &Path, st: &mut State<E>, rows: &mut TableWriter, 
     st.tables = [(rows.sync()?, rows.rows(), rows.crc32()), (jumps.sync()?, jumps.rows(), jumps.crc32())];
     write_checked(out, st)?;
     Ok(())
+}
+
+/// The coordinates of an engine's boundaries (m).
+fn boundary_coordinates<E: Engine>(sys: &E) -> Vec<f64> {
+    sys.boundaries().iter().map(|b| b.s).collect()
+}
+
+impl<E: Engine> State<E> {
+    /// The settlement (m, positive downwards) of the configuration `c` with the
+    /// boundaries at `b`: of the settlement boundary if there is one, else of
+    /// the settlement body or the mean over the mobile bodies.
+    fn settlement(&self, c: &Configuration, b: &[f64], vertical: usize, boundary: Option<usize>) -> f64 {
+        match boundary {
+            Some(j) => {
+                let down = self.sys.boundaries().get(j).map_or(0.0, |w| w.down);
+                (b[j] - self.boundary_origin[j]) * down
+            }
+            None => settlement(&self.origin, c, self.slot, vertical),
+        }
+    }
 }
 
 /// The settlement of `c` (m, positive downwards) from `origin` along axis `vertical`:

@@ -116,11 +116,20 @@ impl MdScene {
     pub fn acceleration(&self) -> Result<Option<crate::scene::common::AccelerationPlan>> {
         let plan = self.plan()?;
         let sim = &self.simulation;
+        use crate::scene::common::SettlementRef;
         crate::scene::common::check_settlement(self.settlement.as_ref(), plan.cycles.as_ref(), sim, |name| {
-            self.bodies
-                .iter()
-                .position(|b| b.name == name && !name.is_empty())
-                .ok_or_else(|| format!("unknown sphere '{}'", crate::scene::clip(name)))
+            if let Some(i) = self.bodies.iter().position(|b| b.name == name && !name.is_empty()) {
+                return Ok(SettlementRef::Body(i));
+            }
+            let servo: Vec<&str> = self.walls.iter().filter(|w| w.servo.is_some()).map(|w| w.name.as_str()).collect();
+            match servo.iter().position(|w| *w == name) {
+                Some(j) => Ok(SettlementRef::Boundary(j)),
+                None if self.walls.iter().any(|w| w.name == name) => Err(format!(
+                    "wall '{}' does not move (only a servo wall, like the plate, can)",
+                    crate::scene::clip(name)
+                )),
+                None => Err(format!("unknown sphere or servo wall '{}'", crate::scene::clip(name))),
+            }
         })
     }
 

@@ -1,0 +1,133 @@
+//! The settlement-acceleration procedure on the MD engine (Karrech et al. 2007,
+//! the engine of the paper): a small softened Table 1 sample (40 spheres in a
+//! quarter cylinder of radius 2 cm, E = 10 MPa so that a 2 µs step resolves the
+//! contacts) under the fully confined plate load (14.15 kPa, 50 Hz), the plate
+//! (a servo wall) extrapolated with the spheres and its displacement the
+//! settlement; k_i = 10, k = 20, h = 20 over 90 cycles against full runs.
+//! The load is a tenth of the paper's amplitude (at the full one the soft
+//! contacts are pressed by 5 % of a radius and the sample flows).
+
+use ballast::run::{Engine, RunOptions, Runner};
+use ballast::scenarios::karrech::{deposit_scene, loading_scene, KarrechSpec, Loading};
+use ballast::settlement::{Accelerated, Acceleration, SettlementRow};
+use std::path::PathBuf;
+
+const CYCLES: u64 = 90;
+
+/// The fully confined load (50 Hz) at a tenth of its amplitude (1.415 kPa): on
+/// spheres 4700 times softer than diorite, the full amplitude presses the
+/// contacts by 5 % of a radius and the sample flows.
+const LOAD: Loading = Loading { amplitude: 1.415e3, ..Loading::FULL };
+
+fn out_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ballast-driver-md-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn spec() -> KarrechSpec {
+    KarrechSpec { young: 1e7, dt: 2e-6, duration: 0.6, container_radius: 0.02, ..KarrechSpec::table1(40, 1) }
+}
+
+/// The deposited spheres `(radius, centre)`.
+fn deposit() -> Vec<(f64, ballast::md::V3)> {
+    let scene = deposit_scene(&spec(), 1000).unwrap();
+    let dir = out_dir("deposit");
+    let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
+    let run = Runner::from_system(scene.build().unwrap(), scene.plan().unwrap()).unwrap();
+    run.run(&dir, &opts, &mut |_| {}).unwrap();
+    let fin = ballast::io::FinalState::read(&dir.join("final.json")).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    fin.bodies
+        .iter()
+        .map(|b| (b.radius.unwrap(), ballast::md::V3::new(b.position[0], b.position[1], b.position[2])))
+        .collect()
+}
+
+fn accelerate(
+    sys: ballast::md::MdSystem,
+    spec: &Acceleration,
+    name: &str,
+) -> (Vec<SettlementRow>, ballast::settlement::AccelerationSummary) {
+    let run = Accelerated::from_system(sys, spec.clone(), Loading::FULL.frequency, CYCLES).unwrap();
+    let dir = out_dir(name);
+    let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
+    let out = run.run(&dir, &opts, &mut |_| {}).unwrap();
+    let rows: Vec<SettlementRow> = ballast::io::read_csv(&dir.join("settlement.csv")).unwrap();
+    if name == "acc" {
+        let jumps: Vec<ballast::settlement::JumpRow> = ballast::io::read_csv(&dir.join("jumps.csv")).unwrap();
+        assert_eq!(jumps.len(), 2);
+        for j in &jumps {
+            // Each jump's extrapolation overlaps the spheres by far more than a
+            // static contact does (~4e-5 m here), and the relaxation brings the
+            // largest overlap below the tolerance.
+            assert!(j.relax_converged && j.max_overlap_after_relax_m <= spec.relax.tolerance, "{j:?}");
+            assert!(j.max_overlap_before_relax_m > 2.0 * spec.relax.tolerance, "{j:?}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    (rows, out.summary)
+}
+
+#[test]
+fn md_accelerated_run_follows_the_plate_settlement() {
+    use rayon::prelude::*;
+    let t0 = std::time::Instant::now();
+    let spheres = deposit();
+    let scene = loading_scene(&spec(), &spheres, LOAD, CYCLES as u32, 1000).unwrap();
+    let base = scene.build().unwrap();
+    eprintln!("deposit {:.1} s", t0.elapsed().as_secs_f64());
+    // The plate is the first (only) servo wall.
+    assert_eq!(base.boundaries().len(), 1);
+    let mut acc = Acceleration::new(10, 20, 20, 1.5e-4);
+    acc.settlement_boundary = Some(0);
+    let full = Acceleration { computed_cycles: CYCLES + 1, ..acc.clone() };
+    let jobs: Vec<(String, ballast::md::MdSystem, Acceleration)> = (0..3)
+        .map(|r| {
+            let mut sys = base.clone();
+            if r > 0 {
+                // Every sphere moved by at most 1e-9 m (a fixed sequence per replica).
+                let mut c = sys.configuration();
+                for (k, x) in c.q.iter_mut().enumerate() {
+                    if k % 6 < 3 {
+                        *x += 1e-9 * (0.577 * ((k as f64 + 1.0) * (r as f64 * 1.618 + 0.3)).sin());
+                    }
+                }
+                sys.set_configuration(&c).unwrap();
+            }
+            (format!("full{r}"), sys, full.clone())
+        })
+        .chain([("acc".to_string(), base.clone(), acc.clone())])
+        .collect();
+    let runs: Vec<_> = jobs.into_par_iter().map(|(name, sys, spec)| accelerate(sys, &spec, &name)).collect();
+    eprintln!("runs {:.1} s", t0.elapsed().as_secs_f64());
+    let accrued = |rows: &[SettlementRow]| rows[CYCLES as usize - 1].settlement_m - rows[9].settlement_m;
+    let full: Vec<f64> = runs[..3].iter().map(|(r, _)| accrued(r)).collect();
+    let floor = full[1..].iter().map(|a| (a - full[0]).abs()).fold(0.0, f64::max);
+    let (rows, summary) = &runs[3];
+    let err = (accrued(rows) - full[0]).abs();
+    eprintln!(
+        "MD: computed {} of {} (gained {:.2}); seating {:.4e} m; accrued {:.4e} m vs full {:.4e} m: error {:.1} % (noise floor {:.1} %: {full:?})",
+        summary.computed_cycles,
+        summary.total_cycles,
+        summary.gained,
+        rows[9].settlement_m,
+        accrued(rows),
+        full[0],
+        100.0 * err / full[0].abs(),
+        100.0 * floor / full[0].abs()
+    );
+    assert_eq!(summary.computed_cycles, 50);
+    // The plate jumped with the spheres: the settlement of an extrapolated cycle
+    // is the plate's, not a copy of the last computed one.
+    assert!(rows.iter().filter(|r| r.computed == 0).any(|r| r.settlement_m != rows[29].settlement_m));
+    // The total, dominated by the seating (1.9 mm of the first 10 cycles), to 2 %
+    // (measured 1.7 %).
+    // What accrues after it (78 µm over 80 cycles, with cycle-to-cycle swings of
+    // ±10 µm of the plate at the load minimum) is predicted 45 % short (measured);
+    // the full runs from starts moved by 1e-9 m agree to 1.5 %: this small, soft
+    // sample does not follow Shenton's law between cycles 10 and 90 (BENCHMARKS.md).
+    let total = rows[CYCLES as usize - 1].settlement_m;
+    let total_full = runs[0].0[CYCLES as usize - 1].settlement_m;
+    assert!((total - total_full).abs() < 0.02 * total_full, "{total} vs {total_full}");
+}
