@@ -1,0 +1,107 @@
+//! `[settlement]` in a scene: `ballast run` (the library's `settlement::run_file`)
+//! runs the procedure; a stopped run resumes to the same numbers; bad tables are
+//! one-line errors naming the key.
+
+use ballast::run::RunOptions;
+use ballast::settlement::{run_file, JumpRow, SettlementRow};
+use std::path::{Path, PathBuf};
+
+const SCENE: &str = "examples/settlement_sleeper.toml";
+
+fn out_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ballast-settlement-scene-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn tables(dir: &Path) -> (Vec<SettlementRow>, Vec<JumpRow>) {
+    let mut rows: Vec<SettlementRow> = ballast::io::read_csv(&dir.join("settlement.csv")).unwrap();
+    let mut jumps: Vec<JumpRow> = ballast::io::read_csv(&dir.join("jumps.csv")).unwrap();
+    // Wall times differ from run to run.
+    rows.iter_mut().for_each(|r| r.wall_time_s = 0.0);
+    jumps.iter_mut().for_each(|j| j.relax_wall_time_s = 0.0);
+    (rows, jumps)
+}
+
+#[test]
+fn the_example_runs_through_the_procedure_and_resumes_to_the_same_numbers() {
+    let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
+    let whole = out_dir("whole");
+    let s = run_file(SCENE.as_ref(), &whole, &opts, &mut |_| {}).unwrap().expect("the example has [settlement]");
+    // 30 cycles: 2 initial, then 4 computed + 4 extrapolated, three times, and 4 computed.
+    assert_eq!((s.total_cycles, s.computed_cycles, s.jumps), (30, 18, 3));
+    assert!((s.gained - 30.0 / 18.0).abs() < 1e-12);
+    let (rows, jumps) = tables(&whole);
+    assert_eq!(rows.len(), 30);
+    assert_eq!(rows.iter().filter(|r| r.computed == 1).count(), 18);
+    assert_eq!(jumps.len(), 3);
+    for f in ["summary.json", "final.json", "scene.toml", "run.json"] {
+        assert!(whole.join(f).is_file(), "{f}");
+    }
+    assert!(!whole.join("checkpoint.json").exists());
+    // Stopped after 1000 steps (cycle 14, inside the second window), resumed.
+    let cut = out_dir("cut");
+    let stop = RunOptions { stop_after: Some(1000), ..opts.clone() };
+    let s1 = run_file(SCENE.as_ref(), &cut, &stop, &mut |_| {}).unwrap().unwrap();
+    assert_eq!(s1.end, "stopped");
+    assert!(cut.join("checkpoint.json").is_file());
+    let resume = RunOptions { resume: true, ..opts.clone() };
+    let s2 = run_file(SCENE.as_ref(), &cut, &resume, &mut |_| {}).unwrap().unwrap();
+    assert_eq!(s2.end, "finished");
+    assert_eq!(tables(&cut), (rows, jumps), "the resumed run's tables are the uninterrupted run's");
+    assert_eq!(s2.settlement_m.to_bits(), s.settlement_m.to_bits());
+    // A scene without [settlement] is not run by it.
+    assert!(run_file("examples/sleeper_load.toml".as_ref(), &out_dir("none"), &opts, &mut |_| {}).unwrap().is_none());
+    for d in [whole, cut] {
+        let _ = std::fs::remove_dir_all(d);
+    }
+}
+
+#[test]
+fn bad_settlement_tables_name_the_key() {
+    let text = std::fs::read_to_string(SCENE).unwrap();
+    let cases: &[(&str, &str, &str)] = &[
+        ("law = \"shenton\"", "law = \"power\"", "settlement.law: unknown law 'power'"),
+        ("computed_cycles = 4", "computed_cycles = 1", "settlement.computed_cycles: a fit needs at least 2 cycles"),
+        ("extrapolated_cycles = 4", "extrapolated_cycles = 0", "settlement.extrapolated_cycles: must be at least 1"),
+        ("relax_tolerance = 1.0e-5", "relax_tolerance = -1.0", "settlement.relax_tolerance: must be a positive length"),
+        (
+            "settlement_body = \"sleeper\"",
+            "settlement_body = \"floor\"",
+            "settlement.settlement_body: body 'floor' is fixed",
+        ),
+        (
+            "settlement_body = \"sleeper\"",
+            "settlement_body = \"nobody\"",
+            "settlement.settlement_body: unknown body 'nobody'",
+        ),
+        (
+            "law = \"shenton\"",
+            "law = \"shenton\"\nerror = 1e-6",
+            "settlement.probability: needed with settlement.error",
+        ),
+        (
+            "law = \"shenton\"",
+            "law = \"shenton\"\ngrowth = 0.5",
+            "settlement.growth: must be a finite factor of at least 1",
+        ),
+        (
+            "law = \"shenton\"",
+            "law = \"shenton\"\nrelax_method = \"newton\"",
+            "settlement.relax_method: unknown method 'newton'",
+        ),
+        ("law = \"shenton\"", "law = \"shenton\"\nspeed = 2", "unknown field `speed`"),
+        (
+            "cycles = { frequency = 20.0, body = \"sleeper\" }",
+            "",
+            "settlement: needs the loading frequency of [output] cycles",
+        ),
+    ];
+    for (from, to, want) in cases {
+        assert!(text.contains(from), "{from}");
+        let bad = text.replacen(from, to, 1);
+        let e = ballast::scene::Scene::from_toml_str(&bad).unwrap_err().to_string();
+        assert!(e.contains(want), "{to}: {e}");
+        assert!(!e.contains('\n'), "one line: {e}");
+    }
+}
