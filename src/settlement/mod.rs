@@ -12,7 +12,7 @@
 //! - [`driver`]: the procedure of Fig. 10 over any [`crate::run::Engine`]
 //!   ([`Accelerated`]), its tables (`settlement.csv`, `jumps.csv`), summary and
 //!   checkpoints;
-//! - [`file`]: a scene file's `[settlement]` run through it (`ballast run`);
+//! - [`file`](mod@file): a scene file's `[settlement]` run through it (`ballast run`);
 //! - [`relax`]: the minimisation of an engine's relaxation functional (L-BFGS,
 //!   or the paper's steepest descent as a baseline) until the largest overlap
 //!   is below a tolerance; the functionals are the engines' (MD: eq. 29,
