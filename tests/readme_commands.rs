@@ -17,6 +17,8 @@ use std::process::Command;
 /// an empty value is a flag.
 const REDUCTIONS: &[(&str, &[(&str, &str)])] = &[
     ("run", &[("--steps", "20"), ("--quiet", "")]),
+    // 10 cycles: 2 initial, 4 computed, a jump of 4 (20 steps would hold no cycle).
+    ("run examples/settlement_sleeper.toml", &[("--steps", "2500"), ("--quiet", "")]),
     ("figures", &[]),
     ("deposit", &[("--grains", "16"), ("--width", "0.1")]),
     ("saussine sample", &[("--grains", "60"), ("--dt", "1e-4"), ("--quiet", "")]),
