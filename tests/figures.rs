@@ -58,12 +58,14 @@ fn line_chart_writes_png_and_svg_with_legend_and_band() {
             points: (0..20).map(|k| (k as f64, 1e-3 * (k as f64).sqrt())).collect(),
             band: (0..20).map(|k| (k as f64, 0.8e-3 * (k as f64).sqrt(), 1.2e-3 * (k as f64).sqrt())).collect(),
             thin: false,
+            points_only: false,
         },
         Series {
             label: "sample 2".into(),
             points: vec![(0.0, 0.0), (5.0, f64::NAN), (10.0, 2e-3), (f64::INFINITY, 1.0), (19.0, 3e-3)],
             band: vec![],
             thin: false,
+            points_only: false,
         },
     ];
     line_chart(&stem, &axes("Settlement vs cycles", false, false), &series).unwrap();
@@ -85,6 +87,7 @@ fn log_axes_skip_non_positive_and_nan_values() {
         points: vec![(1e-6, 900.0), (0.0, 50.0), (-1e-3, 10.0), (1e-4, f64::NAN), (1e-3, 40.0), (1e-2, 0.0)],
         band: vec![(1e-6, 800.0, 1000.0), (1e-4, -1.0, 200.0), (1e-3, 30.0, 50.0)],
         thin: false,
+        points_only: false,
     }];
     for (lx, ly) in [(true, false), (false, true), (true, true)] {
         let stem = dir.join(format!("iterations_{lx}_{ly}"));
@@ -95,7 +98,13 @@ fn log_axes_skip_non_positive_and_nan_values() {
         assert!(!s.contains("NaN") && !s.contains("inf"));
     }
     // Nothing positive at all on a log axis: "no data".
-    let none = [Series { label: "x".into(), points: vec![(0.0, -1.0), (f64::NAN, 1.0)], band: vec![], thin: false }];
+    let none = [Series {
+        label: "x".into(),
+        points: vec![(0.0, -1.0), (f64::NAN, 1.0)],
+        band: vec![],
+        thin: false,
+        points_only: false,
+    }];
     line_chart(&dir.join("none"), &axes("t", true, true), &none).unwrap();
     assert!(svg(&dir.join("none.svg")).contains("no data"));
     std::fs::remove_dir_all(&dir).unwrap();

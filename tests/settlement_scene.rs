@@ -50,6 +50,24 @@ fn the_example_runs_through_the_procedure_and_resumes_to_the_same_numbers() {
     assert_eq!(s2.end, "finished");
     assert_eq!(tables(&cut), (rows, jumps), "the resumed run's tables are the uninterrupted run's");
     assert_eq!(s2.settlement_m.to_bits(), s.settlement_m.to_bits());
+    // Figures, and the errors against a reference: the uninterrupted run is the
+    // resumed run's reference, so every accrued error is exactly 0.
+    let figs = ballast::settlement::figures::draw(&cut, Some(&whole)).unwrap();
+    assert_eq!(figs.written.len(), 2);
+    for stem in &figs.written {
+        assert!(stem.with_extension("png").is_file() && stem.with_extension("svg").is_file());
+    }
+    let errors: Vec<ballast::settlement::figures::ErrorRow> = ballast::io::read_csv(&cut.join("errors.csv")).unwrap();
+    assert_eq!(errors.len(), 30);
+    assert!(errors[..2].iter().all(|e| e.accrued_error.is_none()), "no accrual before k_i");
+    assert!(errors[2..].iter().all(|e| e.accrued_error == Some(0.0)));
+    // An accelerated run of the same scene as the reference: errors after k_i only.
+    let rows: Vec<SettlementRow> = ballast::io::read_csv(&whole.join("settlement.csv")).unwrap();
+    let full: Vec<(f64, Option<f64>)> = rows.iter().map(|r| (r.settlement_m + 1e-6, r.coordination)).collect();
+    let e = ballast::settlement::figures::errors(&rows, &full, 2);
+    // s_full − s_full(2) is s − s(2): the error is 1e-6 m over what accrued.
+    let accrued = rows[29].settlement_m - rows[1].settlement_m;
+    assert!((e[29].accrued_error.unwrap() - 1e-6 / accrued.abs()).abs() < 1e-9 / accrued.abs());
     // A scene without [settlement] is not run by it.
     assert!(run_file("examples/sleeper_load.toml".as_ref(), &out_dir("none"), &opts, &mut |_| {}).unwrap().is_none());
     for d in [whole, cut] {

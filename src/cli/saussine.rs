@@ -323,6 +323,11 @@ pub(crate) struct AccelerateArgs {
     /// smallest grain's inradius.
     #[arg(long, value_name = "M", requires = "accelerate")]
     relax_tolerance: Option<f64>,
+    /// A full run of the same sample and loading (its output folder, e.g. from
+    /// `--accelerate K_I,N+1,1`, which never jumps, or a plain settle): errors.csv
+    /// (settlement, accrued error after K_I, coordination) and its curve on the figure.
+    #[arg(long, value_name = "DIR", requires = "accelerate")]
+    reference: Option<PathBuf>,
 }
 
 impl AccelerateArgs {
@@ -338,8 +343,26 @@ impl AccelerateArgs {
             law: self.law.clone(),
             growth: self.growth,
             relax_tolerance: self.relax_tolerance,
+            reference: self.reference.clone(),
         }))
     }
+}
+
+/// The accrued-settlement error at the last cycle of an accelerated run compared with its reference.
+fn print_errors(out: &std::path::Path, s: &ballast::settlement::AccelerationSummary) -> Result<(), Failure> {
+    let rows: Vec<ballast::settlement::figures::ErrorRow> =
+        ballast::io::read_csv(&out.join(ballast::settlement::figures::ERRORS_FILE))?;
+    if let Some(last) = rows.last() {
+        println!(
+            "against the reference at cycle {}: settlement {:.4e} m vs {:.4e} m; error on what accrued after the {} initial cycles: {}",
+            last.cycle,
+            last.settlement_m,
+            last.reference_settlement_m,
+            s.initial_cycles,
+            last.accrued_error.map_or("-".to_string(), |e| format!("{:.2} %", 100.0 * e))
+        );
+    }
+    Ok(())
 }
 
 /// The line of an ensemble of settlement runs.
@@ -413,6 +436,9 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                 let s = saussine::settle_accelerated(&sample, &loading.loading()?, &acc, &out, &opts, &mut show)?;
                 bar.finish_and_clear();
                 super::print_acceleration(&s, &out);
+                if accelerate.reference.is_some() {
+                    print_errors(&out, &s)?;
+                }
             } else if replicas.count == 1 {
                 replicas.check()?;
                 saussine::settle(&sample, &loading.loading()?, &out, &opts, &Bars::single(quiet))?;

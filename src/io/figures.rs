@@ -107,6 +107,8 @@ pub struct Series {
     /// A thin grey line without markers, drawn before the others (one replica
     /// among many, behind their mean); it takes no colour of the palette.
     pub thin: bool,
+    /// Markers only, no line (e.g. the computed cycles of an accelerated run).
+    pub points_only: bool,
 }
 
 /// Title, axis labels (with their SI units) and scales of a [`line_chart`].

@@ -47,6 +47,7 @@ pub fn md_figures(dir: &Path) -> Result<RunFigures> {
         points: rows.iter().map(|r| (r.time_s, f(r))).collect(),
         band: vec![],
         thin: false,
+        points_only: false,
     };
     let chart = |stem: &str, title: &str, y_label: &str, log_y: bool, series: &[Series]| -> Result<_> {
         let axes =
@@ -81,6 +82,7 @@ pub fn md_figures(dir: &Path) -> Result<RunFigures> {
                 points: rows.iter().map(|r| (r.time_s, scale * r.walls.get(*k).copied().unwrap_or(f64::NAN))).collect(),
                 band: vec![],
                 thin: false,
+                points_only: false,
             })
             .collect()
     };
@@ -125,6 +127,7 @@ fn plate_cycles(dir: &Path, servos: &[(usize, String)], out: &mut RunFigures) ->
             points: rows.iter().map(|r| (r.cycle as f64, s * r.walls.get(k).copied().unwrap_or(f64::NAN))).collect(),
             band: vec![],
             thin: false,
+            points_only: false,
         })
         .collect();
     let axes = Axes {

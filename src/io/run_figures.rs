@@ -17,7 +17,8 @@
 //!   to the end of the run (Figs. 8–9), when that state is known (the positions
 //!   files of `output.cycles.positions`, or the run loop's own record);
 //!
-//! MD: see [`super::md_figures`].
+//! MD: see [`super::md_figures`]. An accelerated run (a folder with
+//! `settlement.csv`): see [`crate::settlement::figures`].
 //!
 //! A figure whose data the folder does not hold (no cycles, an older run
 //! without `contacts.csv`) is skipped and said so in [`RunFigures::skipped`].
@@ -61,6 +62,10 @@ impl RunFigures {
 /// the others; [`Error::Io`] naming the file if one cannot be read or a figure
 /// written.
 pub fn draw_run_figures(dir: &Path) -> Result<RunFigures> {
+    if dir.join(crate::settlement::driver::SETTLEMENT_FILE).is_file() {
+        // An accelerated run (either engine).
+        return crate::settlement::figures::draw(dir, None);
+    }
     let fin = read_final(dir)?;
     match fin.engine.as_str() {
         "nscd" => nscd_figures(dir, None),
@@ -109,12 +114,14 @@ pub fn settlement_series(rows: &[super::cycles::NscdCycleRow], label: &str, scal
             points: pick(|r| r.settlement_mean_m),
             band: vec![],
             thin: false,
+            points_only: false,
         },
         Series {
             label: format!("{label}{sep}at the load minimum"),
             points: pick(|r| r.settlement_at_min_load_m),
             band: vec![],
             thin: false,
+            points_only: false,
         },
     ]
 }
@@ -235,8 +242,15 @@ pub fn nscd_figures(dir: &Path, first_cycle_q: Option<&[[f64; 3]]>) -> Result<Ru
             points: pick(|r| r.mean_overlap_m),
             band: vec![],
             thin: false,
+            points_only: false,
         },
-        Series { label: "max".into(), points: pick(|r| r.max_overlap_m), band: vec![], thin: false },
+        Series {
+            label: "max".into(),
+            points: pick(|r| r.max_overlap_m),
+            band: vec![],
+            thin: false,
+            points_only: false,
+        },
     ];
     figures::line_chart(&stem, &axes, &curves)?;
     out.wrote(stem);

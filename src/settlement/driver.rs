@@ -28,7 +28,7 @@
 //! (`computed_cycles`, `total_cycles`, `gained` = total/computed), `final.json`,
 //! the record of the input (`scene.toml` or `initial_state.json`, `run.json`),
 //! and `checkpoint.json` every `checkpoint_every_s` (at a cycle's end) for
-//! `--resume`.
+//! `--resume`; with `figures`, the figures of [`super::figures`].
 
 use super::estimate::{chernoff_cycles, extrapolate, fit, Training};
 use super::law::{Linear, ResidualLaw, Shenton, ShentonOrigin};
@@ -268,6 +268,8 @@ pub struct AccelerationSummary {
     pub gained: f64,
     /// Jumps made.
     pub jumps: u64,
+    /// `k_i`: the initial cycles (errors are measured on what accrues after them).
+    pub initial_cycles: u64,
     /// Settlement at the last cycle (m).
     pub settlement_m: f64,
     /// Wall time (s).
@@ -506,6 +508,7 @@ impl<E: Engine> Accelerated<E> {
             total_cycles: st.cycle,
             gained: if st.computed > 0 { st.cycle as f64 / st.computed as f64 } else { 0.0 },
             jumps: st.jumps,
+            initial_cycles: self.spec.initial_cycles,
             settlement_m: st.last_settlement,
             wall_time_s: st.wall_time_s,
             steps: st.sys.steps_done(),
@@ -514,6 +517,9 @@ impl<E: Engine> Accelerated<E> {
         if end != "stopped" {
             st.sys.final_state().write(&out.join(files::FINAL))?;
             io::remove_stale(out, CHECKPOINT_FILE)?;
+            if opts.figures {
+                super::figures::draw(out, None)?;
+            }
         }
         if let Some(e) = failure {
             return Err(e);

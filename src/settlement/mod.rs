@@ -12,6 +12,7 @@
 //! - [`driver`]: the procedure of Fig. 10 over any [`crate::run::Engine`]
 //!   ([`Accelerated`]), its tables (`settlement.csv`, `jumps.csv`), summary and
 //!   checkpoints;
+//! - [`figures`]: an accelerated run's figures and its errors against a full run;
 //! - [`file`](mod@file): a scene file's `[settlement]` run through it (`ballast run`);
 //! - [`relax`]: the minimisation of an engine's relaxation functional (L-BFGS,
 //!   or the paper's steepest descent as a baseline) until the largest overlap
@@ -20,6 +21,7 @@
 
 pub mod driver;
 pub mod estimate;
+pub mod figures;
 pub mod file;
 pub mod law;
 pub mod relax;

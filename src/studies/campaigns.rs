@@ -209,6 +209,7 @@ fn settlement_figure(out: &Path, title: &str, settings: &[(String, Vec<&Outcome>
                     })
                     .collect(),
                 thin: false,
+                points_only: false,
             }
         })
         .collect();
@@ -798,6 +799,7 @@ pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisp
             points,
             band,
             thin: false,
+            points_only: false,
         });
     }
     io::table::write_all(&out.join("ensemble.csv"), &table)?;

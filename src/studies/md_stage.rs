@@ -150,5 +150,6 @@ pub(crate) fn curve(label: &str, x: &[f64], y: &[f64]) -> Series {
         points: x.iter().zip(y).filter(|(a, b)| a.is_finite() && b.is_finite()).map(|(a, b)| (*a, *b)).collect(),
         band: Vec::new(),
         thin: false,
+        points_only: false,
     }
 }

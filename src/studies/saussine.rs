@@ -293,11 +293,15 @@ pub struct Accelerate {
     /// Largest overlap left by the relaxation (m); `None`: 1 % of the smallest
     /// grain's inradius (the overlap the default NLGS setting keeps below).
     pub relax_tolerance: Option<f64>,
+    /// A full run of the same loaded sample (its folder) to measure the errors
+    /// against: `errors.csv` and its curve on the settlement figure.
+    pub reference: Option<PathBuf>,
 }
 
 /// §4 accelerated: [`settle`]'s loaded scene (written as `OUT/loaded.toml`, with
 /// its `[settlement]` table, the sleeper as the settlement body) run through
-/// [`crate::settlement::run_file`]: `settlement.csv`, `jumps.csv`, `summary.json`.
+/// [`crate::settlement::run_file`]: `settlement.csv`, `jumps.csv`, `summary.json`,
+/// the figures; with a reference, `errors.csv` ([`crate::settlement::figures`]).
 ///
 /// # Errors
 /// [`Error::Scene`] for an unreadable sample, an invalid loading or settings;
@@ -334,9 +338,21 @@ pub fn settle_accelerated(
     if !opts.resume {
         write_scene(&path, &scene, &format!("loaded from {}, accelerated", sample.display()))?;
     }
-    let run = RunOptions { checkpoint_every_s: opts.checkpoint_every_s, resume: opts.resume, ..RunOptions::default() };
-    crate::settlement::run_file(&path, out, &run, progress)?
-        .ok_or_else(|| Error::Scene(format!("{}: no [settlement] table", path.display())))
+    if let Some(r) = &accelerate.reference {
+        crate::settlement::figures::reference_settlement(r)?;
+    }
+    let run = RunOptions {
+        checkpoint_every_s: opts.checkpoint_every_s,
+        resume: opts.resume,
+        figures: true,
+        ..RunOptions::default()
+    };
+    let summary = crate::settlement::run_file(&path, out, &run, progress)?
+        .ok_or_else(|| Error::Scene(format!("{}: no [settlement] table", path.display())))?;
+    if let Some(r) = &accelerate.reference {
+        crate::settlement::figures::draw(out, Some(r))?;
+    }
+    Ok(summary)
 }
 
 /// Runs the loaded scene at `path` into `out` as [`settle`] does.
@@ -494,6 +510,7 @@ pub(crate) fn ensemble_figure(
             points: r.iter().map(|c| (c.cycle as f64, mm(c.settlement_at_min_load_m))).collect(),
             band: vec![],
             thin: true,
+            points_only: false,
         })
         .collect();
     if let Some(first) = curves.first_mut() {
@@ -508,6 +525,7 @@ pub(crate) fn ensemble_figure(
         points: rows.iter().map(|r| (r.cycle as f64, mm(r.settlement_mean_m))).collect(),
         band: band(|r| r.settlement_ci95_low_m, |r| r.settlement_ci95_high_m),
         thin: false,
+        points_only: false,
     });
     let s = rows.first().map_or(0, |r| r.seating_cycle);
     curves.push(Series {
@@ -515,6 +533,7 @@ pub(crate) fn ensemble_figure(
         points: rows.iter().filter_map(|r| Some((r.cycle as f64, mm(r.accrued_mean_m?)))).collect(),
         band: band(|r| r.accrued_ci95_low_m, |r| r.accrued_ci95_high_m),
         thin: false,
+        points_only: false,
     });
     let title = format!("{title}: {n} replicas (at the load minimum)");
     crate::io::figures::line_chart(stem, &super::axes(&title, "cycles", "settlement (mm)", false, false), &curves)

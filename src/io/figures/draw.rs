@@ -265,6 +265,10 @@ impl LineChart<'_> {
                 )))?;
             }
             let points: Vec<_> = s.points.iter().copied().filter(|p| self.ok(p.0, p.1)).collect();
+            if s.points_only {
+                chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, colour.filled())))?;
+                continue;
+            }
             let line = colour.stroke_width(3);
             chart.draw_series(std::iter::once(PathElement::new(points.clone(), line)))?;
             if points.len() <= 40 {
