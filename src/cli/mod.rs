@@ -42,7 +42,7 @@ enum Command {
     Deposit(deposit::DepositArgs),
     /// The numerical experiments of Saussine et al. (2006): sample, loaded scenes, studies.
     #[command(subcommand)]
-    Saussine(saussine::SaussineCommand),
+    Saussine(Box<saussine::SaussineCommand>),
     /// The MD sample of Karrech et al. (2007), Table 1: deposit, cyclic plate load.
     #[command(subcommand)]
     Karrech(md_tests::KarrechCommand),
@@ -82,7 +82,7 @@ pub fn main() -> ExitCode {
         Command::Run(args) => run::main(args),
         Command::Figures(args) => figures::main(args),
         Command::Deposit(args) => deposit::main(args),
-        Command::Saussine(cmd) => saussine::main(cmd),
+        Command::Saussine(cmd) => saussine::main(*cmd),
         Command::Karrech(cmd) => md_tests::karrech_main(cmd),
         Command::Luding(cmd) => md_tests::luding_main(cmd),
     };
