@@ -14,7 +14,12 @@
 //!   (`(h/k) Σ_p [u_p − u_{p−1}]` when the window has unit steps).
 //! - [`Shenton`] (the driver's default): Shenton's law with a constant,
 //!   `ũ(N) = c + a ln N + b N`, fitted by least squares on every point of the
-//!   window.
+//!   window, its logarithmic term kept only where it is significant (an F test
+//!   at 95 % of the nested line `c + b N`): far from `N = 1` the columns `1, ln N,
+//!   N` of a short window are nearly dependent, and a scatter of a micrometre
+//!   then makes `a` and `b` large and of opposite signs, whose curvature,
+//!   extrapolated, sent the reference sample's sleeper 0.3 m up in 69 cycles
+//!   (measured; the run then diverged).
 //! - [`ShentonOrigin`], eqs. (17)–(21) as printed: `ũ(N) = a ln N + b N`, fitted
 //!   on `p = 1 … k` by the closed forms (20)–(21).
 //!
@@ -37,6 +42,29 @@
 
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector};
+use statrs::distribution::{ContinuousCDF, FisherSnedecor};
+
+/// Least squares of `u` on `[1, ln N, N]` (`log`) or `[1, N]`, by singular
+/// values with the columns scaled to unit size (they are nearly dependent over a
+/// short window far from `N = 1`): `[c, a, b]` (`a = 0` without `log`); the
+/// minimum-norm solution for a design of lower rank.
+fn least_squares(n: &[f64], u: &[f64], log: bool) -> Coefficients {
+    let sl = n.iter().map(|t| t.ln().abs()).fold(1.0, f64::max);
+    let sn = n.iter().fold(1.0f64, |m, t| m.max(t.abs()));
+    let cols = if log { 3 } else { 2 };
+    let a = DMatrix::from_fn(n.len(), cols, |i, j| match (j, log) {
+        (0, _) => 1.0,
+        (1, true) => n[i].ln() / sl,
+        _ => n[i] / sn,
+    });
+    let b = DVector::from_column_slice(u);
+    let x = a.svd(true, true).solve(&b, 1e-12).unwrap_or_else(|_| DVector::zeros(cols));
+    if log {
+        [x[0], x[1] / sl, x[2] / sn]
+    } else {
+        [x[0], 0.0, x[1] / sn]
+    }
+}
 
 /// Coefficients of a fitted trend (their meaning is the law's).
 pub type Coefficients = [f64; 3];
@@ -100,21 +128,25 @@ impl ResidualLaw for Shenton {
     }
 
     /// `c = [c, a, b]`, the least-squares solution by singular values of the
-    /// design `[1, ln N_p, N_p]` (its columns are nearly dependent over a short
-    /// window far from `N = 1`); with fewer than 3 points, or a design of rank
-    /// below 3, the minimum-norm solution.
+    /// design `[1, ln N_p, N_p]` — unless the logarithmic term is not
+    /// significant: then `[c, 0, b]`, the least-squares line (module doc).
     fn fit(&self, n: &[f64], u: &[f64]) -> Coefficients {
-        // Columns scaled to unit size for the rank decision.
-        let scale =
-            [1.0, n.iter().map(|t| t.ln().abs()).fold(1.0, f64::max), n.iter().fold(1.0, |m, t| m.max(t.abs()))];
-        let a = DMatrix::from_fn(n.len(), 3, |i, j| match j {
-            0 => 1.0,
-            1 => n[i].ln() / scale[1],
-            _ => n[i] / scale[2],
-        });
-        let b = DVector::from_column_slice(u);
-        let x = a.svd(true, true).solve(&b, 1e-12).unwrap_or_else(|_| DVector::zeros(3));
-        [x[0], x[1] / scale[1], x[2] / scale[2]]
+        let log = least_squares(n, u, true);
+        let line = least_squares(n, u, false);
+        let m = n.len();
+        if m <= 3 {
+            return line;
+        }
+        let rss = |c: &Coefficients| n.iter().zip(u).map(|(&t, &v)| (v - self.trend(c, t)).powi(2)).sum::<f64>();
+        let (rss3, rss2) = (rss(&log), rss(&line));
+        // F test of the nested models at 95 %: the curvature must explain more of
+        // the scatter than one more free parameter would by chance.
+        let dof = (m - 3) as f64;
+        let f = if rss3 > 0.0 { (rss2 - rss3) / (rss3 / dof) } else { f64::INFINITY };
+        match FisherSnedecor::new(1.0, dof) {
+            Ok(fisher) if f < fisher.inverse_cdf(0.95) => line,
+            _ => log,
+        }
     }
 
     fn trend(&self, c: &Coefficients, n: f64) -> f64 {
