@@ -187,22 +187,3 @@ fn laws_are_named_and_bad_windows_refused() {
     t.cycles[1] = 3.0;
     assert!(fit(&Linear, &t, 3, 2).unwrap_err().to_string().contains("increasing"));
 }
-
-#[test]
-fn shenton_keeps_the_logarithm_only_where_it_is_significant() {
-    // Far from N = 1 (cycles 216-236) a line with a micrometre of scatter: the
-    // logarithmic term is not significant (F test at 95 %), the fit is the line,
-    // and 69 cycles on it continues the line's slope.
-    let scatter = |n: f64| 1e-6 * (2.3 * n).sin();
-    let t = window(1, 216, 20, |_, d, n| if d == 1 { -(3e-2 + 2e-7 * n + scatter(n)) } else { 0.0 });
-    let f = fit(&Shenton, &t, 3, 2).unwrap();
-    let c = f.coefficients[1];
-    assert_eq!(c[1], 0.0, "a = {}", c[1]);
-    let e = extrapolate(&Shenton, &t, &f, 69.0).q[1] - t.configurations.last().unwrap().q[1];
-    // The least-squares slope of the scattered line is the line's to ~1e-8 m per cycle.
-    assert!((e + 69.0 * 2e-7).abs() < 69.0 * 2e-8, "moved {e:e} m in 69 cycles");
-    // Near the seating (cycles 2-22) a logarithmic settlement with the same scatter keeps its logarithm.
-    let t = window(1, 2, 20, |_, d, n| if d == 1 { -(1e-3 * n.ln() + 2e-7 * n + scatter(n)) } else { 0.0 });
-    let c = fit(&Shenton, &t, 3, 2).unwrap().coefficients[1];
-    assert!((c[1] + 1e-3).abs() < 1e-5, "a = {}", c[1]);
-}

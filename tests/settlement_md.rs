@@ -58,12 +58,13 @@ fn accelerate(
         let jumps: Vec<ballast::settlement::JumpRow> = ballast::io::read_csv(&dir.join("jumps.csv")).unwrap();
         assert_eq!(jumps.len(), 2);
         for j in &jumps {
-            // Each jump's extrapolation overlaps the spheres by far more than a
-            // static contact does (~4e-5 m here), and the relaxation brings the
-            // largest overlap below the tolerance.
+            // The relaxation leaves the largest overlap below the tolerance.
             assert!(j.relax_converged && j.max_overlap_after_relax_m <= spec.relax.tolerance, "{j:?}");
-            assert!(j.max_overlap_before_relax_m > 2.0 * spec.relax.tolerance, "{j:?}");
         }
+        // The first extrapolation overlaps spheres by far more than a static
+        // contact does (~4e-5 m here), and the relaxation had work to do.
+        assert!(jumps[0].max_overlap_before_relax_m > 2.0 * spec.relax.tolerance, "{:?}", jumps[0]);
+        assert!(jumps[0].relax_iterations > 0);
     }
     let _ = std::fs::remove_dir_all(&dir);
     (rows, out.summary)
@@ -124,7 +125,7 @@ fn md_accelerated_run_follows_the_plate_settlement() {
     // The total, dominated by the seating (1.9 mm of the first 10 cycles), to 2 %
     // (measured 1.7 %).
     // What accrues after it (78 µm over 80 cycles, with cycle-to-cycle swings of
-    // ±10 µm of the plate at the load minimum) is predicted 45 % short (measured);
+    // ±10 µm of the plate at the load minimum) is predicted 32 % short (measured; 45 % with Shenton's law fitted on the last window only);
     // the full runs from starts moved by 1e-9 m agree to 1.5 %: this small, soft
     // sample does not follow Shenton's law between cycles 10 and 90 (BENCHMARKS.md).
     let total = rows[CYCLES as usize - 1].settlement_m;

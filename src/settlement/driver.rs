@@ -8,9 +8,12 @@
 //!   cycle's end, at the load phase every cycle starts with. The engine's clock
 //!   counts the computed time only: the loads are periodic, so skipping `h`
 //!   periods changes nothing the next step sees.
-//! - The window of a fit is the configuration at its start and at the end of
-//!   each of its `k` computed cycles (the first window starts after the initial
-//!   cycles), measured from the configuration at the start of the loading.
+//! - A window is the configuration at its start and at the end of each of its
+//!   `k` computed cycles (the first window starts after the initial cycles),
+//!   measured from the configuration at the start of the loading. The linear law
+//!   is fitted on the last window (eq. 16); Shenton's law on the whole history
+//!   since the initial cycles, the configurations the jumps landed on included
+//!   ([`super::law`] says why).
 //! - `h` is multiplied by `growth` after each jump (the paper suggests letting
 //!   it grow) and cut so that the run ends at the target. With `adaptive`, `k`
 //!   grows past `computed_cycles` until the Chernoff bound (eq. 15) of the
@@ -318,7 +321,12 @@ struct State<E> {
     jumps: u64,
     /// The next jump's length before rounding and cutting.
     h: f64,
+    /// Every point since the initial cycles: computed cycle ends and the
+    /// configurations the jumps landed on (a law with [`ResidualLaw::history`]
+    /// is fitted on all of it, the others on the last window).
     window: Training,
+    /// Computed cycles since the last jump (or since the initial cycles).
+    since_jump: u64,
     /// Settlement at each point of the window (m).
     window_settlement: Vec<f64>,
     /// The boundaries' coordinates at the start of the loading, and at each point of the window.
@@ -462,10 +470,13 @@ impl<E: Engine> Accelerated<E> {
                 st.window.push(st.cycle as f64, c);
                 st.window_settlement.push(s);
                 st.window_boundaries.push(b);
+                if st.cycle > self.spec.initial_cycles {
+                    st.since_jump += 1;
+                }
             }
             // A jump when the window is long enough and cycles are left.
             let left = self.target - st.cycle;
-            let k = st.window.k() as u64;
+            let k = st.since_jump;
             if left > 0 && k >= self.spec.computed_cycles {
                 match self.jump(&mut st, law, k, left, &mut rows, &mut jumps, wall0, &started) {
                     Ok(()) => {}
@@ -542,7 +553,15 @@ impl<E: Engine> Accelerated<E> {
         wall0: f64,
         started: &Instant,
     ) -> Result<()> {
-        let f = fit(law, &st.window, E::EXTRAPOLATED, E::DIM)?;
+        // The law's training data: the whole history, or the last window of k cycles.
+        let first = if law.history() { 0 } else { st.window.cycles.len() - 1 - k as usize };
+        let window = Training {
+            origin: st.window.origin.clone(),
+            cycles: st.window.cycles[first..].to_vec(),
+            configurations: st.window.configurations[first..].to_vec(),
+        };
+        let (settlements, boundary_points) = (&st.window_settlement[first..], &st.window_boundaries[first..]);
+        let f = fit(law, &window, E::EXTRAPOLATED, E::DIM)?;
         let chernoff = match &self.spec.adaptive {
             Some(a) => {
                 let need = chernoff_cycles(a.error, a.probability, f.xi_range)?;
@@ -555,9 +574,9 @@ impl<E: Engine> Accelerated<E> {
             None => None,
         };
         let h = (st.h.round() as u64).clamp(1, left);
-        let n = &st.window.cycles;
+        let n = &window.cycles;
         let n_last = *n.last().expect("a window has points");
-        let sc = law.fit(n, &st.window_settlement);
+        let sc = law.fit(n, settlements);
         for j in 1..h {
             rows.write(&SettlementRow {
                 cycle: st.cycle + j,
@@ -569,12 +588,12 @@ impl<E: Engine> Accelerated<E> {
                 wall_time_s: wall0 + started.elapsed().as_secs_f64(),
             })?;
         }
-        let target = extrapolate(law, &st.window, &f, h as f64);
+        let target = extrapolate(law, &window, &f, h as f64);
         // The boundaries (the MD plate) follow the same law.
         let mut series = vec![0.0; n.len()];
         let boundaries: Vec<f64> = (0..st.boundary_origin.len())
             .map(|j| {
-                series.iter_mut().zip(&st.window_boundaries).for_each(|(v, b)| *v = b[j] - st.boundary_origin[j]);
+                series.iter_mut().zip(boundary_points).for_each(|(v, b)| *v = b[j] - st.boundary_origin[j]);
                 let c = law.fit(n, &series);
                 st.boundary_origin[j] + law.extrapolate(&c, n_last, series[series.len() - 1], h as f64)
             })
@@ -620,10 +639,10 @@ impl<E: Engine> Accelerated<E> {
             relax_wall_time_s: relax_wall,
         })?;
         // The next window starts at the relaxed configuration.
-        st.window = Training::new(st.origin.clone());
         st.window.push(st.cycle as f64, c);
-        st.window_settlement = vec![s];
-        st.window_boundaries = vec![b];
+        st.window_settlement.push(s);
+        st.window_boundaries.push(b);
+        st.since_jump = 0;
         Ok(())
     }
 
@@ -674,6 +693,7 @@ impl<E: Engine> Accelerated<E> {
             computed: 0,
             jumps: 0,
             h: self.spec.extrapolated_cycles as f64,
+            since_jump: 0,
             window_settlement: if self.spec.initial_cycles == 0 { vec![0.0] } else { Vec::new() },
             window_boundaries: if self.spec.initial_cycles == 0 { vec![boundary_origin.clone()] } else { Vec::new() },
             boundary_origin,
