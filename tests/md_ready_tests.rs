@@ -89,6 +89,27 @@ fn karrech_deposit_then_cyclic_load() {
     }
     assert!(h.contains(&"plate_position_m".to_string()));
     assert!(load.join("residual_displacement.png").exists());
+
+    // Accelerated (Karrech et al. Fig. 10): 1 initial cycle, windows of 2, jumps of 2.
+    let acc = dir.join("accelerated");
+    ballast(
+        &["karrech", "load", "--from", dep.to_str().unwrap(), "--out", acc.to_str().unwrap(), "--cycles", "7"]
+            .iter()
+            .chain(&["--every", "500", "--quiet", "--accelerate", "1,2,2"])
+            .copied()
+            .collect::<Vec<_>>(),
+    );
+    let (h, rows) = csv(&acc.join("settlement.csv"));
+    assert_eq!(rows.len(), 7, "one row per cycle");
+    // Cycles 1, 2, 3 computed, 4-5 extrapolated, 6-7 computed.
+    let computed: Vec<f64> = rows.iter().map(|r| r[col(&h, "computed")]).collect();
+    assert_eq!(computed, [1.0, 1.0, 1.0, 0.0, 0.0, 1.0, 1.0]);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(acc.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["computed_cycles"], 5);
+    assert!(acc.join("settlement_accelerated.png").exists());
+    let scene = std::fs::read_to_string(acc.join("load.toml")).unwrap();
+    assert!(scene.contains("[settlement]") && scene.contains("settlement_body = \"plate\""));
 }
 
 #[test]

@@ -69,6 +69,10 @@ impl RunArgs {
     fn display(&self) -> Bars {
         Bars::single(self.quiet)
     }
+
+    fn quiet(&self) -> bool {
+        self.quiet
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -112,6 +116,8 @@ pub enum KarrechCommand {
         cycles: u32,
         #[command(flatten)]
         run: RunArgs,
+        #[command(flatten)]
+        accelerate: super::saussine::AccelerateArgs,
     },
 }
 
@@ -167,10 +173,22 @@ pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
             let o = karrech_test::deposit(&spec, &args.stage(), &args.display())?;
             print_written(&o, "figures fig3a–d");
         }
-        KarrechCommand::Load { from, mode, cycles, run: args } => {
+        KarrechCommand::Load { from, mode, cycles, run: args, accelerate } => {
             let loading = if mode == Mode::Full { Loading::FULL } else { Loading::PARTIAL };
-            let o = karrech_test::load(&from, loading, cycles, &args.stage(), &args.display())?;
-            print_written(&o, "figures residual_displacement, plate");
+            if let Some(acc) = accelerate.accelerate()? {
+                if acc.reference.is_some() {
+                    return Err(super::input("karrech load: --reference is not built yet for MD runs".into()));
+                }
+                let bar = super::cycle_bar(args.quiet());
+                let mut show = |p: &ballast::settlement::AccelerationProgress| super::show_cycles(&bar, p);
+                let stage = args.stage();
+                let s = karrech_test::load_accelerated(&from, loading, cycles, &acc, &stage, &mut show)?;
+                bar.finish_and_clear();
+                super::print_acceleration(&s, &stage.out);
+            } else {
+                let o = karrech_test::load(&from, loading, cycles, &args.stage(), &args.display())?;
+                print_written(&o, "figures residual_displacement, plate");
+            }
         }
     }
     Ok(())

@@ -331,7 +331,7 @@ pub(crate) struct AccelerateArgs {
 }
 
 impl AccelerateArgs {
-    fn accelerate(&self) -> Result<Option<saussine::Accelerate>, Failure> {
+    pub(crate) fn accelerate(&self) -> Result<Option<saussine::Accelerate>, Failure> {
         let Some(text) = &self.accelerate else { return Ok(None) };
         let parts: Vec<Option<u64>> = text.split(',').map(|p| p.trim().parse().ok()).collect();
         let cycles = match parts.as_slice() {

@@ -95,6 +95,43 @@ pub fn load(
     Ok(StageOutcome { run, written: load_figures(&stage.out)? })
 }
 
+/// [`load`] accelerated (Karrech et al. 2007, Fig. 10): the loading scene with
+/// its `[settlement]` table (the plate's displacement is the settlement; the
+/// relaxation tolerance by default 1 % of the smallest radius) written as
+/// `load.toml` and run through [`crate::settlement::run_file`]: `settlement.csv`,
+/// `jumps.csv`, `summary.json`, the figures.
+///
+/// # Errors
+/// As [`load`], and for invalid acceleration settings.
+pub fn load_accelerated(
+    from: &Path,
+    loading: Loading,
+    cycles: u32,
+    accelerate: &super::Accelerate,
+    stage: &Stage,
+    progress: &mut dyn FnMut(&crate::settlement::AccelerationProgress),
+) -> Result<crate::settlement::AccelerationSummary> {
+    crate::io::figures::require()?;
+    let sys = final_state(from)?;
+    let v = TestSpec::read(from)?;
+    let paper = Deposit::default();
+    let spec = KarrechSpec {
+        dt: v.dt.unwrap_or(paper.dt),
+        young: v.young.unwrap_or(paper.young),
+        ..KarrechSpec::table1(sys.particles.len(), v.seed)
+    };
+    let smallest = sys.particles.r.iter().copied().fold(f64::INFINITY, f64::min);
+    let (path, _) = stage.write_scene("load.toml", || {
+        let mut scene = karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, stage.every)?;
+        scene.settlement = Some(accelerate.section(Some("plate".into()), 0.01 * smallest));
+        scene.validate()?;
+        Ok(scene)
+    })?;
+    let opts = crate::run::RunOptions { figures: true, ..stage.run.clone() };
+    crate::settlement::run_file(&path, &stage.out, &opts, progress)?
+        .ok_or_else(|| Error::Scene(format!("{}: no [settlement] table", path.display())))
+}
+
 /// Karrech et al. Fig. 3 from a deposit's `series.csv`.
 fn deposit_figures(dir: &Path) -> Result<Vec<String>> {
     let c = columns(

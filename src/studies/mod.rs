@@ -96,3 +96,43 @@ pub(crate) fn write_file(path: &Path, text: &str) -> Result<()> {
 pub(crate) fn axes(title: &str, x: &str, y: &str, log_x: bool, log_y: bool) -> Axes {
     Axes { title: title.into(), x_label: x.into(), y_label: y.into(), log_x, log_y }
 }
+
+/// The settlement-acceleration procedure of `[settlement]` (Karrech et al.
+/// 2007, Fig. 10) on a ready-made cyclic test (`saussine settle`, `karrech
+/// load`): `k_i` cycles first, then windows of `k` computed and `h` extrapolated
+/// cycles.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Accelerate {
+    /// `k_i`, `k`, `h`.
+    pub cycles: [u64; 3],
+    /// `"shenton"` (default), `"linear"` or `"shenton_origin"`.
+    pub law: String,
+    /// Factor on `h` after each jump (≥ 1).
+    pub growth: f64,
+    /// Largest overlap left by the relaxation (m); `None`: 1 % of the smallest
+    /// grain's inradius (NSCD: the overlap the default NLGS setting keeps below)
+    /// or sphere radius (MD).
+    pub relax_tolerance: Option<f64>,
+    /// A full run of the same loaded sample (its folder) to measure the errors
+    /// against: `errors.csv` and its curve on the settlement figure.
+    pub reference: Option<PathBuf>,
+}
+
+impl Accelerate {
+    /// The `[settlement]` table of these settings, the settlement measured on
+    /// `body` (the sleeper, the plate), the relaxation tolerance defaulting to
+    /// `default_tolerance` (m).
+    pub fn section(&self, body: Option<String>, default_tolerance: f64) -> crate::scene::common::SettlementSection {
+        let [initial_cycles, computed_cycles, extrapolated_cycles] = self.cycles;
+        crate::scene::common::SettlementSection {
+            initial_cycles,
+            computed_cycles,
+            extrapolated_cycles,
+            growth: Some(self.growth),
+            law: Some(self.law.clone()),
+            relax_tolerance: self.relax_tolerance.unwrap_or(default_tolerance),
+            settlement_body: body,
+            ..Default::default()
+        }
+    }
+}

@@ -279,24 +279,7 @@ pub fn settle(
     run_settle(&path, out, &spec, opts, default_threads(), opts.resume, display, "settle")
 }
 
-/// The settlement-acceleration procedure of `[settlement]` (Karrech et al.
-/// 2007, Fig. 10) on a Saussine run: the loaded scene's cycles, `k_i` of them
-/// first, then windows of `k` computed and `h` extrapolated cycles.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Accelerate {
-    /// `k_i`, `k`, `h`.
-    pub cycles: [u64; 3],
-    /// `"shenton"` (default), `"linear"` or `"shenton_origin"`.
-    pub law: String,
-    /// Factor on `h` after each jump (≥ 1).
-    pub growth: f64,
-    /// Largest overlap left by the relaxation (m); `None`: 1 % of the smallest
-    /// grain's inradius (the overlap the default NLGS setting keeps below).
-    pub relax_tolerance: Option<f64>,
-    /// A full run of the same loaded sample (its folder) to measure the errors
-    /// against: `errors.csv` and its curve on the settlement figure.
-    pub reference: Option<PathBuf>,
-}
+pub use super::Accelerate;
 
 /// §4 accelerated: [`settle`]'s loaded scene (written as `OUT/loaded.toml`, with
 /// its `[settlement]` table, the sleeper as the settlement body) run through
@@ -321,17 +304,7 @@ pub fn settle_accelerated(
         .map(|i| sys.bodies.info[i].shape.inner_radius())
         .fold(f64::INFINITY, f64::min);
     let sleeper = scene.output.as_ref().and_then(|o| o.cycles.as_ref()).and_then(|c| c.body.clone());
-    let [initial_cycles, computed_cycles, extrapolated_cycles] = accelerate.cycles;
-    scene.settlement = Some(crate::scene::common::SettlementSection {
-        initial_cycles,
-        computed_cycles,
-        extrapolated_cycles,
-        growth: Some(accelerate.growth),
-        law: Some(accelerate.law.clone()),
-        relax_tolerance: accelerate.relax_tolerance.unwrap_or(0.01 * smallest),
-        settlement_body: sleeper,
-        ..Default::default()
-    });
+    scene.settlement = Some(accelerate.section(sleeper, 0.01 * smallest));
     scene.validate()?;
     io::create_output_dir(out)?;
     let path = out.join("loaded.toml");
