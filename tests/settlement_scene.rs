@@ -109,6 +109,7 @@ fn bad_settlement_tables_name_the_key() {
             "settlement.relax_method: unknown method 'newton'",
         ),
         ("law = \"shenton\"", "law = \"shenton\"\nspeed = 2", "unknown field `speed`"),
+        ("initial_cycles = 2", "initial_cycles = 0", "settlement.initial_cycles: Shenton's law needs at least 1"),
         (
             "cycles = { frequency = 20.0, body = \"sleeper\" }",
             "",

@@ -248,7 +248,7 @@ pub(crate) fn inline(entries: &[(&str, Option<String>)]) -> String {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SettlementSection {
-    /// `k_i`: cycles computed before the first fit, ≥ 0.
+    /// `k_i`: cycles computed before the first fit, ≥ 0 (≥ 1 with a Shenton law).
     pub initial_cycles: u64,
     /// `k`: computed cycles per fit, ≥ 2.
     pub computed_cycles: u64,

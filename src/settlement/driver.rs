@@ -153,6 +153,9 @@ impl Acceleration {
         if self.extrapolated_cycles == 0 {
             return bad("extrapolated_cycles: must be at least 1, got 0".into());
         }
+        if self.initial_cycles == 0 && self.law != Law::Linear {
+            return bad("initial_cycles: Shenton's law needs at least 1 (its ln N has no value at cycle 0)".into());
+        }
         if !(self.growth >= 1.0 && self.growth.is_finite()) {
             return bad(format!("growth: must be a finite factor of at least 1, got {}", self.growth));
         }
