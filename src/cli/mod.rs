@@ -220,11 +220,7 @@ pub(crate) fn print_acceleration(s: &ballast::settlement::AccelerationSummary, o
         s.gained,
         s.wall_time_s,
         s.jumps,
-        match s.law {
-            ballast::settlement::Law::Linear => "linear",
-            ballast::settlement::Law::Shenton => "shenton",
-            ballast::settlement::Law::ShentonOrigin => "shenton_origin",
-        },
+        s.law.name(),
         s.settlement_m,
         s.end,
         out.display()

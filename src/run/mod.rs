@@ -25,6 +25,7 @@ pub use runner::{
 };
 
 use crate::error::Result;
+use crate::scene::common::RecordedText;
 use crate::scene::{MdScene, Scene};
 use std::path::Path;
 
@@ -46,13 +47,7 @@ pub fn run_file(
     match crate::scene::engine_of_named(&text, &name)?.as_str() {
         "md" => {
             let mut scene = MdScene::from_toml_str_named(&text, &name)?;
-            let text = match opts.length {
-                Some(length) => {
-                    scene.simulation.set_length(length)?;
-                    scene.to_toml_string()?
-                }
-                None => text,
-            };
+            let text = scene.text_with_length(text, opts.length)?;
             let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts.clone() };
             let (system, plan) = (scene.build()?, scene.plan()?);
             let restart: Restart<crate::md::MdSystem> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
@@ -60,13 +55,7 @@ pub fn run_file(
         }
         _ => {
             let mut scene = Scene::from_toml_str_named(&text, &name)?;
-            let text = match opts.length {
-                Some(length) => {
-                    scene.simulation.set_length(length)?;
-                    scene.to_toml_string()?
-                }
-                None => text,
-            };
+            let text = scene.text_with_length(text, opts.length)?;
             let (system, plan) = (scene.build()?, scene.plan()?);
             let restart: Restart<crate::nscd::System> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
             Runner::from_scene(system, plan, scene_path, text, Some(restart)).run(out, opts, progress)

@@ -373,3 +373,26 @@ pub(crate) fn write_settlement(out: &mut String, s: Option<&SettlementSection>) 
     opt(out, "probability", s.probability, float);
     opt(out, "settlement_body", s.settlement_body.as_deref(), string);
 }
+
+/// A scene of either engine as a run records it (`scene.toml`): the text it was
+/// read from, or, when a run's length replaces its `[simulation] duration`, the
+/// scene written again with it.
+pub(crate) trait RecordedText {
+    /// `[simulation]`, to change.
+    fn simulation_mut(&mut self) -> &mut Simulation;
+
+    /// The scene as TOML text.
+    fn to_text(&self) -> Result<String>;
+
+    /// `text` (the file as read) if `length` is `None`; else the scene with its
+    /// duration replaced by `length` (the scene itself changed too), as text.
+    fn text_with_length(&mut self, text: String, length: Option<crate::run::RunLength>) -> Result<String> {
+        match length {
+            Some(length) => {
+                self.simulation_mut().set_length(length)?;
+                self.to_text()
+            }
+            None => Ok(text),
+        }
+    }
+}

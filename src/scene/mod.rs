@@ -78,6 +78,16 @@ pub fn engine_of_named(text: &str, name: &str) -> Result<String> {
     }
 }
 
+impl common::RecordedText for Scene {
+    fn simulation_mut(&mut self) -> &mut Simulation {
+        &mut self.simulation
+    }
+
+    fn to_text(&self) -> Result<String> {
+        self.to_toml_string()
+    }
+}
+
 impl Scene {
     /// Parses and fully validates a scene. Errors are [`Error::Scene`] with a
     /// single-line message; TOML syntax errors, unknown keys and missing fields

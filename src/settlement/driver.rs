@@ -41,8 +41,9 @@ use crate::error::{Error, Result};
 use crate::io::checkpoint::{check_origin, crc32, read_checked, write_checked, CHECKPOINT_FILE};
 use crate::io::table::TableWriter;
 use crate::io::{self, RunInfo};
-use crate::run::{files, Configuration, Engine, RunOptions};
+use crate::run::{files, Boundary, Configuration, Engine, RunOptions};
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -75,7 +76,13 @@ impl Law {
         }
     }
 
-    /// The law named `name` (`"linear"`, `"shenton"`); `field` names the option in the error.
+    /// The law's name in scenes and outputs.
+    pub fn name(self) -> &'static str {
+        self.estimator().name()
+    }
+
+    /// The law named `name` (`"linear"`, `"shenton"`, `"shenton_origin"`);
+    /// `field` names the option in the error.
     ///
     /// # Errors
     /// [`Error::Scene`] naming `field` and the accepted values.
@@ -452,8 +459,9 @@ impl<E: Engine> Accelerated<E> {
             st.cycle += 1;
             st.computed += 1;
             let c = st.sys.configuration();
-            let b = boundary_coordinates(&st.sys);
-            let s = st.settlement(&c, &b, vertical, self.spec.settlement_boundary);
+            let bounds = st.sys.boundaries();
+            let s = st.settlement(&c, &bounds, vertical, self.spec.settlement_boundary);
+            let b = coordinates(&bounds);
             st.last_settlement = s;
             rows.write(&SettlementRow {
                 cycle: st.cycle,
@@ -464,11 +472,8 @@ impl<E: Engine> Accelerated<E> {
                 max_overlap_after_relax_m: None,
                 wall_time_s: wall0 + started.elapsed().as_secs_f64(),
             })?;
-            if st.cycle == self.spec.initial_cycles {
-                st.window = Training::new(st.origin.clone());
-                st.window_settlement.clear();
-                st.window_boundaries.clear();
-            }
+            // The history starts at the end of the initial cycles (empty until then:
+            // `start`; with none, it holds cycle 0).
             if st.cycle >= self.spec.initial_cycles {
                 st.window.push(st.cycle as f64, c);
                 st.window_settlement.push(s);
@@ -558,10 +563,14 @@ impl<E: Engine> Accelerated<E> {
     ) -> Result<()> {
         // The law's training data: the whole history, or the last window of k cycles.
         let first = if law.history() { 0 } else { st.window.cycles.len() - 1 - k as usize };
-        let window = Training {
-            origin: st.window.origin.clone(),
-            cycles: st.window.cycles[first..].to_vec(),
-            configurations: st.window.configurations[first..].to_vec(),
+        let window = if first == 0 {
+            Cow::Borrowed(&st.window)
+        } else {
+            Cow::Owned(Training {
+                origin: st.window.origin.clone(),
+                cycles: st.window.cycles[first..].to_vec(),
+                configurations: st.window.configurations[first..].to_vec(),
+            })
         };
         let (settlements, boundary_points) = (&st.window_settlement[first..], &st.window_boundaries[first..]);
         let f = fit(law, &window, E::EXTRAPOLATED, E::DIM)?;
@@ -611,8 +620,9 @@ impl<E: Engine> Accelerated<E> {
         st.jumps += 1;
         st.h *= self.spec.growth;
         let c = st.sys.configuration();
-        let b = boundary_coordinates(&st.sys);
-        let s = st.settlement(&c, &b, E::DIM - 1, self.spec.settlement_boundary);
+        let bounds = st.sys.boundaries();
+        let s = st.settlement(&c, &bounds, E::DIM - 1, self.spec.settlement_boundary);
+        let b = coordinates(&bounds);
         st.last_settlement = s;
         rows.write(&SettlementRow {
             cycle: st.cycle,
@@ -675,7 +685,7 @@ impl<E: Engine> Accelerated<E> {
             })?),
             None => None,
         };
-        let boundary_origin = boundary_coordinates(&self.system);
+        let boundary_origin = coordinates(&self.system.boundaries());
         if let Some(j) = self.spec.settlement_boundary.filter(|&j| j >= boundary_origin.len()) {
             return Err(Error::Scene(format!(
                 "settlement.settlement_body: boundary {j} does not exist ({} boundaries)",
@@ -754,21 +764,18 @@ fn checkpoint<E: Engine>(out: &Path, st: &mut State<E>, rows: &mut TableWriter, 
     Ok(())
 }
 
-/// The coordinates of an engine's boundaries (m).
-fn boundary_coordinates<E: Engine>(sys: &E) -> Vec<f64> {
-    sys.boundaries().iter().map(|b| b.s).collect()
+/// The coordinates of boundaries (m).
+fn coordinates(boundaries: &[Boundary]) -> Vec<f64> {
+    boundaries.iter().map(|b| b.s).collect()
 }
 
 impl<E: Engine> State<E> {
     /// The settlement (m, positive downwards) of the configuration `c` with the
-    /// boundaries at `b`: of the settlement boundary if there is one, else of
+    /// boundaries `bounds`: of the settlement boundary if there is one, else of
     /// the settlement body or the mean over the mobile bodies.
-    fn settlement(&self, c: &Configuration, b: &[f64], vertical: usize, boundary: Option<usize>) -> f64 {
+    fn settlement(&self, c: &Configuration, bounds: &[Boundary], vertical: usize, boundary: Option<usize>) -> f64 {
         match boundary {
-            Some(j) => {
-                let down = self.sys.boundaries().get(j).map_or(0.0, |w| w.down);
-                (b[j] - self.boundary_origin[j]) * down
-            }
+            Some(j) => (bounds[j].s - self.boundary_origin[j]) * bounds[j].down,
             None => settlement(&self.origin, c, self.slot, vertical),
         }
     }

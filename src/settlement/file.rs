@@ -5,6 +5,7 @@
 use super::driver::{Accelerated, AccelerationProgress, AccelerationSummary};
 use crate::error::Result;
 use crate::run::RunOptions;
+use crate::scene::common::RecordedText;
 use crate::scene::{MdScene, Scene};
 use std::path::Path;
 
@@ -30,13 +31,7 @@ pub fn run_file(
             if scene.settlement.is_none() {
                 return Ok(None);
             }
-            let text = match opts.length {
-                Some(length) => {
-                    scene.simulation.set_length(length)?;
-                    scene.to_toml_string()?
-                }
-                None => text,
-            };
+            let text = scene.text_with_length(text, opts.length)?;
             let Some(plan) = scene.acceleration()? else { return Ok(None) };
             let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts.clone() };
             let run =
@@ -48,13 +43,7 @@ pub fn run_file(
             if scene.settlement.is_none() {
                 return Ok(None);
             }
-            let text = match opts.length {
-                Some(length) => {
-                    scene.simulation.set_length(length)?;
-                    scene.to_toml_string()?
-                }
-                None => text,
-            };
+            let text = scene.text_with_length(text, opts.length)?;
             let Some(plan) = scene.acceleration()? else { return Ok(None) };
             let run =
                 Accelerated::from_scene(scene.build()?, plan.spec, plan.frequency, plan.cycles, scene.seed(), text);

@@ -46,29 +46,23 @@
 //!
 //! More laws are added by implementing [`ResidualLaw`].
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use nalgebra::{DMatrix, DVector};
 
-/// Least squares of `u` on `[1, ln N, N]` (`log`) or `[1, N]`, by singular
-/// values with the columns scaled to unit size (they are nearly dependent over a
-/// short window far from `N = 1`): `[c, a, b]` (`a = 0` without `log`); the
-/// minimum-norm solution for a design of lower rank.
-fn least_squares(n: &[f64], u: &[f64], log: bool) -> Coefficients {
+/// Least squares of `u` on `[1, ln N, N]` by singular values, with the columns
+/// scaled to unit size (they are nearly dependent over a short window far from
+/// `N = 1`): `[c, a, b]`, the minimum-norm solution for a design of lower rank.
+fn least_squares(n: &[f64], u: &[f64]) -> Coefficients {
     let sl = n.iter().map(|t| t.ln().abs()).fold(1.0, f64::max);
     let sn = n.iter().fold(1.0f64, |m, t| m.max(t.abs()));
-    let cols = if log { 3 } else { 2 };
-    let a = DMatrix::from_fn(n.len(), cols, |i, j| match (j, log) {
-        (0, _) => 1.0,
-        (1, true) => n[i].ln() / sl,
+    let a = DMatrix::from_fn(n.len(), 3, |i, j| match j {
+        0 => 1.0,
+        1 => n[i].ln() / sl,
         _ => n[i] / sn,
     });
     let b = DVector::from_column_slice(u);
-    let x = a.svd(true, true).solve(&b, 1e-12).unwrap_or_else(|_| DVector::zeros(cols));
-    if log {
-        [x[0], x[1] / sl, x[2] / sn]
-    } else {
-        [x[0], 0.0, x[1] / sn]
-    }
+    let x = a.svd(true, true).solve(&b, 1e-12).unwrap_or_else(|_| DVector::zeros(3));
+    [x[0], x[1] / sl, x[2] / sn]
 }
 
 /// Coefficients of a fitted trend (their meaning is the law's).
@@ -141,7 +135,7 @@ impl ResidualLaw for Shenton {
     /// `c = [c, a, b]`, the least-squares solution by singular values of the
     /// design `[1, ln N_p, N_p]`.
     fn fit(&self, n: &[f64], u: &[f64]) -> Coefficients {
-        least_squares(n, u, true)
+        least_squares(n, u)
     }
 
     fn history(&self) -> bool {
@@ -205,18 +199,10 @@ impl ResidualLaw for ShentonOrigin {
 }
 
 /// The law named `name` in a scene or on the command line: `"linear"`,
-/// `"shenton"` or `"shenton_origin"`.
+/// `"shenton"` or `"shenton_origin"` ([`super::Law::from_name`]).
 ///
 /// # Errors
-/// [`Error::Scene`] naming the accepted values.
+/// [`crate::Error::Scene`] naming `settlement.law` and the accepted values.
 pub fn law_named(name: &str) -> Result<&'static dyn ResidualLaw> {
-    match name {
-        "linear" => Ok(&Linear),
-        "shenton" => Ok(&Shenton),
-        "shenton_origin" => Ok(&ShentonOrigin),
-        _ => Err(Error::Scene(format!(
-            "settlement.law: unknown law '{}' (expected \"linear\", \"shenton\" or \"shenton_origin\")",
-            crate::scene::clip(name)
-        ))),
-    }
+    super::Law::from_name(name, "settlement.law").map(super::Law::estimator)
 }

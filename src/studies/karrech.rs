@@ -81,14 +81,7 @@ pub fn load(
     display: &dyn RunDisplay,
 ) -> Result<StageOutcome> {
     crate::io::figures::require()?; // the stage ends with its figures
-    let sys = final_state(from)?;
-    let v = TestSpec::read(from)?;
-    let paper = Deposit::default();
-    let spec = KarrechSpec {
-        dt: v.dt.unwrap_or(paper.dt),
-        young: v.young.unwrap_or(paper.young),
-        ..KarrechSpec::table1(sys.particles.len(), v.seed)
-    };
+    let (sys, spec) = deposited(from)?;
     let (scene, _) = stage
         .write_scene("load.toml", || karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, stage.every))?;
     let run = stage.run(&scene, display, "karrech load")?;
@@ -112,14 +105,7 @@ pub fn load_accelerated(
     progress: &mut dyn FnMut(&crate::settlement::AccelerationProgress),
 ) -> Result<crate::settlement::AccelerationSummary> {
     crate::io::figures::require()?;
-    let sys = final_state(from)?;
-    let v = TestSpec::read(from)?;
-    let paper = Deposit::default();
-    let spec = KarrechSpec {
-        dt: v.dt.unwrap_or(paper.dt),
-        young: v.young.unwrap_or(paper.young),
-        ..KarrechSpec::table1(sys.particles.len(), v.seed)
-    };
+    let (sys, spec) = deposited(from)?;
     let smallest = sys.particles.r.iter().copied().fold(f64::INFINITY, f64::min);
     let (path, _) = stage.write_scene("load.toml", || {
         let mut scene = karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, stage.every)?;
@@ -130,6 +116,20 @@ pub fn load_accelerated(
     let opts = crate::run::RunOptions { figures: true, ..stage.run.clone() };
     crate::settlement::run_file(&path, &stage.out, &opts, progress)?
         .ok_or_else(|| Error::Scene(format!("{}: no [settlement] table", path.display())))
+}
+
+/// The sample deposited in `from` (its final state) and the specification it
+/// was made with (`spec.json`; the paper's time step and modulus where it has none).
+fn deposited(from: &Path) -> Result<(crate::md::MdSystem, KarrechSpec)> {
+    let sys = final_state(from)?;
+    let v = TestSpec::read(from)?;
+    let paper = Deposit::default();
+    let spec = KarrechSpec {
+        dt: v.dt.unwrap_or(paper.dt),
+        young: v.young.unwrap_or(paper.young),
+        ..KarrechSpec::table1(sys.particles.len(), v.seed)
+    };
+    Ok((sys, spec))
 }
 
 /// Karrech et al. Fig. 3 from a deposit's `series.csv`.

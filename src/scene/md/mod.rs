@@ -47,6 +47,16 @@ use crate::error::{Error, Result};
 use crate::scene::{parse, Scene, DEFAULT_OUTPUT_EVERY};
 use std::path::Path;
 
+impl crate::scene::common::RecordedText for MdScene {
+    fn simulation_mut(&mut self) -> &mut crate::scene::common::Simulation {
+        &mut self.simulation
+    }
+
+    fn to_text(&self) -> Result<String> {
+        self.to_toml_string()
+    }
+}
+
 impl MdScene {
     /// Parses and fully validates an MD scene. Errors are [`Error::Scene`] with a
     /// single-line message; TOML syntax errors, unknown keys and missing fields
