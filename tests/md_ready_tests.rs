@@ -110,6 +110,35 @@ fn karrech_deposit_then_cyclic_load() {
     assert!(acc.join("settlement_accelerated.png").exists());
     let scene = std::fs::read_to_string(acc.join("load.toml")).unwrap();
     assert!(scene.contains("[settlement]") && scene.contains("settlement_body = \"plate\""));
+
+    // Against a full run through the driver (a window longer than the run never
+    // jumps): errors.csv. Cycles 2 and 3 are computed by both from the same
+    // state, step for step, so their accrued error is exactly 0; after the jump
+    // it is |s_acc − s_full| / |s_full − s_full(1)|.
+    let full = dir.join("full");
+    let args = ["--from", dep.to_str().unwrap(), "--cycles", "7", "--every", "500", "--quiet"];
+    ballast(&[&["karrech", "load", "--out", full.to_str().unwrap()][..], &args, &["--accelerate", "1,8,1"]].concat());
+    let referenced = dir.join("referenced");
+    ballast(
+        &[
+            &["karrech", "load", "--out", referenced.to_str().unwrap()][..],
+            &args,
+            &["--accelerate", "1,2,2", "--reference", full.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    let (h, errors) = csv(&referenced.join("errors.csv"));
+    let (hf, full_rows) = csv(&full.join("settlement.csv"));
+    assert_eq!(errors.len(), 7);
+    let s = col(&h, "settlement_m");
+    let s_full = col(&h, "reference_settlement_m");
+    let e = col(&h, "accrued_error");
+    assert_eq!((errors[1][e], errors[2][e]), (0.0, 0.0));
+    let base = full_rows[0][col(&hf, "settlement_m")];
+    for row in &errors[3..] {
+        let want = (row[s] - row[s_full]).abs() / (row[s_full] - base).abs();
+        assert!((row[e] - want).abs() <= 1e-12 * want.max(1.0), "{row:?}");
+    }
 }
 
 #[test]

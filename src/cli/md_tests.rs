@@ -176,15 +176,15 @@ pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
         KarrechCommand::Load { from, mode, cycles, run: args, accelerate } => {
             let loading = if mode == Mode::Full { Loading::FULL } else { Loading::PARTIAL };
             if let Some(acc) = accelerate.accelerate()? {
-                if acc.reference.is_some() {
-                    return Err(super::input("karrech load: --reference is not built yet for MD runs".into()));
-                }
                 let bar = super::cycle_bar(args.quiet());
                 let mut show = |p: &ballast::settlement::AccelerationProgress| super::show_cycles(&bar, p);
                 let stage = args.stage();
                 let s = karrech_test::load_accelerated(&from, loading, cycles, &acc, &stage, &mut show)?;
                 bar.finish_and_clear();
                 super::print_acceleration(&s, &stage.out);
+                if acc.reference.is_some() {
+                    super::saussine::print_errors(&stage.out, &s)?;
+                }
             } else {
                 let o = karrech_test::load(&from, loading, cycles, &args.stage(), &args.display())?;
                 print_written(&o, "figures residual_displacement, plate");

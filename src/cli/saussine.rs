@@ -312,8 +312,9 @@ pub(crate) struct AccelerateArgs {
     /// settlement.csv (one row per cycle, computed or not), jumps.csv, summary.json.
     #[arg(long, value_name = "K_I,K,H")]
     accelerate: Option<String>,
-    /// Law of the residual displacement: shenton (c + a ln N + b N), linear (eq. 16),
-    /// shenton_origin (a ln N + b N, eqs. 20-21).
+    /// Law of the residual displacement: shenton (c + a ln N + b N on the whole
+    /// history, one c per window), shenton_decelerating (the same with a b ≥ 0),
+    /// linear (eq. 16), shenton_origin (a ln N + b N, eqs. 20-21).
     #[arg(long, default_value = "shenton", requires = "accelerate")]
     law: String,
     /// Factor on H after each jump.
@@ -349,17 +350,19 @@ impl AccelerateArgs {
 }
 
 /// The accrued-settlement error at the last cycle of an accelerated run compared with its reference.
-fn print_errors(out: &std::path::Path, s: &ballast::settlement::AccelerationSummary) -> Result<(), Failure> {
+pub(crate) fn print_errors(out: &std::path::Path, s: &ballast::settlement::AccelerationSummary) -> Result<(), Failure> {
     let rows: Vec<ballast::settlement::figures::ErrorRow> =
         ballast::io::read_csv(&out.join(ballast::settlement::figures::ERRORS_FILE))?;
     if let Some(last) = rows.last() {
         println!(
-            "against the reference at cycle {}: settlement {:.4e} m vs {:.4e} m; error on what accrued after the {} initial cycles: {}",
+            "against the reference at cycle {}: settlement {:.4e} m vs {:.4e} m; error on what accrued after the {} \
+             initial cycles: {}; configuration error E_r (eq. 22): {}",
             last.cycle,
             last.settlement_m,
             last.reference_settlement_m,
             s.initial_cycles,
-            last.accrued_error.map_or("-".to_string(), |e| format!("{:.2} %", 100.0 * e))
+            last.accrued_error.map_or("-".to_string(), |e| format!("{:.2} %", 100.0 * e)),
+            last.configuration_error.map_or("- (needs both runs' cycle positions)".to_string(), |e| format!("{e:.4}")),
         );
     }
     Ok(())

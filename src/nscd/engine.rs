@@ -20,7 +20,7 @@ impl Engine for System {
     const NAME: &'static str = "nscd";
     const DOF: usize = 3;
     const DIM: usize = 2;
-    const EXTRAPOLATED: usize = 3;
+    const EXTRAPOLATED: usize = 2;
     const ITERATIVE: bool = true;
     type Stats = StepStats;
     type Row = NscdSeriesRow;

@@ -115,8 +115,9 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// last of them is the vertical (y in 2D, z in 3D), along which gravity pulls.
     const DIM: usize;
     /// The leading coordinates of a body a settlement driver extrapolates: NSCD
-    /// 3 (x, y, θ: a polygon's rotation matters to its contacts), MD 3 (x, y, z:
-    /// a sphere's orientation does not).
+    /// 2 (x, y: a pentagon turns by rolling events, not by a creep a law can
+    /// extrapolate; docs/settlement-driver.md), MD 3 (x, y, z: a sphere's
+    /// orientation does not matter).
     const EXTRAPOLATED: usize;
     /// Whether a step solves an iterative problem (NSCD: NLGS sweeps), whose
     /// iterations and unconverged steps the summary reports.

@@ -19,6 +19,7 @@ mod runner;
 
 pub use engine::{Boundary, Configuration, Energies, Engine};
 pub use equilibrium::{Equilibrium, EquilibriumWatch, DEFAULT_EQUILIBRIUM_STEPS};
+pub(crate) use runner::body_names;
 pub use runner::{
     check_options, cores, default_threads, files, CyclePlan, Prior, Progress, Restart, RunLength, RunOptions,
     RunOutcome, RunPlan, Runner, Status,

@@ -457,7 +457,7 @@ impl<E: Engine> Runner<E> {
                 let table = TableWriter::create(&out.join(files::CYCLES), &sys.cycle_header())?;
                 let positions = if c.positions {
                     let reference = sys.configuration();
-                    let names = reference.bodies.iter().map(|&i| body_name(&sys, i)).collect::<Vec<_>>();
+                    let names = body_names(&sys, &reference.bodies);
                     Some(PositionsWriter::create(out, reference, &names)?)
                 } else {
                     None
@@ -552,7 +552,7 @@ impl<E: Engine> Runner<E> {
                         if reference != self.system.configuration() {
                             return Err(bad("the followed bodies or their start differ from the scene's".into()));
                         }
-                        let names: Vec<String> = reference.bodies.iter().map(|&i| body_name(&self.system, i)).collect();
+                        let names = body_names(&self.system, &reference.bodies);
                         Some(PositionsWriter::resume(out, reference, &names, done, cp.positions_crc32)?)
                     }
                     (false, None) if cp.positions_crc32 == 0 => None,
@@ -621,8 +621,10 @@ impl<E: Engine> Runner<E> {
     }
 }
 
-fn body_name<E: Engine>(sys: &E, i: usize) -> String {
-    sys.final_state().bodies.get(i).map(|b| b.name.clone()).unwrap_or_default()
+/// The names of `bodies` of `sys` (empty where a body has none).
+pub(crate) fn body_names<E: Engine>(sys: &E, bodies: &[usize]) -> Vec<String> {
+    let state = sys.final_state();
+    bodies.iter().map(|&i| state.bodies.get(i).map(|b| b.name.clone()).unwrap_or_default()).collect()
 }
 
 /// Checks the options; the message names the option.

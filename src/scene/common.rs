@@ -315,6 +315,7 @@ pub(crate) fn check_settlement(
         return err("settlement: needs the loading frequency of [output] cycles = { frequency = … }".into());
     };
     let mut spec = Acceleration::new(s.initial_cycles, s.computed_cycles, s.extrapolated_cycles, s.relax_tolerance);
+    spec.positions = c.positions;
     if let Some(g) = s.growth {
         spec.growth = g;
     }

@@ -8,12 +8,14 @@
 //!   cycle's end, at the load phase every cycle starts with. The engine's clock
 //!   counts the computed time only: the loads are periodic, so skipping `h`
 //!   periods changes nothing the next step sees.
-//! - A window is the configuration at its start and at the end of each of its
-//!   `k` computed cycles (the first window starts after the initial cycles),
-//!   measured from the configuration at the start of the loading. The linear law
-//!   is fitted on the last window (eq. 16); Shenton's law on the whole history
-//!   since the initial cycles, the configurations the jumps landed on included
-//!   ([`super::law`] says why).
+//! - A window is the configurations at the ends of its computed cycles,
+//!   measured from the configuration at the start of the loading: the first
+//!   starts at the end of the initial cycles and has `k + 1` points; after a
+//!   jump, the relaxed configuration the jump landed on is not a point (its
+//!   first cycle re-seats it) and the window has the `k` ends of its computed
+//!   cycles. The linear law is fitted on the last window (eq. 16); Shenton's law
+//!   on the whole history since the initial cycles, each window a segment with
+//!   its own constant ([`super::law`] says why).
 //! - `h` is multiplied by `growth` after each jump (the paper suggests letting
 //!   it grow) and cut so that the run ends at the target. With `adaptive`, `k`
 //!   grows past `computed_cycles` until the Chernoff bound (eq. 15) of the
@@ -30,18 +32,22 @@
 //! error range, the Chernoff cycles, the relaxation), `summary.json`
 //! (`computed_cycles`, `total_cycles`, `gained` = total/computed), `final.json`,
 //! the record of the input (`scene.toml` or `initial_state.json`, `run.json`),
-//! and `checkpoint.json` every `checkpoint_every_s` (at a cycle's end) for
+//! with `positions` (a scene's `[output] cycles = { positions = true }`) the
+//! positions of every mobile body at the end of every cycle
+//! ([`crate::io::positions`]: computed, on the fitted trend over extrapolated
+//! cycles, relaxed where a jump lands), and `checkpoint.json` every `checkpoint_every_s` (at a cycle's end) for
 //! `--resume`; with `figures`, the figures of [`super::figures`].
 
 use super::estimate::{chernoff_cycles, extrapolate, fit, Training};
-use super::law::{Linear, ResidualLaw, Shenton, ShentonOrigin};
+use super::law::{Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
 use super::relax::{RelaxReport, RelaxSettings};
 use crate::clock::cycles_at;
 use crate::error::{Error, Result};
 use crate::io::checkpoint::{check_origin, crc32, read_checked, write_checked, CHECKPOINT_FILE};
+use crate::io::positions::{PositionsWriter, BODIES_FILE, DISPLACEMENTS_FILE};
 use crate::io::table::TableWriter;
 use crate::io::{self, RunInfo};
-use crate::run::{files, Boundary, Configuration, Engine, RunOptions};
+use crate::run::{body_names, files, Boundary, Configuration, Engine, RunOptions};
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
@@ -62,6 +68,9 @@ pub enum Law {
     /// law for the procedure; [`super::law`] says why the constant).
     #[default]
     Shenton,
+    /// Shenton's law with a constant over `a b ≥ 0`: a window's fit that would
+    /// accelerate or turn back gives way to its better one-term law.
+    ShentonDecelerating,
     /// Shenton's law through the origin, eqs. (17)–(21) as printed.
     ShentonOrigin,
 }
@@ -72,6 +81,7 @@ impl Law {
         match self {
             Law::Linear => &Linear,
             Law::Shenton => &Shenton,
+            Law::ShentonDecelerating => &ShentonDecelerating,
             Law::ShentonOrigin => &ShentonOrigin,
         }
     }
@@ -81,7 +91,8 @@ impl Law {
         self.estimator().name()
     }
 
-    /// The law named `name` (`"linear"`, `"shenton"`, `"shenton_origin"`);
+    /// The law named `name` (`"linear"`, `"shenton"`, `"shenton_decelerating"`,
+    /// `"shenton_origin"`);
     /// `field` names the option in the error.
     ///
     /// # Errors
@@ -90,9 +101,11 @@ impl Law {
         match name {
             "linear" => Ok(Law::Linear),
             "shenton" => Ok(Law::Shenton),
+            "shenton_decelerating" => Ok(Law::ShentonDecelerating),
             "shenton_origin" => Ok(Law::ShentonOrigin),
             _ => Err(Error::Scene(format!(
-                "{field}: unknown law '{}' (expected \"linear\", \"shenton\" or \"shenton_origin\")",
+                "{field}: unknown law '{}' (expected \"linear\", \"shenton\", \"shenton_decelerating\" or \
+                 \"shenton_origin\")",
                 crate::scene::clip(name)
             ))),
         }
@@ -132,6 +145,12 @@ pub struct Acceleration {
     /// plate) whose downward displacement is the settlement, instead of a body.
     #[serde(default)]
     pub settlement_boundary: Option<usize>,
+    /// Write every mobile body's position at the end of each cycle
+    /// ([`crate::io::positions`]): the computed configuration, the fitted trend
+    /// over extrapolated cycles, the relaxed one where a jump lands. The
+    /// configuration error of `--reference` (eq. 22) needs them in both runs.
+    #[serde(default)]
+    pub positions: bool,
 }
 
 impl Acceleration {
@@ -148,6 +167,7 @@ impl Acceleration {
             adaptive: None,
             settlement_body: None,
             settlement_boundary: None,
+            positions: false,
         }
     }
 
@@ -331,9 +351,9 @@ struct State<E> {
     jumps: u64,
     /// The next jump's length before rounding and cutting.
     h: f64,
-    /// Every point since the initial cycles: computed cycle ends and the
-    /// configurations the jumps landed on (a law with [`ResidualLaw::history`]
-    /// is fitted on all of it, the others on the last window).
+    /// Every computed cycle end since the initial cycles, one segment per
+    /// window (a law with [`ResidualLaw::history`] is fitted on all of it, the
+    /// others on the last window).
     window: Training,
     /// Computed cycles since the last jump (or since the initial cycles).
     since_jump: u64,
@@ -346,6 +366,9 @@ struct State<E> {
     wall_time_s: f64,
     /// Bytes, rows and CRC-32 of `settlement.csv` and `jumps.csv`.
     tables: [(u64, u64, u32); 2],
+    /// CRC-32 of the cycle positions written (with `positions`).
+    #[serde(default)]
+    positions_crc32: u32,
 }
 
 /// Where the system of a run comes from (for its record and `--resume`).
@@ -421,7 +444,7 @@ impl<E: Engine> Accelerated<E> {
     ) -> Result<AccelerationOutcome<E>> {
         self.check()?;
         crate::run::check_options(opts)?;
-        let (mut st, mut rows, mut jumps) = if opts.resume { self.resume(out)? } else { self.start(out)? };
+        let (mut st, mut files) = if opts.resume { self.resume(out)? } else { self.start(out)? };
         st.sys.set_threads(opts.threads.max(1));
         let law = self.spec.law.estimator();
         let started = Instant::now();
@@ -463,7 +486,10 @@ impl<E: Engine> Accelerated<E> {
             let s = st.settlement(&c, &bounds, vertical, self.spec.settlement_boundary);
             let b = coordinates(&bounds);
             st.last_settlement = s;
-            rows.write(&SettlementRow {
+            if let Some(p) = files.positions.as_mut() {
+                p.append(&c)?;
+            }
+            files.rows.write(&SettlementRow {
                 cycle: st.cycle,
                 computed: 1,
                 settlement_m: s,
@@ -475,7 +501,12 @@ impl<E: Engine> Accelerated<E> {
             // The history starts at the end of the initial cycles (empty until then:
             // `start`; with none, it holds cycle 0).
             if st.cycle >= self.spec.initial_cycles {
-                st.window.push(st.cycle as f64, c);
+                // The first computed cycle after a jump starts a new segment.
+                if st.jumps > 0 && st.since_jump == 0 {
+                    st.window.push_segment(st.cycle as f64, c);
+                } else {
+                    st.window.push(st.cycle as f64, c);
+                }
                 st.window_settlement.push(s);
                 st.window_boundaries.push(b);
                 if st.cycle > self.spec.initial_cycles {
@@ -486,7 +517,7 @@ impl<E: Engine> Accelerated<E> {
             let left = self.target - st.cycle;
             let k = st.since_jump;
             if left > 0 && k >= self.spec.computed_cycles {
-                match self.jump(&mut st, law, k, left, &mut rows, &mut jumps, wall0, &started) {
+                match self.jump(&mut st, law, k, left, &mut files, wall0, &started) {
                     Ok(()) => {}
                     Err(e) => {
                         failure = Some(e);
@@ -508,7 +539,7 @@ impl<E: Engine> Accelerated<E> {
                         && checkpointed.elapsed().as_secs_f64() >= opts.checkpoint_every_s))
             {
                 st.wall_time_s = wall0 + started.elapsed().as_secs_f64();
-                checkpoint(out, &mut st, &mut rows, &mut jumps)?;
+                checkpoint(out, &mut st, &mut files)?;
                 checkpointed = Instant::now();
                 if stop {
                     end = "stopped";
@@ -517,8 +548,8 @@ impl<E: Engine> Accelerated<E> {
             }
         }
         st.wall_time_s = wall0 + started.elapsed().as_secs_f64();
-        rows.finish()?;
-        jumps.finish()?;
+        files.rows.finish()?;
+        files.jumps.finish()?;
         let summary = AccelerationSummary {
             engine: E::NAME.to_string(),
             end: end.to_string(),
@@ -556,22 +587,19 @@ impl<E: Engine> Accelerated<E> {
         law: &dyn ResidualLaw,
         k: u64,
         left: u64,
-        rows: &mut TableWriter,
-        jumps: &mut TableWriter,
+        files: &mut Files,
         wall0: f64,
         started: &Instant,
     ) -> Result<()> {
-        // The law's training data: the whole history, or the last window of k cycles.
-        let first = if law.history() { 0 } else { st.window.cycles.len() - 1 - k as usize };
-        let window = if first == 0 {
-            Cow::Borrowed(&st.window)
+        // The law's training data: the whole history, or the last window (the
+        // points since the last jump).
+        let first = if law.history() {
+            0
         } else {
-            Cow::Owned(Training {
-                origin: st.window.origin.clone(),
-                cycles: st.window.cycles[first..].to_vec(),
-                configurations: st.window.configurations[first..].to_vec(),
-            })
+            let last = st.window.segments.last().copied().unwrap_or(0);
+            st.window.segments.iter().position(|&s| s == last).unwrap_or(0)
         };
+        let window = if first == 0 { Cow::Borrowed(&st.window) } else { Cow::Owned(st.window.last_segment()) };
         let (settlements, boundary_points) = (&st.window_settlement[first..], &st.window_boundaries[first..]);
         let f = fit(law, &window, E::EXTRAPOLATED, E::DIM)?;
         let chernoff = match &self.spec.adaptive {
@@ -586,11 +614,14 @@ impl<E: Engine> Accelerated<E> {
             None => None,
         };
         let h = (st.h.round() as u64).clamp(1, left);
-        let n = &window.cycles;
+        let (n, segments) = (&window.cycles, &window.segments);
         let n_last = *n.last().expect("a window has points");
-        let sc = law.fit(n, settlements);
+        let sc = law.fit(n, settlements, segments);
         for j in 1..h {
-            rows.write(&SettlementRow {
+            if let Some(p) = files.positions.as_mut() {
+                p.append(&extrapolate(law, &window, &f, j as f64))?;
+            }
+            files.rows.write(&SettlementRow {
                 cycle: st.cycle + j,
                 computed: 0,
                 settlement_m: law.extrapolate(&sc, n_last, st.last_settlement, j as f64),
@@ -606,7 +637,7 @@ impl<E: Engine> Accelerated<E> {
         let boundaries: Vec<f64> = (0..st.boundary_origin.len())
             .map(|j| {
                 series.iter_mut().zip(boundary_points).for_each(|(v, b)| *v = b[j] - st.boundary_origin[j]);
-                let c = law.fit(n, &series);
+                let c = law.fit(n, &series, segments);
                 st.boundary_origin[j] + law.extrapolate(&c, n_last, series[series.len() - 1], h as f64)
             })
             .collect();
@@ -622,9 +653,11 @@ impl<E: Engine> Accelerated<E> {
         let c = st.sys.configuration();
         let bounds = st.sys.boundaries();
         let s = st.settlement(&c, &bounds, E::DIM - 1, self.spec.settlement_boundary);
-        let b = coordinates(&bounds);
         st.last_settlement = s;
-        rows.write(&SettlementRow {
+        if let Some(p) = files.positions.as_mut() {
+            p.append(&c)?;
+        }
+        files.rows.write(&SettlementRow {
             cycle: st.cycle,
             computed: 0,
             settlement_m: s,
@@ -633,7 +666,7 @@ impl<E: Engine> Accelerated<E> {
             max_overlap_after_relax_m: Some(report.max_overlap_after),
             wall_time_s: wall0 + started.elapsed().as_secs_f64(),
         })?;
-        jumps.write(&JumpRow {
+        files.jumps.write(&JumpRow {
             jump: st.jumps,
             from_cycle: from,
             to_cycle: st.cycle,
@@ -651,16 +684,14 @@ impl<E: Engine> Accelerated<E> {
             relax_largest_move: report.largest_move,
             relax_wall_time_s: relax_wall,
         })?;
-        // The next window starts at the relaxed configuration.
-        st.window.push(st.cycle as f64, c);
-        st.window_settlement.push(s);
-        st.window_boundaries.push(b);
+        // The next window starts at the end of the first computed cycle after
+        // the landing (the relaxed configuration re-seats in that cycle).
         st.since_jump = 0;
         Ok(())
     }
 
     /// A fresh run: the folder prepared, the records and table headers written.
-    fn start(&self, out: &Path) -> Result<(State<E>, TableWriter, TableWriter)> {
+    fn start(&self, out: &Path) -> Result<(State<E>, Files)> {
         io::create_output_dir(out)?;
         for stale in [CHECKPOINT_FILE, files::SUMMARY, files::FINAL, files::SCENE, files::INITIAL_STATE] {
             io::remove_stale(out, stale)?;
@@ -715,14 +746,24 @@ impl<E: Engine> Accelerated<E> {
             last_settlement: 0.0,
             wall_time_s: 0.0,
             tables: [(0, 0, 0); 2],
+            positions_crc32: 0,
         };
         let rows = TableWriter::create(&out.join(SETTLEMENT_FILE), SettlementRow::COLUMNS)?;
         let jumps = TableWriter::create(&out.join(JUMPS_FILE), JumpRow::COLUMNS)?;
-        Ok((st, rows, jumps))
+        for stale in [BODIES_FILE, DISPLACEMENTS_FILE] {
+            io::remove_stale(out, stale)?;
+        }
+        let positions = if self.spec.positions {
+            let names = body_names(&self.system, &st.origin.bodies);
+            Some(PositionsWriter::create(out, st.origin.clone(), &names)?)
+        } else {
+            None
+        };
+        Ok((st, Files { rows, jumps, positions }))
     }
 
     /// The run continued from `OUT/checkpoint.json`.
-    fn resume(&self, out: &Path) -> Result<(State<E>, TableWriter, TableWriter)> {
+    fn resume(&self, out: &Path) -> Result<(State<E>, Files)> {
         if !out.join(CHECKPOINT_FILE).is_file() {
             return Err(Error::Scene(format!(
                 "--resume: no {CHECKPOINT_FILE} in '{}' (nothing to continue: run without --resume)",
@@ -740,6 +781,7 @@ impl<E: Engine> Accelerated<E> {
         if st.computed > st.cycle
             || st.cycle > self.target
             || st.window.configurations.len() != st.window_settlement.len()
+            || st.window.segments.len() != st.window.cycles.len()
         {
             return Err(bad(format!("{} computed of {} cycles, target {}", st.computed, st.cycle, self.target)));
         }
@@ -752,14 +794,32 @@ impl<E: Engine> Accelerated<E> {
         }
         let rows = TableWriter::resume(&out.join(SETTLEMENT_FILE), rb, rr, rc)?;
         let jumps = TableWriter::resume(&out.join(JUMPS_FILE), jb, jr, jc)?;
+        let positions = if self.spec.positions {
+            let names = body_names(&self.system, &st.origin.bodies);
+            Some(PositionsWriter::resume(out, st.origin.clone(), &names, st.cycle, st.positions_crc32)?)
+        } else {
+            None
+        };
         io::remove_stale(out, files::SUMMARY)?;
-        Ok((st, rows, jumps))
+        Ok((st, Files { rows, jumps, positions }))
     }
 }
 
+/// The files a run appends to.
+struct Files {
+    rows: TableWriter,
+    jumps: TableWriter,
+    positions: Option<PositionsWriter>,
+}
+
 /// Writes the checkpoint of the run in progress.
-fn checkpoint<E: Engine>(out: &Path, st: &mut State<E>, rows: &mut TableWriter, jumps: &mut TableWriter) -> Result<()> {
+fn checkpoint<E: Engine>(out: &Path, st: &mut State<E>, files: &mut Files) -> Result<()> {
+    let (rows, jumps) = (&mut files.rows, &mut files.jumps);
     st.tables = [(rows.sync()?, rows.rows(), rows.crc32()), (jumps.sync()?, jumps.rows(), jumps.crc32())];
+    if let Some(p) = files.positions.as_mut() {
+        p.sync()?;
+        st.positions_crc32 = p.crc32();
+    }
     write_checked(out, st)?;
     Ok(())
 }

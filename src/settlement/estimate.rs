@@ -28,18 +28,33 @@ pub struct Training {
     pub cycles: Vec<f64>,
     /// The configuration at the end of each cycle `N_p`, same bodies as `origin`.
     pub configurations: Vec<Configuration>,
+    /// The run of computed cycles each point belongs to (non-decreasing, from
+    /// 0; a jump starts a new one: [`Training::cut`]).
+    #[serde(default)]
+    pub segments: Vec<u32>,
 }
 
 impl Training {
     /// An empty window measured from `origin`.
     pub fn new(origin: Configuration) -> Self {
-        Self { origin, cycles: Vec::new(), configurations: Vec::new() }
+        Self { origin, cycles: Vec::new(), configurations: Vec::new(), segments: Vec::new() }
     }
 
-    /// Adds the configuration at the end of cycle `n`.
+    /// Adds the configuration at the end of cycle `n`, in the last point's segment.
     pub fn push(&mut self, n: f64, c: Configuration) {
+        let segment = self.segments.last().copied().unwrap_or(0);
         self.cycles.push(n);
         self.configurations.push(c);
+        self.segments.push(segment);
+    }
+
+    /// Adds the configuration at the end of cycle `n` as the first point of a new
+    /// segment (the first computed cycle after a jump).
+    pub fn push_segment(&mut self, n: f64, c: Configuration) {
+        let segment = self.segments.last().map_or(0, |s| s + 1);
+        self.cycles.push(n);
+        self.configurations.push(c);
+        self.segments.push(segment);
     }
 
     /// Computed cycles of the window, `k` (points minus the start).
@@ -47,11 +62,16 @@ impl Training {
         self.cycles.len().saturating_sub(1)
     }
 
-    /// Keeps only the last point, as the start of the next window.
-    pub fn restart(&mut self) {
-        let keep = self.cycles.len().saturating_sub(1);
-        self.cycles.drain(..keep);
-        self.configurations.drain(..keep);
+    /// The points of the last segment (the last window), as a training set of its own.
+    pub fn last_segment(&self) -> Training {
+        let last = self.segments.last().copied().unwrap_or(0);
+        let first = self.segments.iter().position(|&s| s == last).unwrap_or(0);
+        Training {
+            origin: self.origin.clone(),
+            cycles: self.cycles[first..].to_vec(),
+            configurations: self.configurations[first..].to_vec(),
+            segments: self.segments[first..].to_vec(),
+        }
     }
 
     fn check(&self) -> Result<()> {
@@ -65,6 +85,9 @@ impl Training {
         let increasing = self.cycles.windows(2).all(|w| w[1] > w[0]) && self.cycles[0] >= 0.0;
         if !increasing {
             return bad(format!("cycle numbers not increasing from 0 or more: {:?}", self.cycles));
+        }
+        if self.segments.len() != self.cycles.len() || self.segments.windows(2).any(|w| w[1] < w[0]) {
+            return bad("one non-decreasing segment number per point is needed".into());
         }
         for c in &self.configurations {
             if c.bodies != self.origin.bodies || c.dof != self.origin.dof || c.q.len() != self.origin.q.len() {
@@ -93,7 +116,7 @@ pub struct Fit {
     /// The widest range `b − a` of one coordinate's error terms `ξ_p` over the
     /// window (m): the bound of eq. (15).
     pub xi_range: f64,
-    /// Computed cycles of the window, `k`.
+    /// Points of the window (its last segment) minus its start, `k`.
     pub k: usize,
 }
 
@@ -112,7 +135,13 @@ pub fn fit(law: &dyn ResidualLaw, training: &Training, fitted: usize, dim: usize
         )));
     }
     let n = &training.cycles;
-    let k = training.k();
+    let segments = &training.segments;
+    // The measures are over the last segment, the window.
+    let w0 = segments.iter().position(|&s| Some(&s) == segments.last()).unwrap_or(0);
+    let k = n.len() - 1 - w0;
+    if k == 0 {
+        return Err(Error::Scene("settlement fit: the last window has a single point".into()));
+    }
     let bodies = training.origin.len();
     let mut u = vec![0.0; n.len()];
     let mut coefficients = Vec::with_capacity(bodies * fitted);
@@ -123,11 +152,11 @@ pub fn fit(law: &dyn ResidualLaw, training: &Training, fitted: usize, dim: usize
             for (up, c) in u.iter_mut().zip(&training.configurations) {
                 *up = c.q[at] - training.origin.q[at];
             }
-            let c = law.fit(n, &u);
+            let c = law.fit(n, &u, segments);
             if d < dim {
-                let mut prev = law.trend(&c, n[0]);
+                let mut prev = law.trend(&c, n[w0]);
                 let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-                for (p, (&np, &up)) in n.iter().zip(&u).enumerate() {
+                for (p, (&np, &up)) in n.iter().zip(&u).enumerate().skip(w0).map(|(p, x)| (p - w0, x)) {
                     let t = law.trend(&c, np);
                     if p >= 1 {
                         sum_g += (t - prev) * (t - prev);

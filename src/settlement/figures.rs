@@ -9,12 +9,16 @@
 //!   `settlement.csv`, or its `cycles.csv` at the load minimum), `errors.csv`: per
 //!   cycle the two settlements and the error on what accrued after the initial
 //!   cycles, `|s_acc(N) − s_full(N)| / |s_full(N) − s_full(k_i)|` (the total is
-//!   dominated by the first cycles and would hide a wrong extrapolation), and the
-//!   relative error of the coordination number on the computed cycles.
+//!   dominated by the first cycles and would hide a wrong extrapolation), the
+//!   relative error of the coordination number on the computed cycles, and,
+//!   when both folders hold the cycle positions ([`crate::io::positions`]), the
+//!   relative configuration error `E_r` of eq. (22) over the translations.
 
 use super::driver::{JumpRow, SettlementRow, JUMPS_FILE, SETTLEMENT_FILE};
+use super::estimate::configuration_error;
 use crate::error::{Error, Result};
 use crate::io::figures::{self, Axes, Series};
+use crate::io::positions::{self, CyclePositions, DISPLACEMENTS_FILE};
 use crate::io::run_figures::RunFigures;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -37,6 +41,9 @@ pub struct ErrorRow {
     pub accrued_error: Option<f64>,
     /// `|z_acc − z_full| / z_full` on computed cycles with both coordinations.
     pub coordination_error: Option<f64>,
+    /// Eq. (22), `‖u_full − u_acc‖ / ‖u_full‖` over every mobile body's
+    /// translations since the start of the loading (both runs' cycle positions).
+    pub configuration_error: Option<f64>,
 }
 
 /// A reference run's settlement and coordination per cycle (index = cycle − 1).
@@ -48,7 +55,12 @@ pub fn reference_settlement(dir: &Path) -> Result<Vec<(f64, Option<f64>)>> {
     }
     let c = dir.join(crate::run::files::CYCLES);
     if c.is_file() {
-        let cols = crate::io::table::read_columns(&c, &["settlement_at_min_load_m"])?;
+        let cols = crate::io::table::read_columns(&c, &["settlement_at_min_load_m"]).map_err(|e| {
+            Error::Scene(format!(
+                "--reference: {e} (an MD run's cycles.csv has no settlement: give the folder of a full run made \
+                 through the driver, --accelerate K_I,N+1,1)"
+            ))
+        })?;
         return Ok(cols[0].iter().map(|&v| (v, None)).collect());
     }
     Err(Error::Scene(format!(
@@ -78,9 +90,34 @@ pub fn errors(rows: &[SettlementRow], reference: &[(f64, Option<f64>)], initial_
                     (Some(a), Some(b)) if b != 0.0 => Some((a - b).abs() / b.abs()),
                     _ => None,
                 },
+                configuration_error: None,
             })
         })
         .collect()
+}
+
+/// Eq. (22) per cycle of `rows` (their `configuration_error`) from the cycle
+/// positions of the accelerated run and of the reference, over the cycles both have.
+///
+/// # Errors
+/// [`Error::Scene`] if the two runs do not follow the same bodies from the same start.
+pub fn add_configuration_errors(rows: &mut [ErrorRow], run: &CyclePositions, reference: &CyclePositions) -> Result<()> {
+    let (a, b) = (&run.reference, &reference.reference);
+    let same = a.bodies == b.bodies && a.dof == b.dof && a.q.iter().zip(&b.q).all(|(x, y)| (x - y).abs() <= 1e-12);
+    if !same {
+        return Err(Error::Scene(
+            "--reference: the two runs' cycle positions do not follow the same bodies from the same start".into(),
+        ));
+    }
+    // The translations: 2 of (x, y, θ) in 2D, 3 of (x, y, z, r) in 3D.
+    let dim = if a.dof == 3 { 2 } else { 3 };
+    for r in rows {
+        let at = r.cycle as usize - 1;
+        if let (Some(c), Some(f)) = (run.cycles.get(at), reference.cycles.get(at)) {
+            r.configuration_error = Some(configuration_error(a, f, c, dim)).filter(|e| e.is_finite());
+        }
+    }
+    Ok(())
 }
 
 /// Draws the figures of the accelerated run in `dir` (module doc), with the full
@@ -123,7 +160,11 @@ pub fn draw(dir: &Path, reference: Option<&Path>) -> Result<RunFigures> {
             },
         );
         let summary: super::AccelerationSummary = crate::io::read_json(&dir.join(crate::run::files::SUMMARY))?;
-        crate::io::table::write_all(&dir.join(ERRORS_FILE), &errors(&rows, &full, summary.initial_cycles))?;
+        let mut table = errors(&rows, &full, summary.initial_cycles);
+        if dir.join(DISPLACEMENTS_FILE).is_file() && reference.join(DISPLACEMENTS_FILE).is_file() {
+            add_configuration_errors(&mut table, &positions::read(dir)?, &positions::read(reference)?)?;
+        }
+        crate::io::table::write_all(&dir.join(ERRORS_FILE), &table)?;
     }
     let stem = dir.join("settlement_accelerated");
     let axes = Axes {

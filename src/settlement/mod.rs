@@ -32,5 +32,5 @@ pub use driver::{
 };
 pub use estimate::{chernoff_cycles, chernoff_probability, configuration_error, extrapolate, fit, Fit, Training};
 pub use file::run_file;
-pub use law::{law_named, Linear, ResidualLaw, Shenton, ShentonOrigin};
+pub use law::{law_named, Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
 pub use relax::{minimise, Functional, Method, RelaxReport, RelaxSettings};

@@ -92,7 +92,8 @@ pub fn load(
 /// its `[settlement]` table (the plate's displacement is the settlement; the
 /// relaxation tolerance by default 1 % of the smallest radius) written as
 /// `load.toml` and run through [`crate::settlement::run_file`]: `settlement.csv`,
-/// `jumps.csv`, `summary.json`, the figures.
+/// `jumps.csv`, `summary.json`, the figures; with a reference (a full run through
+/// the driver), `errors.csv` ([`crate::settlement::figures`]).
 ///
 /// # Errors
 /// As [`load`], and for invalid acceleration settings.
@@ -113,9 +114,16 @@ pub fn load_accelerated(
         scene.validate()?;
         Ok(scene)
     })?;
+    if let Some(r) = &accelerate.reference {
+        crate::settlement::figures::reference_settlement(r)?;
+    }
     let opts = crate::run::RunOptions { figures: true, ..stage.run.clone() };
-    crate::settlement::run_file(&path, &stage.out, &opts, progress)?
-        .ok_or_else(|| Error::Scene(format!("{}: no [settlement] table", path.display())))
+    let summary = crate::settlement::run_file(&path, &stage.out, &opts, progress)?
+        .ok_or_else(|| Error::Scene(format!("{}: no [settlement] table", path.display())))?;
+    if let Some(r) = &accelerate.reference {
+        crate::settlement::figures::draw(&stage.out, Some(r))?;
+    }
+    Ok(summary)
 }
 
 /// The sample deposited in `from` (its final state) and the specification it

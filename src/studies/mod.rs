@@ -105,7 +105,7 @@ pub(crate) fn axes(title: &str, x: &str, y: &str, log_x: bool, log_y: bool) -> A
 pub struct Accelerate {
     /// `k_i`, `k`, `h`.
     pub cycles: [u64; 3],
-    /// `"shenton"` (default), `"linear"` or `"shenton_origin"`.
+    /// `"shenton"` (default), `"shenton_decelerating"`, `"linear"` or `"shenton_origin"`.
     pub law: String,
     /// Factor on `h` after each jump (≥ 1).
     pub growth: f64,
