@@ -282,7 +282,7 @@ fn figures(out: &Path, study: &[Row], floor: f64, floor_e_r: f64, ci_half: f64) 
             },
             x_label: x_label.into(),
             y_label: "error (%)".into(),
-            log_x: true,
+            log_x: !stem.ends_with("time"),
             ..Axes::default()
         };
         line_chart(&out.join(stem), &axes, &series)?;

@@ -29,7 +29,8 @@ pub struct Training {
     /// The configuration at the end of each cycle `N_p`, same bodies as `origin`.
     pub configurations: Vec<Configuration>,
     /// The run of computed cycles each point belongs to (non-decreasing, from
-    /// 0; a jump starts a new one: [`Training::cut`]).
+    /// 0; the first computed cycle after a jump starts a new one:
+    /// [`Training::push_segment`]).
     #[serde(default)]
     pub segments: Vec<u32>,
 }
