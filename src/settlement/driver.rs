@@ -593,12 +593,7 @@ impl<E: Engine> Accelerated<E> {
     ) -> Result<()> {
         // The law's training data: the whole history, or the last window (the
         // points since the last jump).
-        let first = if law.history() {
-            0
-        } else {
-            let last = st.window.segments.last().copied().unwrap_or(0);
-            st.window.segments.iter().position(|&s| s == last).unwrap_or(0)
-        };
+        let first = if law.history() { 0 } else { st.window.window_start() };
         let window = if first == 0 { Cow::Borrowed(&st.window) } else { Cow::Owned(st.window.last_segment()) };
         let (settlements, boundary_points) = (&st.window_settlement[first..], &st.window_boundaries[first..]);
         let f = fit(law, &window, E::EXTRAPOLATED, E::DIM)?;

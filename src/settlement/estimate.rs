@@ -63,10 +63,14 @@ impl Training {
         self.cycles.len().saturating_sub(1)
     }
 
+    /// The index of the first point of the last segment (the last window's start).
+    pub fn window_start(&self) -> usize {
+        self.segments.iter().position(|&s| Some(&s) == self.segments.last()).unwrap_or(0)
+    }
+
     /// The points of the last segment (the last window), as a training set of its own.
     pub fn last_segment(&self) -> Training {
-        let last = self.segments.last().copied().unwrap_or(0);
-        let first = self.segments.iter().position(|&s| s == last).unwrap_or(0);
+        let first = self.window_start();
         Training {
             origin: self.origin.clone(),
             cycles: self.cycles[first..].to_vec(),
@@ -138,7 +142,7 @@ pub fn fit(law: &dyn ResidualLaw, training: &Training, fitted: usize, dim: usize
     let n = &training.cycles;
     let segments = &training.segments;
     // The measures are over the last segment, the window.
-    let w0 = segments.iter().position(|&s| Some(&s) == segments.last()).unwrap_or(0);
+    let w0 = training.window_start();
     let k = n.len() - 1 - w0;
     if k == 0 {
         return Err(Error::Scene("settlement fit: the last window has a single point".into()));

@@ -114,16 +114,8 @@ pub fn load_accelerated(
         scene.validate()?;
         Ok(scene)
     })?;
-    if let Some(r) = &accelerate.reference {
-        crate::settlement::figures::reference_settlement(r)?;
-    }
     let opts = crate::run::RunOptions { figures: true, ..stage.run.clone() };
-    let summary = crate::settlement::run_file(&path, &stage.out, &opts, progress)?
-        .ok_or_else(|| Error::Scene(format!("{}: no [settlement] table", path.display())))?;
-    if let Some(r) = &accelerate.reference {
-        crate::settlement::figures::draw(&stage.out, Some(r))?;
-    }
-    Ok(summary)
+    accelerate.run_scene(&path, &stage.out, &opts, progress)
 }
 
 /// The sample deposited in `from` (its final state) and the specification it

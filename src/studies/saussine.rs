@@ -311,21 +311,13 @@ pub fn settle_accelerated(
     if !opts.resume {
         write_scene(&path, &scene, &format!("loaded from {}, accelerated", sample.display()))?;
     }
-    if let Some(r) = &accelerate.reference {
-        crate::settlement::figures::reference_settlement(r)?;
-    }
     let run = RunOptions {
         checkpoint_every_s: opts.checkpoint_every_s,
         resume: opts.resume,
         figures: true,
         ..RunOptions::default()
     };
-    let summary = crate::settlement::run_file(&path, out, &run, progress)?
-        .ok_or_else(|| Error::Scene(format!("{}: no [settlement] table", path.display())))?;
-    if let Some(r) = &accelerate.reference {
-        crate::settlement::figures::draw(out, Some(r))?;
-    }
-    Ok(summary)
+    accelerate.run_scene(&path, out, &run, progress)
 }
 
 /// Runs the loaded scene at `path` into `out` as [`settle`] does.
