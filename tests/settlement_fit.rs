@@ -6,8 +6,8 @@
 
 use ballast::run::Configuration;
 use ballast::settlement::{
-    chernoff_cycles, chernoff_probability, configuration_error, extrapolate, fit, law_named, Linear, ResidualLaw,
-    Shenton, ShentonDecelerating, ShentonOrigin, Training,
+    chernoff_cycles, chernoff_probability, configuration_error, extrapolate, extrapolate_within, fit, law_named,
+    Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin, Training,
 };
 
 /// A configuration of `bodies` bodies with 3 coordinates (x, y, θ) from `f(body, coordinate)`.
@@ -222,6 +222,35 @@ fn rotations_are_extrapolated_but_not_measured() {
     let f = fit(&Linear, &t, 2, 2).unwrap();
     let e = extrapolate(&Linear, &t, &f, 10.0);
     assert_eq!(e.q[2], t.configurations.last().unwrap().q[2]);
+}
+
+#[test]
+fn bounded_moves_keep_the_direction_and_hold_rattlers() {
+    // Linear drifts in (x, y) and θ: body 0 moves 15 × |(3, -4)| µm = 75 µm,
+    // inside its 1 mm bound; body 1 moves 15 × 5 mm = 75 mm, past its 1 mm
+    // bound; body 2 is held (bound 0).
+    let rate = |b: usize, d: usize| [3e-6, -4e-6, 1e-3][d] * if b == 1 { 1e3 } else { 1.0 };
+    let t = window(3, 10, 20, |b, d, n| rate(b, d) * n);
+    let f = fit(&Linear, &t, 3, 2).unwrap();
+    let free = extrapolate(&Linear, &t, &f, 15.0);
+    let (e, limited) = extrapolate_within(&Linear, &t, &f, 15.0, &[1e-3, 1e-3, 0.0]);
+    let last = t.configurations.last().unwrap();
+    assert_eq!(limited, 2, "body 1 (past its bound) and body 2 (held, with a trend)");
+    // Body 0: the law's move, bit for bit (scale 1).
+    assert_eq!(&e.q[0..3], &free.q[0..3]);
+    // Body 1: |move| = the bound, along the trend (−0.6, 0.8 of it in x, y
+    // within rounding of 0.3 m coordinates, ~1e-16 m), θ scaled by the same
+    // factor 1 mm / 75 mm (θ ~30 rad carries ~4e-15 rad of rounding).
+    let (dx, dy) = (e.q[3] - last.q[3], e.q[4] - last.q[4]);
+    assert!((dx.hypot(dy) - 1e-3).abs() < 1e-15, "move {}", dx.hypot(dy));
+    assert!((dx - 0.6e-3).abs() < 1e-15 && (dy + 0.8e-3).abs() < 1e-15, "direction ({dx}, {dy})");
+    let dtheta = e.q[5] - last.q[5];
+    assert!((dtheta - 15.0 / 75.0).abs() < 1e-12, "θ moved {dtheta}");
+    // Body 2: where it was.
+    assert_eq!(&e.q[6..9], &last.q[6..9]);
+    // Unbounded (an empty slice, or infinite bounds): the law's configuration.
+    assert_eq!(extrapolate_within(&Linear, &t, &f, 15.0, &[]), (free.clone(), 0));
+    assert_eq!(extrapolate_within(&Linear, &t, &f, 15.0, &[f64::INFINITY; 3]), (free, 0));
 }
 
 #[test]

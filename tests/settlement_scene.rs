@@ -108,6 +108,16 @@ fn bad_settlement_tables_name_the_key() {
             "law = \"shenton\"\nrelax_method = \"newton\"",
             "settlement.relax_method: unknown method 'newton'",
         ),
+        (
+            "law = \"shenton\"",
+            "law = \"shenton\"\nextrapolation_limit = 0.0",
+            "settlement.extrapolation_limit: must be a positive fraction",
+        ),
+        (
+            "law = \"shenton\"",
+            "law = \"shenton\"\nextrapolation_limit = nan",
+            "settlement.extrapolation_limit: must be a positive fraction",
+        ),
         ("law = \"shenton\"", "law = \"shenton\"\nspeed = 2", "unknown field `speed`"),
         ("initial_cycles = 2", "initial_cycles = 0", "settlement.initial_cycles: Shenton's law needs at least 1"),
         (
@@ -123,4 +133,26 @@ fn bad_settlement_tables_name_the_key() {
         assert!(e.contains(want), "{to}: {e}");
         assert!(!e.contains('\n'), "one line: {e}");
     }
+}
+
+#[test]
+fn a_body_that_leaves_the_domain_stops_the_run_naming_it() {
+    // A pentagon thrown sideways at 30 m/s above the walls: 1.5 m in the first
+    // cycle (0.05 s), far out of the domain (the start box of the mobile bodies,
+    // 0.24 m × 0.48 m, widened by 0.24 m on each side).
+    let text = std::fs::read_to_string(SCENE).unwrap().replace("duration = 1.5 ", "duration = 0.5 ")
+        + "\n[[body]]\nname = \"stray\"\nmaterial = \"grain\"\nregular = { sides = 5, radius = 0.03 }\n\
+           position = [0.0, 0.5]\nvelocity = [30.0, 0.0]\n";
+    let dir = out_dir("stray");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("stray.toml");
+    std::fs::write(&scene, text).unwrap();
+    let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
+    let e = run_file(&scene, &dir.join("out"), &opts, &mut |_| {}).unwrap_err().to_string();
+    assert!(e.contains("'stray'") && e.contains("computed cycle 1 carried it out of the domain"), "{e}");
+    assert!(!e.contains('\n'), "one line: {e}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["end"], "diverged");
+    let _ = std::fs::remove_dir_all(dir);
 }

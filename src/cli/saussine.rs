@@ -324,6 +324,10 @@ pub(crate) struct AccelerateArgs {
     /// smallest grain's inradius.
     #[arg(long, value_name = "M", requires = "accelerate")]
     relax_tolerance: Option<f64>,
+    /// The largest move a jump may give a body, as a fraction of its size (NSCD
+    /// inradius, MD radius); default 0.25; inf: no bound.
+    #[arg(long, value_name = "FRACTION", requires = "accelerate")]
+    extrapolation_limit: Option<f64>,
     /// A full run of the same sample and loading (its output folder, e.g. from
     /// `--accelerate K_I,N+1,1`, which never jumps, or a plain settle): errors.csv
     /// (settlement, accrued error after K_I, coordination) and its curve on the figure.
@@ -344,6 +348,7 @@ impl AccelerateArgs {
             law: self.law.clone(),
             growth: self.growth,
             relax_tolerance: self.relax_tolerance,
+            extrapolation_limit: self.extrapolation_limit,
             reference: self.reference.clone(),
         }))
     }

@@ -240,6 +240,25 @@ impl Engine for MdSystem {
         Configuration { dof: 6, bodies: bodies.to_vec(), q }
     }
 
+    fn body_sizes(&self, bodies: &[usize]) -> Vec<f64> {
+        bodies.iter().map(|&i| self.particles.r[i]).collect()
+    }
+
+    fn contact_counts(&self, bodies: &[usize]) -> Vec<usize> {
+        // The pair list is a half list: a pair (or a sphere and the image of
+        // another) is listed once, and counts for both spheres.
+        let mut count = vec![0usize; self.particles.len()];
+        for c in self.contact_forces() {
+            count[c.sphere] += 1;
+            match c.kind {
+                MdContactKind::Pair { j } => count[j] += 1,
+                MdContactKind::Image { origin, .. } => count[origin] += 1,
+                MdContactKind::Wall { .. } => {}
+            }
+        }
+        bodies.iter().map(|&i| count[i]).collect()
+    }
+
     fn set_configuration(&mut self, c: &Configuration) -> Result<()> {
         MdSystem::set_configuration(self, c)
     }

@@ -236,6 +236,15 @@ impl Engine for System {
         Configuration { dof: 3, bodies: bodies.to_vec(), q }
     }
 
+    fn body_sizes(&self, bodies: &[usize]) -> Vec<f64> {
+        bodies.iter().map(|&i| self.bodies.info[i].shape.inner_radius()).collect()
+    }
+
+    fn contact_counts(&self, bodies: &[usize]) -> Vec<usize> {
+        let count = super::measure::neighbour_counts(self, 0.0);
+        bodies.iter().map(|&i| count[i]).collect()
+    }
+
     fn set_configuration(&mut self, c: &Configuration) -> Result<()> {
         System::set_configuration(self, c)
     }

@@ -145,9 +145,18 @@ pub struct Coordination {
 /// Coordination number of `grains` over the last step: a neighbour counts when
 /// the pair's total normal force exceeds `threshold` (N).
 pub fn coordination(sys: &System, grains: &[usize], threshold: f64) -> Coordination {
+    let count = neighbour_counts(sys, threshold);
+    let active: Vec<usize> = grains.iter().map(|&i| count[i]).filter(|&k| k >= 2).collect();
+    let z = if active.is_empty() { 0.0 } else { active.iter().sum::<usize>() as f64 / active.len() as f64 };
+    let rattlers = if grains.is_empty() { 0.0 } else { 1.0 - active.len() as f64 / grains.len() as f64 };
+    Coordination { z, rattlers }
+}
+
+/// Per body (every body of the system, fixed ones too), the number of bodies it
+/// touches with a pair force `Σ r_n` (summed over the pair's contact points,
+/// mean force of the last step, N) above `threshold`.
+pub fn neighbour_counts(sys: &System, threshold: f64) -> Vec<usize> {
     let n = sys.bodies.len();
-    let mut is_grain = vec![false; n];
-    grains.iter().for_each(|&i| is_grain[i] = true);
     // Contacts come sorted by (candidate, antagonist, feature): sum each pair's points.
     let mut pairs: Vec<(usize, usize, f64)> = Vec::new();
     for c in sys.contact_forces() {
@@ -163,10 +172,7 @@ pub fn coordination(sys: &System, grains: &[usize], threshold: f64) -> Coordinat
             count[b] += 1;
         }
     }
-    let active: Vec<usize> = grains.iter().map(|&i| count[i]).filter(|&k| k >= 2).collect();
-    let z = if active.is_empty() { 0.0 } else { active.iter().sum::<usize>() as f64 / active.len() as f64 };
-    let rattlers = if grains.is_empty() { 0.0 } else { 1.0 - active.len() as f64 / grains.len() as f64 };
-    Coordination { z, rattlers }
+    count
 }
 
 #[cfg(test)]

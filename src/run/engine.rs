@@ -235,6 +235,16 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// The generalised positions of `bodies` ([`Configuration`]).
     fn configuration_of(&self, bodies: &[usize]) -> Configuration;
 
+    /// A length per body of `bodies` (m), the scale a settlement driver bounds
+    /// an extrapolated move by: NSCD the shape's inner radius (a polygon's
+    /// inradius), MD the sphere's radius.
+    fn body_sizes(&self, bodies: &[usize]) -> Vec<f64>;
+
+    /// Per body of `bodies`, the number of bodies and walls it touches with a
+    /// contact that carries a force in the last step (NSCD `r_n > 0` summed
+    /// over the pair's contact points; MD a touching pair, image or wall).
+    fn contact_counts(&self, bodies: &[usize]) -> Vec<usize>;
+
     /// The generalised positions of every mobile body.
     fn configuration(&self) -> Configuration {
         self.configuration_of(&self.mobile_bodies())

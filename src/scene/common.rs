@@ -278,6 +278,10 @@ pub struct SettlementSection {
     /// plate); default: the mean over the mobile bodies.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub settlement_body: Option<String>,
+    /// The largest move a jump may give a body, as a fraction of its size
+    /// (NSCD inradius, MD radius), > 0; default 0.25.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extrapolation_limit: Option<f64>,
 }
 
 /// A validated `[settlement]`: the procedure's settings, the loading frequency
@@ -324,6 +328,9 @@ pub(crate) fn check_settlement(
     }
     if let Some(n) = s.relax_max_iterations {
         spec.relax.max_iterations = n;
+    }
+    if let Some(f) = s.extrapolation_limit {
+        spec.extrapolation_limit = f;
     }
     spec.relax.method = match s.relax_method.as_deref() {
         None | Some("lbfgs") => Method::Lbfgs,
@@ -373,6 +380,7 @@ pub(crate) fn write_settlement(out: &mut String, s: Option<&SettlementSection>) 
     opt(out, "error", s.error, float);
     opt(out, "probability", s.probability, float);
     opt(out, "settlement_body", s.settlement_body.as_deref(), string);
+    opt(out, "extrapolation_limit", s.extrapolation_limit, float);
 }
 
 /// A scene of either engine as a run records it (`scene.toml`): the text it was

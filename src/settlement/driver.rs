@@ -38,7 +38,7 @@
 //! cycles, relaxed where a jump lands), and `checkpoint.json` every `checkpoint_every_s` (at a cycle's end) for
 //! `--resume`; with `figures`, the figures of [`super::figures`].
 
-use super::estimate::{chernoff_cycles, extrapolate, fit, Training};
+use super::estimate::{chernoff_cycles, extrapolate_within, fit, Training};
 use super::law::{Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
 use super::relax::{RelaxReport, RelaxSettings};
 use crate::clock::cycles_at;
@@ -151,9 +151,23 @@ pub struct Acceleration {
     /// configuration error of `--reference` (eq. 22) needs them in both runs.
     #[serde(default)]
     pub positions: bool,
+    /// The largest move a jump may give a body, as a fraction of its size
+    /// ([`Engine::body_sizes`]: NSCD the inradius, MD the radius), > 0; default
+    /// [`Acceleration::EXTRAPOLATION_LIMIT`]. A body whose trend goes further is
+    /// moved that far along it (module doc).
+    #[serde(default = "default_extrapolation_limit")]
+    pub extrapolation_limit: f64,
+}
+
+fn default_extrapolation_limit() -> f64 {
+    Acceleration::EXTRAPOLATION_LIMIT
 }
 
 impl Acceleration {
+    /// The default `extrapolation_limit`: a quarter of a body's size per jump
+    /// (docs/settlement-driver.md, "Bounded moves").
+    pub const EXTRAPOLATION_LIMIT: f64 = 0.25;
+
     /// `k_i`, `k`, `h` with the defaults: Shenton's law, no growth, relaxation to
     /// `relax_tolerance` (m) in at most 10 000 iterations.
     pub fn new(initial_cycles: u64, computed_cycles: u64, extrapolated_cycles: u64, relax_tolerance: f64) -> Self {
@@ -168,6 +182,7 @@ impl Acceleration {
             settlement_body: None,
             settlement_boundary: None,
             positions: false,
+            extrapolation_limit: Self::EXTRAPOLATION_LIMIT,
         }
     }
 
@@ -188,6 +203,12 @@ impl Acceleration {
         }
         if let Some(a) = &self.adaptive {
             chernoff_cycles(a.error, a.probability, 1.0)?;
+        }
+        if !(self.extrapolation_limit > 0.0) {
+            return bad(format!(
+                "extrapolation_limit: must be a positive fraction of a body's size (inf: no bound), got {}",
+                self.extrapolation_limit
+            ));
         }
         self.relax.check()
     }
@@ -260,6 +281,14 @@ pub struct JumpRow {
     pub relax_largest_move: f64,
     /// Wall time of the relaxation (s).
     pub relax_wall_time_s: f64,
+    /// Bodies held where they were (fewer than two force-carrying contacts at
+    /// the window's end: rattlers).
+    #[serde(default)]
+    pub held_bodies: u64,
+    /// Bodies moved less than their trend by `extrapolation_limit` (held ones
+    /// with a trend included).
+    #[serde(default)]
+    pub limited_bodies: u64,
 }
 
 impl JumpRow {
@@ -281,6 +310,8 @@ impl JumpRow {
         "max_overlap_after_relax_m",
         "relax_largest_move",
         "relax_wall_time_s",
+        "held_bodies",
+        "limited_bodies",
     ];
 }
 
@@ -482,6 +513,11 @@ impl<E: Engine> Accelerated<E> {
             st.cycle += 1;
             st.computed += 1;
             let c = st.sys.configuration();
+            if let Err(e) = check_domain(&st.sys, &st.origin, &c, || format!("computed cycle {}", st.cycle)) {
+                failure = Some(e);
+                end = "diverged";
+                break;
+            }
             let bounds = st.sys.boundaries();
             let s = st.settlement(&c, &bounds, vertical, self.spec.settlement_boundary);
             let b = coordinates(&bounds);
@@ -612,9 +648,17 @@ impl<E: Engine> Accelerated<E> {
         let (n, segments) = (&window.cycles, &window.segments);
         let n_last = *n.last().expect("a window has points");
         let sc = law.fit(n, settlements, segments);
+        // Bounded moves: a rattler is held, the others move at most
+        // `extrapolation_limit` of their size (module doc).
+        let bodies = &window.origin.bodies;
+        let contacts = st.sys.contact_counts(bodies);
+        let max_move: Vec<f64> = (st.sys.body_sizes(bodies).iter().zip(&contacts))
+            .map(|(size, &n)| if n < 2 { 0.0 } else { self.spec.extrapolation_limit * size })
+            .collect();
+        let held = contacts.iter().filter(|&&n| n < 2).count() as u64;
         for j in 1..h {
             if let Some(p) = files.positions.as_mut() {
-                p.append(&extrapolate(law, &window, &f, j as f64))?;
+                p.append(&extrapolate_within(law, &window, &f, j as f64, &max_move).0)?;
             }
             files.rows.write(&SettlementRow {
                 cycle: st.cycle + j,
@@ -626,7 +670,8 @@ impl<E: Engine> Accelerated<E> {
                 wall_time_s: wall0 + started.elapsed().as_secs_f64(),
             })?;
         }
-        let target = extrapolate(law, &window, &f, h as f64);
+        let (target, limited) = extrapolate_within(law, &window, &f, h as f64, &max_move);
+        check_domain(&st.sys, &st.origin, &target, || format!("the extrapolation of jump {}", st.jumps + 1))?;
         // The boundaries (the MD plate) follow the same law.
         let mut series = vec![0.0; n.len()];
         let boundaries: Vec<f64> = (0..st.boundary_origin.len())
@@ -641,6 +686,9 @@ impl<E: Engine> Accelerated<E> {
         let t0 = Instant::now();
         let report: RelaxReport = st.sys.relax(&self.spec.relax)?;
         let relax_wall = t0.elapsed().as_secs_f64();
+        check_domain(&st.sys, &st.origin, &st.sys.configuration(), || {
+            format!("the relaxation of jump {}", st.jumps + 1)
+        })?;
         let from = st.cycle;
         st.cycle += h;
         st.jumps += 1;
@@ -678,6 +726,8 @@ impl<E: Engine> Accelerated<E> {
             max_overlap_after_relax_m: report.max_overlap_after,
             relax_largest_move: report.largest_move,
             relax_wall_time_s: relax_wall,
+            held_bodies: held,
+            limited_bodies: limited as u64,
         })?;
         // The next window starts at the end of the first computed cycle after
         // the landing (the relaxed configuration re-seats in that cycle).
@@ -820,6 +870,48 @@ fn checkpoint<E: Engine>(out: &Path, st: &mut State<E>, files: &mut Files) -> Re
 }
 
 /// The coordinates of boundaries (m).
+/// Checks that every body of `c` is inside the run's domain: the box of the
+/// translations of `origin` (the start of the loading) widened on every side
+/// by half its largest side. A body outside has left the container (through a
+/// wall or over it): its motion is no settlement, and a fit would extrapolate
+/// its fall. `what` says what moved it there.
+fn check_domain<E: Engine>(
+    sys: &E,
+    origin: &Configuration,
+    c: &Configuration,
+    what: impl FnOnce() -> String,
+) -> Result<()> {
+    let dim = E::DIM;
+    let (mut lo, mut hi) = (vec![f64::INFINITY; dim], vec![f64::NEG_INFINITY; dim]);
+    for b in 0..origin.len() {
+        for (d, &x) in origin.body(b)[..dim].iter().enumerate() {
+            lo[d] = lo[d].min(x);
+            hi[d] = hi[d].max(x);
+        }
+    }
+    let margin = 0.5 * (0..dim).map(|d| hi[d] - lo[d]).fold(0.0, f64::max);
+    for b in 0..c.len() {
+        let x = &c.body(b)[..dim];
+        if (0..dim).all(|d| x[d] >= lo[d] - margin && x[d] <= hi[d] + margin) {
+            continue;
+        }
+        let body = c.bodies[b];
+        let box_ = (0..dim).map(|d| format!("[{:.4}, {:.4}]", lo[d] - margin, hi[d] + margin)).collect::<Vec<_>>();
+        return Err(Error::Diverged {
+            step: sys.steps_done(),
+            body,
+            name: body_names(sys, &[body]).pop().unwrap_or_default(),
+            what: format!(
+                "{} carried it out of the domain, to {x:?} (m); the domain is {} (m), the box of the bodies at the \
+                 start of the loading widened by half its size (docs/settlement-driver.md, \"Bounded moves\")",
+                what(),
+                box_.join(" × ")
+            ),
+        });
+    }
+    Ok(())
+}
+
 fn coordinates(boundaries: &[Boundary]) -> Vec<f64> {
     boundaries.iter().map(|b| b.s).collect()
 }

@@ -187,19 +187,51 @@ pub fn fit(law: &dyn ResidualLaw, training: &Training, fitted: usize, dim: usize
 /// each fitted coordinate moved by its trend's increment from `N_k` to `N_k + h`,
 /// the others (an MD sphere's orientation) kept at their last computed value.
 pub fn extrapolate(law: &dyn ResidualLaw, training: &Training, fit: &Fit, h: f64) -> Configuration {
+    extrapolate_within(law, training, fit, h, &[]).0
+}
+
+/// [`extrapolate`] with a bound on each body's move: the fitted increments of
+/// body `b` are scaled down together (the move keeps its direction) so that its
+/// translation from the last computed configuration is at most `max_move[b]`
+/// (m); `0` holds the body where it is. An empty `max_move` bounds nothing.
+/// Also returns how many bodies the bound moved less than their trend (held
+/// bodies with a trend included).
+///
+/// # Panics
+/// If `max_move` is neither empty nor one value per body.
+pub fn extrapolate_within(
+    law: &dyn ResidualLaw,
+    training: &Training,
+    fit: &Fit,
+    h: f64,
+    max_move: &[f64],
+) -> (Configuration, usize) {
     let last = training.configurations.last().expect("a fitted window has points");
     let n_last = *training.cycles.last().expect("a fitted window has points");
     let dof = last.dof;
+    assert!(max_move.is_empty() || max_move.len() == last.len(), "one bound per body");
     let mut out = last.clone();
+    let mut moved = vec![0.0; fit.fitted];
+    let mut limited = 0;
     for b in 0..last.len() {
-        for d in 0..fit.fitted {
+        for (d, m) in moved.iter_mut().enumerate().take(fit.fitted) {
             let at = b * dof + d;
             let u_last = last.q[at] - training.origin.q[at];
-            let u = law.extrapolate(&fit.coefficients[b * fit.fitted + d], n_last, u_last, h);
-            out.q[at] = training.origin.q[at] + u;
+            *m = law.extrapolate(&fit.coefficients[b * fit.fitted + d], n_last, u_last, h) - u_last;
+        }
+        let length = moved[..fit.dim].iter().map(|m| m * m).sum::<f64>().sqrt();
+        let scale = match max_move.get(b) {
+            Some(&bound) if length > bound => {
+                limited += 1;
+                bound / length
+            }
+            _ => 1.0,
+        };
+        for (d, m) in moved.iter().enumerate().take(fit.fitted) {
+            out.q[b * dof + d] += scale * m;
         }
     }
-    out
+    (out, limited)
 }
 
 /// Eq. (15), the Chernoff bound: the probability that the mean of `k` independent

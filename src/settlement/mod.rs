@@ -30,7 +30,9 @@ pub use driver::{
     Accelerated, Acceleration, AccelerationOutcome, AccelerationProgress, AccelerationSummary, Adaptive, JumpRow, Law,
     SettlementRow,
 };
-pub use estimate::{chernoff_cycles, chernoff_probability, configuration_error, extrapolate, fit, Fit, Training};
+pub use estimate::{
+    chernoff_cycles, chernoff_probability, configuration_error, extrapolate, extrapolate_within, fit, Fit, Training,
+};
 pub use file::run_file;
 pub use law::{law_named, Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
 pub use relax::{minimise, Functional, Method, RelaxReport, RelaxSettings};

@@ -113,6 +113,9 @@ pub struct Accelerate {
     /// grain's inradius (NSCD: the overlap the default NLGS setting keeps below)
     /// or sphere radius (MD).
     pub relax_tolerance: Option<f64>,
+    /// The largest move a jump may give a body, as a fraction of its size;
+    /// `None`: [`crate::settlement::Acceleration::EXTRAPOLATION_LIMIT`].
+    pub extrapolation_limit: Option<f64>,
     /// A full run of the same loaded sample (its folder) to measure the errors
     /// against: `errors.csv` and its curve on the settlement figure.
     pub reference: Option<PathBuf>,
@@ -132,6 +135,7 @@ impl Accelerate {
             law: Some(self.law.clone()),
             relax_tolerance: self.relax_tolerance.unwrap_or(default_tolerance),
             settlement_body: body,
+            extrapolation_limit: self.extrapolation_limit,
             ..Default::default()
         }
     }
