@@ -225,7 +225,7 @@ fn rotations_are_extrapolated_but_not_measured() {
 }
 
 #[test]
-fn bounded_moves_keep_the_direction_and_hold_rattlers() {
+fn bounded_moves_keep_the_direction_and_hold_a_body_at_bound_zero() {
     // Linear drifts in (x, y) and θ: body 0 moves 15 × |(3, -4)| µm = 75 µm,
     // inside its 1 mm bound; body 1 moves 15 × 5 mm = 75 mm, past its 1 mm
     // bound; body 2 is held (bound 0).

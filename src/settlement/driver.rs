@@ -281,8 +281,8 @@ pub struct JumpRow {
     pub relax_largest_move: f64,
     /// Wall time of the relaxation (s).
     pub relax_wall_time_s: f64,
-    /// Bodies held where they were (fewer than two force-carrying contacts at
-    /// the window's end: rattlers).
+    /// Bodies held where they were (no force-carrying contact at the window's
+    /// end: in flight, or loose in their cage).
     #[serde(default)]
     pub held_bodies: u64,
     /// Bodies moved less than their trend by `extrapolation_limit` (held ones
@@ -648,14 +648,14 @@ impl<E: Engine> Accelerated<E> {
         let (n, segments) = (&window.cycles, &window.segments);
         let n_last = *n.last().expect("a window has points");
         let sc = law.fit(n, settlements, segments);
-        // Bounded moves: a rattler is held, the others move at most
-        // `extrapolation_limit` of their size (module doc).
+        // Bounded moves: a body without a force-carrying contact is held, the
+        // others move at most `extrapolation_limit` of their size (docs/settlement-driver.md).
         let bodies = &window.origin.bodies;
         let contacts = st.sys.contact_counts(bodies);
         let max_move: Vec<f64> = (st.sys.body_sizes(bodies).iter().zip(&contacts))
-            .map(|(size, &n)| if n < 2 { 0.0 } else { self.spec.extrapolation_limit * size })
+            .map(|(size, &n)| if n == 0 { 0.0 } else { self.spec.extrapolation_limit * size })
             .collect();
-        let held = contacts.iter().filter(|&&n| n < 2).count() as u64;
+        let held = contacts.iter().filter(|&&n| n == 0).count() as u64;
         for j in 1..h {
             if let Some(p) = files.positions.as_mut() {
                 p.append(&extrapolate_within(law, &window, &f, j as f64, &max_move).0)?;
