@@ -325,7 +325,7 @@ pub(crate) struct AccelerateArgs {
     #[arg(long, value_name = "M", requires = "accelerate")]
     relax_tolerance: Option<f64>,
     /// The largest move a jump may give a body, as a fraction of its size (NSCD
-    /// inradius, MD radius); default 0.25; inf: no bound.
+    /// equal-area radius, MD radius); default 0.25; inf: no bound.
     #[arg(long, value_name = "FRACTION", requires = "accelerate")]
     extrapolation_limit: Option<f64>,
     /// A full run of the same sample and loading (its output folder, e.g. from

@@ -236,8 +236,8 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     fn configuration_of(&self, bodies: &[usize]) -> Configuration;
 
     /// A length per body of `bodies` (m), the scale a settlement driver bounds
-    /// an extrapolated move by: NSCD the shape's inner radius (a polygon's
-    /// inradius), MD the sphere's radius.
+    /// an extrapolated move by: NSCD the radius of the disc of the shape's area
+    /// (`√(A/π)`), MD the sphere's radius.
     fn body_sizes(&self, bodies: &[usize]) -> Vec<f64>;
 
     /// Per body of `bodies`, the number of bodies and walls it touches with a

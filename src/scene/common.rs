@@ -279,7 +279,7 @@ pub struct SettlementSection {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub settlement_body: Option<String>,
     /// The largest move a jump may give a body, as a fraction of its size
-    /// (NSCD inradius, MD radius), > 0; default 0.25.
+    /// (NSCD the equal-area radius √(A/π), MD the radius), > 0; default 0.25.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub extrapolation_limit: Option<f64>,
 }

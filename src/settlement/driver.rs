@@ -152,7 +152,7 @@ pub struct Acceleration {
     #[serde(default)]
     pub positions: bool,
     /// The largest move a jump may give a body, as a fraction of its size
-    /// ([`Engine::body_sizes`]: NSCD the inradius, MD the radius), > 0; default
+    /// ([`Engine::body_sizes`]: NSCD √(A/π), MD the radius), > 0; default
     /// [`Acceleration::EXTRAPOLATION_LIMIT`]. A body whose trend goes further is
     /// moved that far along it (module doc).
     #[serde(default = "default_extrapolation_limit")]
