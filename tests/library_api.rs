@@ -1,7 +1,8 @@
 //! The library's constructors for systems built in code (issue 12, item 4): NSCD
 //! bodies with their mass and inertia computed and their centroid returned, the
 //! same system as the equivalent scene bit for bit, MD spheres, a missing MD
-//! contact law refused by `MdSystem::new`, and `GeometryError` converted by `?`.
+//! contact law refused by `MdSystem::new`, `GeometryError` converted by `?`, and
+//! the engines' contact counts and body sizes (the settlement driver's bounds).
 
 use ballast::geometry::{ConvexPolygon, GeometryError, Shape};
 use ballast::md::{
@@ -437,4 +438,48 @@ fn md_sphere_on_plane_rests_at_the_hertz_overlap() {
         sys.particles.kinetic_energy()
     );
     assert!((overlap - expected).abs() < 1e-3 * expected);
+}
+
+#[test]
+fn engines_count_the_force_carrying_contacts_and_size_the_bodies() {
+    use ballast::run::Engine;
+    // NSCD: two 10 cm blocks stacked on a floor, at rest after 100 steps: the
+    // lower one touches the floor and the upper one (2), the upper one the
+    // lower one (1). Size: the radius of the disc of the same area, √(0.01/π).
+    let mut sys = System::new(NscdParams { dt: 1e-3, ..NscdParams::default() }, 1);
+    sys.set_law(0, 0, ballast::nscd::ContactLaw { friction: 0.5, ..Default::default() });
+    let (ground, q) =
+        BodyInfo::polygon("floor", &[[-0.5, -0.1], [0.5, -0.1], [0.5, 0.0], [-0.5, 0.0]], 0, 2700.0, 1.0).unwrap();
+    sys.bodies.push(ground.into_fixed(), q, [0.0; 3]);
+    for (name, y) in [("lower", 0.0), ("upper", 0.1)] {
+        let (block, q) =
+            BodyInfo::polygon(name, &[[0.0, y], [0.1, y], [0.1, y + 0.1], [0.0, y + 0.1]], 0, 2700.0, 1.0).unwrap();
+        sys.bodies.push(block, q, [0.0; 3]);
+    }
+    sys.params.alert_distance = sys.bodies.default_alert_distance();
+    for _ in 0..100 {
+        sys.step().unwrap();
+    }
+    let mobile = sys.mobile_bodies();
+    assert_eq!(mobile, vec![1, 2]);
+    assert_eq!(sys.contact_counts(&mobile), vec![2, 1]);
+    for size in sys.body_sizes(&mobile) {
+        assert!(close(size, (0.01 / PI).sqrt()), "{size}");
+    }
+
+    // MD: two spheres stacked on a plane (the same, by the half pair list).
+    let r = 0.01;
+    let mut spheres = Particles::default();
+    spheres.add_sphere(0, ROCK.density, r, V3::new(0.0, 0.0, r), V3::zeros()).unwrap();
+    spheres.add_sphere(0, ROCK.density, 0.5 * r, V3::new(0.0, 0.0, 2.5 * r), V3::zeros()).unwrap();
+    let mut laws = LawTable::named(&["rock"]);
+    laws.set(0, 0, PairLaw::hertz(&ROCK, &ROCK, 0.5, 0.5, 0.5));
+    let settings = MdSettings { dt: 1e-5, skin: 0.1 * r, ..MdSettings::default() };
+    let mut sys = MdSystem::new(settings, spheres, vec![floor(0)], laws, Ghosts::new(Vec::new())).unwrap();
+    for _ in 0..2000 {
+        sys.step().unwrap();
+    }
+    let mobile = sys.mobile_bodies();
+    assert_eq!(sys.contact_counts(&mobile), vec![2, 1]);
+    assert_eq!(sys.body_sizes(&mobile), vec![r, 0.5 * r]);
 }

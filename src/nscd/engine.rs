@@ -239,7 +239,10 @@ impl Engine for System {
     fn body_sizes(&self, bodies: &[usize]) -> Vec<f64> {
         // The radius of the disc of the same area: a compound (the sleeper and
         // its feet) is as large as its area, not as its smallest part.
-        bodies.iter().map(|&i| (self.bodies.info[i].shape.area_and_polar_moment().0 / std::f64::consts::PI).sqrt()).collect()
+        bodies
+            .iter()
+            .map(|&i| (self.bodies.info[i].shape.area_and_polar_moment().0 / std::f64::consts::PI).sqrt())
+            .collect()
     }
 
     fn contact_counts(&self, bodies: &[usize]) -> Vec<usize> {
