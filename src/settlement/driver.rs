@@ -204,7 +204,7 @@ impl Acceleration {
         if let Some(a) = &self.adaptive {
             chernoff_cycles(a.error, a.probability, 1.0)?;
         }
-        if !(self.extrapolation_limit > 0.0) {
+        if self.extrapolation_limit.is_nan() || self.extrapolation_limit <= 0.0 {
             return bad(format!(
                 "extrapolation_limit: must be a positive fraction of a body's size (inf: no bound), got {}",
                 self.extrapolation_limit
