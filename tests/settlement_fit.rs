@@ -7,7 +7,7 @@
 use ballast::run::Configuration;
 use ballast::settlement::{
     chernoff_cycles, chernoff_probability, configuration_error, extrapolate, extrapolate_within, fit, law_named,
-    Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin, Training,
+    trend_moves, Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin, Training,
 };
 
 /// A configuration of `bodies` bodies with 3 coordinates (x, y, θ) from `f(body, coordinate)`.
@@ -248,6 +248,12 @@ fn bounded_moves_keep_the_direction_and_hold_a_body_at_bound_zero() {
     assert!((dtheta - 15.0 / 75.0).abs() < 1e-12, "θ moved {dtheta}");
     // Body 2: where it was.
     assert_eq!(&e.q[6..9], &last.q[6..9]);
+    // The trend moves the driver takes the median of: 15 × 5 µm, 15 × 5 mm (body 2
+    // has body 0's trend).
+    let moves = trend_moves(&Linear, &t, &f, 15.0);
+    for (m, want) in moves.iter().zip([75e-6, 75e-3, 75e-6]) {
+        assert!((m - want).abs() < 1e-12 * want.max(1e-3), "{m} vs {want}");
+    }
     // Unbounded (an empty slice, or infinite bounds): the law's configuration.
     assert_eq!(extrapolate_within(&Linear, &t, &f, 15.0, &[]), (free.clone(), 0));
     assert_eq!(extrapolate_within(&Linear, &t, &f, 15.0, &[f64::INFINITY; 3]), (free, 0));

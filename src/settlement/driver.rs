@@ -38,7 +38,7 @@
 //! cycles, relaxed where a jump lands), and `checkpoint.json` every `checkpoint_every_s` (at a cycle's end) for
 //! `--resume`; with `figures`, the figures of [`super::figures`].
 
-use super::estimate::{chernoff_cycles, extrapolate_within, fit, Training};
+use super::estimate::{chernoff_cycles, extrapolate_within, fit, trend_moves, Training};
 use super::law::{Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
 use super::relax::{RelaxReport, RelaxSettings};
 use crate::clock::cycles_at;
@@ -153,8 +153,9 @@ pub struct Acceleration {
     pub positions: bool,
     /// The largest move a jump may give a body, as a fraction of its size
     /// ([`Engine::body_sizes`]: NSCD √(A/π), MD the radius), > 0; default
-    /// [`Acceleration::EXTRAPOLATION_LIMIT`]. A body whose trend goes further is
-    /// moved that far along it (module doc).
+    /// [`Acceleration::EXTRAPOLATION_LIMIT`]; never less than [`MEDIAN_MOVES`]
+    /// times the median of the bodies' trend moves. A body whose trend goes
+    /// further is moved that far along it (docs/settlement-driver.md).
     #[serde(default = "default_extrapolation_limit")]
     pub extrapolation_limit: f64,
 }
@@ -649,11 +650,15 @@ impl<E: Engine> Accelerated<E> {
         let n_last = *n.last().expect("a window has points");
         let sc = law.fit(n, settlements, segments);
         // Bounded moves: a body without a force-carrying contact is held, the
-        // others move at most `extrapolation_limit` of their size (docs/settlement-driver.md).
+        // others move at most `extrapolation_limit` of their size or
+        // `MEDIAN_MOVES` times the median trend move, whichever is larger
+        // (docs/settlement-driver.md, "Bounded moves").
         let bodies = &window.origin.bodies;
         let contacts = st.sys.contact_counts(bodies);
+        let mut moves = trend_moves(law, &window, &f, h as f64);
+        let coherent = MEDIAN_MOVES * median(&mut moves);
         let max_move: Vec<f64> = (st.sys.body_sizes(bodies).iter().zip(&contacts))
-            .map(|(size, &n)| if n == 0 { 0.0 } else { self.spec.extrapolation_limit * size })
+            .map(|(size, &n)| if n == 0 { 0.0 } else { (self.spec.extrapolation_limit * size).max(coherent) })
             .collect();
         let held = contacts.iter().filter(|&&n| n == 0).count() as u64;
         for j in 1..h {
@@ -870,6 +875,21 @@ fn checkpoint<E: Engine>(out: &Path, st: &mut State<E>, files: &mut Files) -> Re
 }
 
 /// The coordinates of boundaries (m).
+/// The factor on the median of the bodies' trend moves below which a jump does
+/// not bound a move: the coherent motion of the sample (the grains under the
+/// sleeper follow it) is never cut, only the outliers.
+pub const MEDIAN_MOVES: f64 = 3.0;
+
+/// The median of `x` (reordered; 0 if empty).
+fn median(x: &mut [f64]) -> f64 {
+    if x.is_empty() {
+        return 0.0;
+    }
+    let mid = x.len() / 2;
+    let (_, m, _) = x.select_nth_unstable_by(mid, f64::total_cmp);
+    *m
+}
+
 /// Checks that every body of `c` is inside the run's domain: the box of the
 /// translations of `origin` (the start of the loading) widened on every side
 /// by half its largest side. A body outside has left the container (through a
@@ -935,5 +955,17 @@ pub fn settlement(origin: &Configuration, c: &Configuration, slot: Option<usize>
         Some(k) => origin.body(k)[vertical] - c.body(k)[vertical],
         None if c.is_empty() => 0.0,
         None => (0..c.len()).map(|k| origin.body(k)[vertical] - c.body(k)[vertical]).sum::<f64>() / c.len() as f64,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn median_of_odd_and_even_counts() {
+        // Odd: the middle value; even: the upper middle (the bound only needs a
+        // robust scale); empty: 0.
+        assert_eq!(super::median(&mut [3.0, 1e-3, 2.0, 0.5, 1e3]), 2.0);
+        assert_eq!(super::median(&mut [4.0, 1.0, 3.0, 2.0]), 3.0);
+        assert_eq!(super::median(&mut []), 0.0);
     }
 }

@@ -190,6 +190,25 @@ pub fn extrapolate(law: &dyn ResidualLaw, training: &Training, fit: &Fit, h: f64
     extrapolate_within(law, training, fit, h, &[]).0
 }
 
+/// The length of each body's trend move over `h` cycles after the last of the
+/// window (m): the norm of the increments [`extrapolate`] gives its first
+/// `fit.dim` coordinates (its translation), `‖ũ(N_k + h) − ũ(N_k)‖`.
+pub fn trend_moves(law: &dyn ResidualLaw, training: &Training, fit: &Fit, h: f64) -> Vec<f64> {
+    let last = training.configurations.last().expect("a fitted window has points");
+    let n_last = *training.cycles.last().expect("a fitted window has points");
+    (0..last.len())
+        .map(|b| {
+            (0..fit.dim)
+                .map(|d| {
+                    let m = law.extrapolate(&fit.coefficients[b * fit.fitted + d], n_last, 0.0, h);
+                    m * m
+                })
+                .sum::<f64>()
+                .sqrt()
+        })
+        .collect()
+}
+
 /// [`extrapolate`] with a bound on each body's move: the fitted increments of
 /// body `b` are scaled down together (the move keeps its direction) so that its
 /// translation from the last computed configuration is at most `max_move[b]`

@@ -31,7 +31,8 @@ pub use driver::{
     SettlementRow,
 };
 pub use estimate::{
-    chernoff_cycles, chernoff_probability, configuration_error, extrapolate, extrapolate_within, fit, Fit, Training,
+    chernoff_cycles, chernoff_probability, configuration_error, extrapolate, extrapolate_within, fit, trend_moves, Fit,
+    Training,
 };
 pub use file::run_file;
 pub use law::{law_named, Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
