@@ -325,7 +325,8 @@ pub(crate) struct AccelerateArgs {
     #[arg(long, value_name = "M", requires = "accelerate")]
     relax_tolerance: Option<f64>,
     /// The largest move a jump may give a body, as a fraction of its size (NSCD
-    /// equal-area radius, MD radius); default 0.25; inf: no bound.
+    /// equal-area radius, MD radius), never less than 3 times the median trend
+    /// move; default 0.25; inf: no bound.
     #[arg(long, value_name = "FRACTION", requires = "accelerate")]
     extrapolation_limit: Option<f64>,
     /// A full run of the same sample and loading (its output folder, e.g. from
