@@ -394,14 +394,20 @@ position = [0.0, 0.0, 0.002]
     );
 }
 
-#[test]
-fn nscd_block_on_floor_carries_its_weight() {
-    // The crate's doc example, with the numbers printed.
+/// An NSCD system (dt 1 ms, friction 0.5) with a fixed 1 m × 0.1 m floor whose top is y = 0.
+fn system_on_floor() -> System {
     let mut sys = System::new(NscdParams { dt: 1e-3, ..NscdParams::default() }, 1);
     sys.set_law(0, 0, ballast::nscd::ContactLaw { friction: 0.5, ..Default::default() });
     let (floor, q) =
         BodyInfo::polygon("floor", &[[-0.5, -0.1], [0.5, -0.1], [0.5, 0.0], [-0.5, 0.0]], 0, 2700.0, 1.0).unwrap();
     sys.bodies.push(floor.into_fixed(), q, [0.0; 3]);
+    sys
+}
+
+#[test]
+fn nscd_block_on_floor_carries_its_weight() {
+    // The crate's doc example, with the numbers printed.
+    let mut sys = system_on_floor();
     let (block, q) =
         BodyInfo::polygon("block", &[[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.0, 0.1]], 0, 2700.0, 1.0).unwrap();
     let weight = block.mass * 9.81;
@@ -446,11 +452,7 @@ fn engines_count_the_force_carrying_contacts_and_size_the_bodies() {
     // NSCD: two 10 cm blocks stacked on a floor, at rest after 100 steps: the
     // lower one touches the floor and the upper one (2), the upper one the
     // lower one (1). Size: the radius of the disc of the same area, √(0.01/π).
-    let mut sys = System::new(NscdParams { dt: 1e-3, ..NscdParams::default() }, 1);
-    sys.set_law(0, 0, ballast::nscd::ContactLaw { friction: 0.5, ..Default::default() });
-    let (ground, q) =
-        BodyInfo::polygon("floor", &[[-0.5, -0.1], [0.5, -0.1], [0.5, 0.0], [-0.5, 0.0]], 0, 2700.0, 1.0).unwrap();
-    sys.bodies.push(ground.into_fixed(), q, [0.0; 3]);
+    let mut sys = system_on_floor();
     for (name, y) in [("lower", 0.0), ("upper", 0.1)] {
         let (block, q) =
             BodyInfo::polygon(name, &[[0.0, y], [0.1, y], [0.1, y + 0.1], [0.0, y + 0.1]], 0, 2700.0, 1.0).unwrap();

@@ -874,7 +874,6 @@ fn checkpoint<E: Engine>(out: &Path, st: &mut State<E>, files: &mut Files) -> Re
     Ok(())
 }
 
-/// The coordinates of boundaries (m).
 /// The factor on the median of the bodies' trend moves below which a jump does
 /// not bound a move: the coherent motion of the sample (the grains under the
 /// sleeper follow it) is never cut, only the outliers.
@@ -932,6 +931,7 @@ fn check_domain<E: Engine>(
     Ok(())
 }
 
+/// The coordinates of boundaries (m).
 fn coordinates(boundaries: &[Boundary]) -> Vec<f64> {
     boundaries.iter().map(|b| b.s).collect()
 }
