@@ -3,8 +3,8 @@
 //! a 50-grain sample (flat sleeper, 2 cycles at dt = 1 ms), whose ensemble
 //! tables must be the statistics of the replicas' own `cycles.csv`.
 
-use ballast::scene::Scene;
-use ballast::studies::replicas::{perturb_scene, t_quantile_975, Perturbation};
+use ballast::scene::{MdScene, Scene};
+use ballast::studies::replicas::{ball_point, perturb_md_scene, perturb_scene, t_quantile_975, Perturbation};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -79,6 +79,53 @@ fn perturbation_moves_mobile_bodies_within_the_disc() {
 }
 
 /// A 50-grain sample (as the ensemble study's test deposits it).
+#[test]
+fn md_perturbation_moves_every_sphere_within_the_ball() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = MdScene::load(root.join("examples/md_two_spheres.toml")).unwrap();
+    let p = Perturbation { distance_m: 1e-9, seed: 3 };
+    let perturbed = |r: u64| {
+        let mut s = scene.clone();
+        let record = perturb_md_scene(&mut s, &p, r).unwrap();
+        (s, record)
+    };
+    let (zero, record) = perturbed(0);
+    assert_eq!((zero, record.bodies_moved), (scene.clone(), 0));
+    let (one, record) = perturbed(1);
+    assert_eq!(record.bodies_moved, scene.bodies.len());
+    for (a, b) in scene.bodies.iter().zip(&one.bodies) {
+        let d: f64 = a.position.iter().zip(b.position).map(|(a, b)| (b - a) * (b - a)).sum::<f64>().sqrt();
+        assert!(d > 0.0 && d <= 1e-9 + 1e-15, "{}: moved {d:e}", a.name);
+        assert_eq!((a.velocity, a.spin, a.sphere), (b.velocity, b.spin, b.sphere));
+    }
+    assert_eq!(one.walls, scene.walls);
+    assert_eq!(perturbed(1).0, one);
+    assert_ne!(perturbed(2).0, one);
+    let e = perturb_md_scene(&mut scene.clone(), &Perturbation { distance_m: f64::NAN, seed: 0 }, 1).unwrap_err();
+    assert!(e.to_string().contains("--perturb"), "{e}");
+
+    // Uniform in the ball of radius R: E|d| = 3R/4 (the density of |d| is 3r²/R³),
+    // P(|d| < R/2) = 1/8, E d = 0. With n = 20 000 draws the standard errors are
+    // √(3/80)/√n R = 1.4e-3 R, √(7/64)/√n = 2.3e-3 and √(1/5)/√n R = 3.2e-3 R per
+    // coordinate: the bounds below are 5 standard errors.
+    let mut rng = p.rng(9);
+    let n = 20_000;
+    let (mut mean_r, mut inner, mut mean) = (0.0, 0.0, [0.0; 3]);
+    for _ in 0..n {
+        let d = ball_point(&mut rng, 2.0);
+        let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        assert!(r <= 2.0);
+        mean_r += r / 2.0 / n as f64;
+        inner += f64::from(u8::from(r < 1.0)) / n as f64;
+        for k in 0..3 {
+            mean[k] += d[k] / 2.0 / n as f64;
+        }
+    }
+    assert!((mean_r - 0.75).abs() < 7e-3, "E|d|/R = {mean_r}");
+    assert!((inner - 0.125).abs() < 1.2e-2, "P(|d| < R/2) = {inner}");
+    assert!(mean.iter().all(|m| m.abs() < 1.6e-2), "E d / R = {mean:?}");
+}
+
 fn sample(dir: &Path) -> String {
     let out = dir.join("sample");
     run(&["saussine", "sample", "--grains", "50", "--dt", "5e-4", "--out", out.to_str().unwrap()]);

@@ -68,9 +68,35 @@ fn the_example_runs_through_the_procedure_and_resumes_to_the_same_numbers() {
     // s_full − s_full(2) is s − s(2): the error is 1e-6 m over what accrued.
     let accrued = rows[29].settlement_m - rows[1].settlement_m;
     assert!((e[29].accrued_error.unwrap() - 1e-6 / accrued.abs()).abs() < 1e-9 / accrued.abs());
-    // A scene without [settlement] is not run by it.
-    assert!(run_file("examples/sleeper_load.toml".as_ref(), &out_dir("none"), &opts, &mut |_| {}).unwrap().is_none());
-    for d in [whole, cut] {
+    // The same errors afterwards from the command line: `ballast figures ACC --reference FULL`.
+    std::fs::remove_file(cut.join("errors.csv")).unwrap();
+    let figures = |dir: &Path| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_ballast"))
+            .arg("figures")
+            .arg(dir)
+            .arg("--reference")
+            .arg(&whole)
+            .output()
+            .unwrap()
+    };
+    let out = figures(&cut);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("error on what accrued after the 2 initial cycles: 0.00 %"), "{stdout}");
+    assert_eq!(
+        ballast::io::read_csv::<ballast::settlement::figures::ErrorRow>(&cut.join("errors.csv")).unwrap().len(),
+        30
+    );
+    // A scene without [settlement] is not run by it, and its folder has no
+    // accelerated run to measure: one line naming the file, exit code 2.
+    let none = out_dir("none");
+    assert!(run_file("examples/sleeper_load.toml".as_ref(), &none, &opts, &mut |_| {}).unwrap().is_none());
+    std::fs::create_dir_all(&none).unwrap();
+    let out = figures(&none);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("has no settlement.csv") && stderr.lines().count() == 1, "{stderr}");
+    for d in [whole, cut, none] {
         let _ = std::fs::remove_dir_all(d);
     }
 }

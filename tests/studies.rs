@@ -208,8 +208,10 @@ fn karrech_deposit_then_one_cycle() {
     assert_eq!((written.spheres, written.dt, written.young), (40, Some(2e-6), Some(1e7)));
 
     // The load needs a finished deposit: an input error naming the option.
-    assert!(input_error(karrech::load(&dir.join("bad"), Plate::FULL, 1, &stage("x"), &Quiet)).contains("--from"));
-    let load = karrech::load(&dir.join("deposit"), Plate::FULL, 1, &stage("load"), &Quiet).unwrap();
+    assert!(input_error(karrech::load(&dir.join("bad"), Plate::FULL, 1, &Default::default(), &stage("x"), &Quiet))
+        .contains("--from"));
+    let load =
+        karrech::load(&dir.join("deposit"), Plate::FULL, 1, &Default::default(), &stage("load"), &Quiet).unwrap();
     assert!(dir.join("load/load.toml").is_file());
     assert_eq!(load.written, ["residual_displacement", "plate"]);
     figures_exist(&dir.join("load"), &load.written);

@@ -22,9 +22,10 @@
 use super::{Bars, Failure};
 use ballast::run::{default_threads, RunOptions};
 use ballast::scenarios::karrech::Loading;
-use ballast::studies::karrech::{self as karrech_test, Deposit};
+use ballast::studies::karrech::{self as karrech_test, Deposit, Start};
 use ballast::studies::luding::{self, Compression};
 use ballast::studies::md_stage::{Stage, StageOutcome};
+use ballast::studies::replicas::{Perturbation, DEFAULT_PERTURBATION_M, DEFAULT_PERTURB_SEED};
 use clap::{Args, Subcommand, ValueEnum};
 use std::path::PathBuf;
 
@@ -114,6 +115,16 @@ pub enum KarrechCommand {
         mode: Mode,
         #[arg(long, default_value_t = 10)]
         cycles: u32,
+        /// Start from replica R of the deposit: 0 as deposited, R ≥ 1 with every sphere
+        /// moved by at most --perturb (the noise floor of a comparison; `replica.json`).
+        #[arg(long, value_name = "R", default_value_t = 0)]
+        replica: u64,
+        /// Largest displacement of a sphere at a replica's start (m), uniform in the ball.
+        #[arg(long, value_name = "DIST", default_value_t = DEFAULT_PERTURBATION_M)]
+        perturb: f64,
+        /// Seed of the perturbations (replica R draws from stream R of it).
+        #[arg(long, value_name = "SEED", default_value_t = DEFAULT_PERTURB_SEED)]
+        perturb_seed: u64,
         #[command(flatten)]
         run: RunArgs,
         #[command(flatten)]
@@ -173,20 +184,21 @@ pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
             let o = karrech_test::deposit(&spec, &args.stage(), &args.display())?;
             print_written(&o, "figures fig3a–d");
         }
-        KarrechCommand::Load { from, mode, cycles, run: args, accelerate } => {
+        KarrechCommand::Load { from, mode, cycles, replica, perturb, perturb_seed, run: args, accelerate } => {
             let loading = if mode == Mode::Full { Loading::FULL } else { Loading::PARTIAL };
+            let start = Start { replica, perturbation: Perturbation { distance_m: perturb, seed: perturb_seed } };
             if let Some(acc) = accelerate.accelerate()? {
                 let bar = super::cycle_bar(args.quiet());
                 let mut show = |p: &ballast::settlement::AccelerationProgress| super::show_cycles(&bar, p);
                 let stage = args.stage();
-                let s = karrech_test::load_accelerated(&from, loading, cycles, &acc, &stage, &mut show)?;
+                let s = karrech_test::load_accelerated(&from, loading, cycles, &acc, &start, &stage, &mut show)?;
                 bar.finish_and_clear();
                 super::print_acceleration(&s, &stage.out);
                 if acc.reference.is_some() {
                     super::saussine::print_errors(&stage.out, &s)?;
                 }
             } else {
-                let o = karrech_test::load(&from, loading, cycles, &args.stage(), &args.display())?;
+                let o = karrech_test::load(&from, loading, cycles, &start, &args.stage(), &args.display())?;
                 print_written(&o, "figures residual_displacement, plate");
             }
         }

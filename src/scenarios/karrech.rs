@@ -370,8 +370,10 @@ pub fn loading_scene(
             area: Some(area),
         }),
     });
+    // The spheres' positions at every cycle end (20 kB a cycle for 850 spheres):
+    // what the settlement driver fits, and the configuration error of eq. (22).
     scene.output.get_or_insert_with(OutputSection::default).cycles =
-        Some(CyclesSpec { frequency: loading.frequency, body: None, positions: None });
+        Some(CyclesSpec { frequency: loading.frequency, body: None, positions: Some(true) });
     scene.bodies = spheres.iter().enumerate().map(|(k, &(r, x))| md_sphere(format!("g{k}"), "diorite", r, x)).collect();
     scene.validate()?;
     Ok(scene)

@@ -7,9 +7,13 @@
 //!   number, packing fraction, kinetic and potential energy;
 //! - [`load`] (§4): the deposited sample under the cyclic plate (`load.toml`),
 //!   then the residual displacement per cycle (from `cycles.csv`) and the
-//!   plate's motion as figures.
+//!   plate's motion as figures. A loading run may start from a perturbed copy
+//!   of the deposit ([`Start`]: replica `r ≥ 1` moves every sphere by at most
+//!   1e-9 m, [`crate::studies::replicas::perturb_md_scene`]), the noise floor of
+//!   a settlement comparison.
 
 use super::md_stage::{chart, columns, curve, final_state, spheres_of, Stage, StageOutcome, TestSpec};
+use super::replicas::{perturb_md_scene, Perturbation, REPLICA_FILE};
 use super::RunDisplay;
 use crate::error::{Error, Result};
 use crate::scenarios::karrech::{self, KarrechSpec, Loading};
@@ -65,10 +69,50 @@ pub fn deposit(spec: &Deposit, stage: &Stage, display: &dyn RunDisplay) -> Resul
     Ok(StageOutcome { run, written: deposit_figures(&stage.out)? })
 }
 
+/// The start of a loading run: replica 0 is the deposit as it is, replica
+/// `r ≥ 1` the deposit with every sphere moved by [`perturb_md_scene`]
+/// (recorded as [`REPLICA_FILE`] in the run's folder).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Start {
+    /// The replica: 0 for the deposit as it is.
+    pub replica: u64,
+    /// How replicas `r ≥ 1` are perturbed (default: ≤ 1e-9 m, seed 1).
+    pub perturbation: Perturbation,
+}
+
+/// The loading scene of the sample deposited in `from`, from `start`, written
+/// as `load.toml` in `stage.out` (with `[settlement]` from `settlement` if
+/// given, else a plain run) unless a resumed stage has it already.
+fn write_load_scene(
+    from: &Path,
+    loading: Loading,
+    cycles: u32,
+    start: &Start,
+    stage: &Stage,
+    settlement: impl FnOnce(&crate::md::MdSystem) -> Option<crate::scene::common::SettlementSection>,
+) -> Result<std::path::PathBuf> {
+    let (sys, spec) = deposited(from)?;
+    start.perturbation.check()?;
+    let mut record = None;
+    let (path, written) = stage.write_scene("load.toml", || {
+        let mut scene = karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, stage.every)?;
+        record = Some(perturb_md_scene(&mut scene, &start.perturbation, start.replica)?);
+        scene.settlement = settlement(&sys);
+        scene.validate()?;
+        Ok(scene)
+    })?;
+    if let (true, Some(record)) = (written, record) {
+        if record.replica > 0 {
+            crate::io::write_json(&stage.out.join(REPLICA_FILE), &record)?;
+        }
+    }
+    Ok(path)
+}
+
 /// Loads the sample deposited in `from` (its `final_scene.toml` and
-/// `spec.json`) cyclically by the plate of `loading` ([`Loading::FULL`] or
-/// [`Loading::PARTIAL`]) for `cycles` cycles in `stage.out` (`load.toml`), then
-/// draws `residual_displacement` and `plate`.
+/// `spec.json`), from `start`, cyclically by the plate of `loading`
+/// ([`Loading::FULL`] or [`Loading::PARTIAL`]) for `cycles` cycles in
+/// `stage.out` (`load.toml`), then draws `residual_displacement` and `plate`.
 ///
 /// # Errors
 /// [`Error::Scene`] if `from` holds no finished deposit, or for an invalid
@@ -77,18 +121,17 @@ pub fn load(
     from: &Path,
     loading: Loading,
     cycles: u32,
+    start: &Start,
     stage: &Stage,
     display: &dyn RunDisplay,
 ) -> Result<StageOutcome> {
     crate::io::figures::require()?; // the stage ends with its figures
-    let (sys, spec) = deposited(from)?;
-    let (scene, _) = stage
-        .write_scene("load.toml", || karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, stage.every))?;
+    let scene = write_load_scene(from, loading, cycles, start, stage, |_| None)?;
     let run = stage.run(&scene, display, "karrech load")?;
     Ok(StageOutcome { run, written: load_figures(&stage.out)? })
 }
 
-/// [`load`] accelerated (Karrech et al. 2007, Fig. 10): the loading scene with
+/// [`load`] accelerated (Karrech et al. 2007, Fig. 10), from `start`: the loading scene with
 /// its `[settlement]` table (the plate's displacement is the settlement; the
 /// relaxation tolerance by default 1 % of the smallest radius) written as
 /// `load.toml` and run through [`crate::settlement::run_file`]: `settlement.csv`,
@@ -102,17 +145,14 @@ pub fn load_accelerated(
     loading: Loading,
     cycles: u32,
     accelerate: &super::Accelerate,
+    start: &Start,
     stage: &Stage,
     progress: &mut dyn FnMut(&crate::settlement::AccelerationProgress),
 ) -> Result<crate::settlement::AccelerationSummary> {
     crate::io::figures::require()?;
-    let (sys, spec) = deposited(from)?;
-    let smallest = sys.particles.r.iter().copied().fold(f64::INFINITY, f64::min);
-    let (path, _) = stage.write_scene("load.toml", || {
-        let mut scene = karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, stage.every)?;
-        scene.settlement = Some(accelerate.section(Some("plate".into()), 0.01 * smallest));
-        scene.validate()?;
-        Ok(scene)
+    let path = write_load_scene(from, loading, cycles, start, stage, |sys| {
+        let smallest = sys.particles.r.iter().copied().fold(f64::INFINITY, f64::min);
+        Some(accelerate.section(Some("plate".into()), 0.01 * smallest))
     })?;
     let opts = crate::run::RunOptions { figures: true, ..stage.run.clone() };
     accelerate.run_scene(&path, &stage.out, &opts, progress)

@@ -16,7 +16,8 @@
 //!   same `(seed, r)` always gives the same scene. The bodies draw in the
 //!   scene's order, mobile bodies only. The angle and the velocities are not
 //!   touched. What was done is recorded in each run folder as
-//!   [`REPLICA_FILE`] ([`ReplicaRecord`]).
+//!   [`REPLICA_FILE`] ([`ReplicaRecord`]). The 3D (MD) scenes have the same
+//!   with a displacement uniform in the ball ([`perturb_md_scene`], [`ball_point`]).
 //! - **Statistics of the mean** ([`Estimate`]): mean, sample standard deviation
 //!   (divisor `R − 1`) and the 95 % confidence interval of the mean,
 //!   `mean ± t_{0.975, R−1} · sd / √R` (Student's t quantile from `statrs`,
@@ -47,9 +48,10 @@
 
 use crate::error::{Error, Result};
 use crate::io::cycles::NscdCycleRow;
-use crate::scene::Scene;
+use crate::scene::{MdScene, Scene};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, UnitBall};
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ContinuousCDF, StudentsT};
 
@@ -128,6 +130,13 @@ pub fn disc_point(rng: &mut impl RngExt, radius: f64) -> [f64; 2] {
     [r * angle.cos(), r * angle.sin()]
 }
 
+/// A point uniform in the ball of radius `radius` centred on the origin
+/// (`rand_distr::UnitBall`, by rejection from the cube, scaled).
+pub fn ball_point(rng: &mut impl rand::Rng, radius: f64) -> [f64; 3] {
+    let u: [f64; 3] = UnitBall.sample(rng);
+    u.map(|c| c * radius)
+}
+
 /// What a replica's start was: written as [`REPLICA_FILE`] in its run folder.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ReplicaRecord {
@@ -169,6 +178,37 @@ pub fn perturb_scene(scene: &mut Scene, perturbation: &Perturbation, replica: u6
         record.largest_displacement_m = record.largest_displacement_m.max(d[0].hypot(d[1]));
     }
     record.bodies_moved = mobile.len();
+    Ok(record)
+}
+
+/// [`perturb_scene`] for an MD (3D) scene: replica `r ≥ 1` moves every sphere
+/// by a displacement uniform in the ball of radius [`Perturbation::distance_m`]
+/// ([`ball_point`], drawn in the scene's order from [`Perturbation::rng`]);
+/// walls, velocities and spins are not touched; replica 0 is left as it is.
+///
+/// # Errors
+/// [`Error::Scene`] for an invalid perturbation ([`Perturbation::check`]).
+pub fn perturb_md_scene(scene: &mut MdScene, perturbation: &Perturbation, replica: u64) -> Result<ReplicaRecord> {
+    perturbation.check()?;
+    let mut record = ReplicaRecord {
+        replica,
+        perturb_m: perturbation.distance_m,
+        perturb_seed: perturbation.seed,
+        bodies_moved: 0,
+        largest_displacement_m: 0.0,
+    };
+    if replica == 0 {
+        return Ok(record);
+    }
+    let mut rng = perturbation.rng(replica);
+    for body in &mut scene.bodies {
+        let d = ball_point(&mut rng, perturbation.distance_m);
+        for (p, d) in body.position.iter_mut().zip(d) {
+            *p += d;
+        }
+        record.largest_displacement_m = record.largest_displacement_m.max(d[0].hypot(d[1]).hypot(d[2]));
+    }
+    record.bodies_moved = scene.bodies.len();
     Ok(record)
 }
 
