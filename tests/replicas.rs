@@ -78,7 +78,8 @@ fn perturbation_moves_mobile_bodies_within_the_disc() {
     assert!(e.to_string().contains("--perturb"), "{e}");
 }
 
-/// A 50-grain sample (as the ensemble study's test deposits it).
+/// MD replicas: every sphere moves within the ball, walls stay; the ball's draws
+/// have its moments.
 #[test]
 fn md_perturbation_moves_every_sphere_within_the_ball() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -126,6 +127,7 @@ fn md_perturbation_moves_every_sphere_within_the_ball() {
     assert!(mean.iter().all(|m| m.abs() < 1.6e-2), "E d / R = {mean:?}");
 }
 
+/// A 50-grain sample (as the ensemble study's test deposits it).
 fn sample(dir: &Path) -> String {
     let out = dir.join("sample");
     run(&["saussine", "sample", "--grains", "50", "--dt", "5e-4", "--out", out.to_str().unwrap()]);

@@ -152,6 +152,19 @@ pub struct ReplicaRecord {
     pub largest_displacement_m: f64,
 }
 
+impl ReplicaRecord {
+    /// The record of replica `replica` of `perturbation` before any body moved.
+    fn unmoved(perturbation: &Perturbation, replica: u64) -> Self {
+        Self {
+            replica,
+            perturb_m: perturbation.distance_m,
+            perturb_seed: perturbation.seed,
+            bodies_moved: 0,
+            largest_displacement_m: 0.0,
+        }
+    }
+}
+
 /// Perturbs the start of `scene` for replica `replica` (see the module
 /// documentation): the position of every body that is not fixed moves by its
 /// displacement of [`Perturbation::displacements`]; replica 0 is left as it is.
@@ -161,13 +174,7 @@ pub struct ReplicaRecord {
 pub fn perturb_scene(scene: &mut Scene, perturbation: &Perturbation, replica: u64) -> Result<ReplicaRecord> {
     perturbation.check()?;
     let mobile: Vec<usize> = (0..scene.bodies.len()).filter(|&i| !scene.bodies[i].is_fixed()).collect();
-    let mut record = ReplicaRecord {
-        replica,
-        perturb_m: perturbation.distance_m,
-        perturb_seed: perturbation.seed,
-        bodies_moved: 0,
-        largest_displacement_m: 0.0,
-    };
+    let mut record = ReplicaRecord::unmoved(perturbation, replica);
     if replica == 0 {
         return Ok(record);
     }
@@ -190,13 +197,7 @@ pub fn perturb_scene(scene: &mut Scene, perturbation: &Perturbation, replica: u6
 /// [`Error::Scene`] for an invalid perturbation ([`Perturbation::check`]).
 pub fn perturb_md_scene(scene: &mut MdScene, perturbation: &Perturbation, replica: u64) -> Result<ReplicaRecord> {
     perturbation.check()?;
-    let mut record = ReplicaRecord {
-        replica,
-        perturb_m: perturbation.distance_m,
-        perturb_seed: perturbation.seed,
-        bodies_moved: 0,
-        largest_displacement_m: 0.0,
-    };
+    let mut record = ReplicaRecord::unmoved(perturbation, replica);
     if replica == 0 {
         return Ok(record);
     }
