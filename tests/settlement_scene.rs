@@ -110,6 +110,11 @@ fn bad_settlement_tables_name_the_key() {
         ("extrapolated_cycles = 4", "extrapolated_cycles = 0", "settlement.extrapolated_cycles: must be at least 1"),
         ("relax_tolerance = 1.0e-5", "relax_tolerance = -1.0", "settlement.relax_tolerance: must be a positive length"),
         (
+            "relax_tolerance = 1.0e-5",
+            "relax_tolerance = \"loose\"",
+            "settlement.relax_tolerance: expected a length (m) or \"computed\", got 'loose'",
+        ),
+        (
             "settlement_body = \"sleeper\"",
             "settlement_body = \"floor\"",
             "settlement.settlement_body: body 'floor' is fixed",
@@ -158,6 +163,23 @@ fn bad_settlement_tables_name_the_key() {
         let e = ballast::scene::Scene::from_toml_str(&bad).unwrap_err().to_string();
         assert!(e.contains(want), "{to}: {e}");
         assert!(!e.contains('\n'), "one line: {e}");
+    }
+}
+
+#[test]
+fn the_relaxation_tolerance_is_a_length_or_the_computed_overlap() {
+    // A length is the tolerance; "computed", or no key, asks each jump to relax
+    // down to the largest overlap of the configuration it starts from.
+    let text = std::fs::read_to_string(SCENE).unwrap();
+    let plan = |t: &str| ballast::scene::Scene::from_toml_str(t).unwrap().acceleration().unwrap().unwrap().spec;
+    let given = plan(&text);
+    assert!(!given.relax_to_computed && given.relax.tolerance == 1.0e-5);
+    for t in [
+        text.replace("relax_tolerance = 1.0e-5", "relax_tolerance = \"computed\""),
+        text.replace("relax_tolerance = 1.0e-5\n", ""),
+    ] {
+        assert!(t != text);
+        assert!(plan(&t).relax_to_computed);
     }
 }
 

@@ -320,8 +320,9 @@ pub(crate) struct AccelerateArgs {
     /// Factor on H after each jump.
     #[arg(long, default_value_t = 1.0, requires = "accelerate")]
     growth: f64,
-    /// Largest overlap left by the relaxation after a jump (m); default 1 % of the
-    /// smallest grain's inradius.
+    /// Largest overlap left by the relaxation after a jump (m); default: 1 % of
+    /// the smallest grain's inradius (saussine), the largest overlap of the
+    /// computed configuration the jump starts from (karrech).
     #[arg(long, value_name = "M", requires = "accelerate")]
     relax_tolerance: Option<f64>,
     /// The largest move a jump may give a body, as a fraction of its size (NSCD

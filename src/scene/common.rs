@@ -260,8 +260,11 @@ pub struct SettlementSection {
     /// `"shenton"` (default) or `"linear"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub law: Option<String>,
-    /// Largest overlap left by the relaxation (m), > 0.
-    pub relax_tolerance: f64,
+    /// Largest overlap left by the relaxation: a length (m), > 0, or
+    /// `"computed"` (the default): at each jump, the largest overlap of the
+    /// computed configuration the jump starts from.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relax_tolerance: Option<RelaxTolerance>,
     /// Iterations of the relaxation at most, ≥ 1; default 10 000.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub relax_max_iterations: Option<u64>,
@@ -282,6 +285,17 @@ pub struct SettlementSection {
     /// (NSCD the equal-area radius √(A/π), MD the radius), > 0; default 0.25.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub extrapolation_limit: Option<f64>,
+}
+
+/// `settlement.relax_tolerance`: a length (m) or a word (`"computed"`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum RelaxTolerance {
+    /// This largest overlap (m).
+    Length(f64),
+    /// `"computed"`: the largest overlap of the computed configuration each
+    /// jump starts from ([`crate::settlement::Acceleration::relax_to_computed`]).
+    Word(String),
 }
 
 /// A validated `[settlement]`: the procedure's settings, the loading frequency
@@ -318,7 +332,16 @@ pub(crate) fn check_settlement(
     let Some(c) = cycles else {
         return err("settlement: needs the loading frequency of [output] cycles = { frequency = … }".into());
     };
-    let mut spec = Acceleration::new(s.initial_cycles, s.computed_cycles, s.extrapolated_cycles, s.relax_tolerance);
+    let (tolerance, to_computed) = match &s.relax_tolerance {
+        Some(RelaxTolerance::Length(t)) => (*t, false),
+        None => (f64::MAX, true),
+        Some(RelaxTolerance::Word(w)) if w == "computed" => (f64::MAX, true),
+        Some(RelaxTolerance::Word(w)) => {
+            return err(format!("settlement.relax_tolerance: expected a length (m) or \"computed\", got '{w}'"))
+        }
+    };
+    let mut spec = Acceleration::new(s.initial_cycles, s.computed_cycles, s.extrapolated_cycles, tolerance);
+    spec.relax_to_computed = to_computed;
     spec.positions = c.positions;
     if let Some(g) = s.growth {
         spec.growth = g;
@@ -374,7 +397,15 @@ pub(crate) fn write_settlement(out: &mut String, s: Option<&SettlementSection>) 
     let _ = writeln!(out, "extrapolated_cycles = {}", s.extrapolated_cycles);
     opt(out, "growth", s.growth, float);
     opt(out, "law", s.law.as_deref(), string);
-    let _ = writeln!(out, "relax_tolerance = {}", float(s.relax_tolerance));
+    match &s.relax_tolerance {
+        Some(RelaxTolerance::Length(t)) => {
+            let _ = writeln!(out, "relax_tolerance = {}", float(*t));
+        }
+        Some(RelaxTolerance::Word(w)) => {
+            let _ = writeln!(out, "relax_tolerance = {}", string(w));
+        }
+        None => {}
+    }
     opt(out, "relax_max_iterations", s.relax_max_iterations, |n| n.to_string());
     opt(out, "relax_method", s.relax_method.as_deref(), string);
     opt(out, "error", s.error, float);

@@ -136,6 +136,13 @@ pub struct Acceleration {
     pub law: Law,
     /// The relaxation after each jump.
     pub relax: RelaxSettings,
+    /// Relax each jump's landing down to the largest overlap of the computed
+    /// configuration the jump starts from (the last step of its last computed
+    /// cycle, at the same load phase), instead of `relax.tolerance`: no contact
+    /// then stores more energy than the most loaded contact the engine itself
+    /// carried (docs/settlement-driver.md, "The relaxation's tolerance").
+    #[serde(default)]
+    pub relax_to_computed: bool,
     /// `k` from the Chernoff bound, if asked.
     pub adaptive: Option<Adaptive>,
     /// The body whose vertical displacement is the settlement (index in the
@@ -179,6 +186,7 @@ impl Acceleration {
             growth: 1.0,
             law: Law::Shenton,
             relax: RelaxSettings::new(relax_tolerance),
+            relax_to_computed: false,
             adaptive: None,
             settlement_body: None,
             settlement_boundary: None,
@@ -268,6 +276,8 @@ pub struct JumpRow {
     pub f_xi_m: f64,
     /// Widest range of one coordinate's error terms (m).
     pub xi_range_m: f64,
+    /// The largest overlap the relaxation was asked to reach (m).
+    pub relax_tolerance_m: f64,
     /// Iterations of the relaxation.
     pub relax_iterations: u64,
     /// Evaluations of its functional.
@@ -304,6 +314,7 @@ impl JumpRow {
         "g_u_m",
         "f_xi_m",
         "xi_range_m",
+        "relax_tolerance_m",
         "relax_iterations",
         "relax_evaluations",
         "relax_converged",
@@ -395,6 +406,9 @@ struct State<E> {
     boundary_origin: Vec<f64>,
     window_boundaries: Vec<Vec<f64>>,
     last_settlement: f64,
+    /// The largest overlap at the end of the last computed cycle (m).
+    #[serde(default)]
+    computed_overlap: f64,
     wall_time_s: f64,
     /// Bytes, rows and CRC-32 of `settlement.csv` and `jumps.csv`.
     tables: [(u64, u64, u32); 2],
@@ -492,9 +506,12 @@ impl<E: Engine> Accelerated<E> {
             let before = cycles_at(st.sys.time(), self.frequency, st.sys.dt());
             let mut made = 0;
             while cycles_at(st.sys.time(), self.frequency, st.sys.dt()) == before {
-                if let Err(e) = st.sys.step() {
-                    failure = Some(e);
-                    break;
+                match st.sys.step() {
+                    Ok(stats) => st.computed_overlap = E::summary(&stats).max_overlap,
+                    Err(e) => {
+                        failure = Some(e);
+                        break;
+                    }
                 }
                 made += 1;
                 if made > per_cycle {
@@ -689,7 +706,15 @@ impl<E: Engine> Accelerated<E> {
         st.sys.set_boundaries(&boundaries)?;
         st.sys.set_configuration(&target)?;
         let t0 = Instant::now();
-        let report: RelaxReport = st.sys.relax(&self.spec.relax)?;
+        let mut relax = self.spec.relax.clone();
+        if self.spec.relax_to_computed {
+            // A floor for a configuration without contacts: a millionth of the
+            // smallest body (any overlap a jump makes there is spurious).
+            let smallest = st.sys.body_sizes(bodies).iter().copied().fold(f64::INFINITY, f64::min);
+            let floor = if smallest.is_finite() { 1e-6 * smallest } else { f64::MIN_POSITIVE };
+            relax.tolerance = st.computed_overlap.max(floor);
+        }
+        let report: RelaxReport = st.sys.relax(&relax)?;
         let relax_wall = t0.elapsed().as_secs_f64();
         check_domain(&st.sys, &st.origin, &st.sys.configuration(), || {
             format!("the relaxation of jump {}", st.jumps + 1)
@@ -724,6 +749,7 @@ impl<E: Engine> Accelerated<E> {
             g_u_m: f.g_u,
             f_xi_m: f.f_xi,
             xi_range_m: f.xi_range,
+            relax_tolerance_m: relax.tolerance,
             relax_iterations: report.iterations,
             relax_evaluations: report.evaluations,
             relax_converged: report.converged,
@@ -794,6 +820,7 @@ impl<E: Engine> Accelerated<E> {
             window,
             origin,
             last_settlement: 0.0,
+            computed_overlap: 0.0,
             wall_time_s: 0.0,
             tables: [(0, 0, 0); 2],
             positions_crc32: 0,

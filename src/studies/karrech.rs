@@ -150,9 +150,8 @@ pub fn load_accelerated(
     progress: &mut dyn FnMut(&crate::settlement::AccelerationProgress),
 ) -> Result<crate::settlement::AccelerationSummary> {
     crate::io::figures::require()?;
-    let path = write_load_scene(from, loading, cycles, start, stage, |sys| {
-        let smallest = sys.particles.r.iter().copied().fold(f64::INFINITY, f64::min);
-        Some(accelerate.section(Some("plate".into()), 0.01 * smallest))
+    let path = write_load_scene(from, loading, cycles, start, stage, |_| {
+        Some(accelerate.section(Some("plate".into()), None))
     })?;
     let opts = crate::run::RunOptions { figures: true, ..stage.run.clone() };
     accelerate.run_scene(&path, &stage.out, &opts, progress)

@@ -109,9 +109,10 @@ pub struct Accelerate {
     pub law: String,
     /// Factor on `h` after each jump (≥ 1).
     pub growth: f64,
-    /// Largest overlap left by the relaxation (m); `None`: 1 % of the smallest
-    /// grain's inradius (NSCD: the overlap the default NLGS setting keeps below)
-    /// or sphere radius (MD).
+    /// Largest overlap left by the relaxation (m); `None`: the command's default
+    /// (NSCD: 1 % of the smallest grain's inradius, the overlap the default NLGS
+    /// setting keeps below; MD: the largest overlap of the computed
+    /// configuration each jump starts from).
     pub relax_tolerance: Option<f64>,
     /// The largest move a jump may give a body, as a fraction of its size;
     /// `None`: [`crate::settlement::Acceleration::EXTRAPOLATION_LIMIT`].
@@ -124,8 +125,12 @@ pub struct Accelerate {
 impl Accelerate {
     /// The `[settlement]` table of these settings, the settlement measured on
     /// `body` (the sleeper, the plate), the relaxation tolerance defaulting to
-    /// `default_tolerance` (m).
-    pub fn section(&self, body: Option<String>, default_tolerance: f64) -> crate::scene::common::SettlementSection {
+    /// `default_tolerance` (m; `None`: `"computed"`).
+    pub fn section(
+        &self,
+        body: Option<String>,
+        default_tolerance: Option<f64>,
+    ) -> crate::scene::common::SettlementSection {
         let [initial_cycles, computed_cycles, extrapolated_cycles] = self.cycles;
         crate::scene::common::SettlementSection {
             initial_cycles,
@@ -133,7 +138,10 @@ impl Accelerate {
             extrapolated_cycles,
             growth: Some(self.growth),
             law: Some(self.law.clone()),
-            relax_tolerance: self.relax_tolerance.unwrap_or(default_tolerance),
+            relax_tolerance: self
+                .relax_tolerance
+                .or(default_tolerance)
+                .map(crate::scene::common::RelaxTolerance::Length),
             settlement_body: body,
             extrapolation_limit: self.extrapolation_limit,
             ..Default::default()

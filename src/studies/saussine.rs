@@ -304,7 +304,7 @@ pub fn settle_accelerated(
         .map(|i| sys.bodies.info[i].shape.inner_radius())
         .fold(f64::INFINITY, f64::min);
     let sleeper = scene.output.as_ref().and_then(|o| o.cycles.as_ref()).and_then(|c| c.body.clone());
-    scene.settlement = Some(accelerate.section(sleeper, 0.01 * smallest));
+    scene.settlement = Some(accelerate.section(sleeper, Some(0.01 * smallest)));
     scene.validate()?;
     io::create_output_dir(out)?;
     let path = out.join("loaded.toml");
