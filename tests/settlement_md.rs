@@ -29,10 +29,10 @@ fn spec() -> KarrechSpec {
     KarrechSpec { young: 1e7, dt: 2e-6, duration: 0.6, container_radius: 0.02, ..KarrechSpec::table1(40, 1) }
 }
 
-/// The deposited spheres `(radius, centre)`.
-fn deposit() -> Vec<(f64, ballast::md::V3)> {
-    let scene = deposit_scene(&spec(), 1000).unwrap();
-    let dir = out_dir("deposit");
+/// The spheres of `spec` deposited, `(radius, centre)`.
+fn deposit(spec: &KarrechSpec, name: &str) -> Vec<(f64, ballast::md::V3)> {
+    let scene = deposit_scene(spec, 1000).unwrap();
+    let dir = out_dir(name);
     let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
     let run = Runner::from_system(scene.build().unwrap(), scene.plan().unwrap()).unwrap();
     run.run(&dir, &opts, &mut |_| {}).unwrap();
@@ -42,6 +42,19 @@ fn deposit() -> Vec<(f64, ballast::md::V3)> {
         .iter()
         .map(|b| (b.radius.unwrap(), ballast::md::V3::new(b.position[0], b.position[1], b.position[2])))
         .collect()
+}
+
+/// `sys` with every sphere moved by at most 1e-9 m (a fixed sequence, one per `phase`).
+fn perturbed(sys: &ballast::md::MdSystem, phase: f64) -> ballast::md::MdSystem {
+    let mut sys = sys.clone();
+    let mut c = sys.configuration();
+    for (k, x) in c.q.iter_mut().enumerate() {
+        if k % 6 < 3 {
+            *x += 1e-9 * (0.577 * ((k as f64 + 1.0) * phase).sin());
+        }
+    }
+    sys.set_configuration(&c).unwrap();
+    sys
 }
 
 fn accelerate(
@@ -80,7 +93,7 @@ fn accelerate(
 fn md_accelerated_run_follows_the_plate_settlement() {
     use rayon::prelude::*;
     let t0 = std::time::Instant::now();
-    let spheres = deposit();
+    let spheres = deposit(&spec(), "deposit");
     let scene = loading_scene(&spec(), &spheres, LOAD, CYCLES as u32, 1000).unwrap();
     let base = scene.build().unwrap();
     eprintln!("deposit {:.1} s", t0.elapsed().as_secs_f64());
@@ -91,17 +104,7 @@ fn md_accelerated_run_follows_the_plate_settlement() {
     let full = Acceleration { computed_cycles: CYCLES + 1, ..acc.clone() };
     let jobs: Vec<(String, ballast::md::MdSystem, Acceleration)> = (0..3)
         .map(|r| {
-            let mut sys = base.clone();
-            if r > 0 {
-                // Every sphere moved by at most 1e-9 m (a fixed sequence per replica).
-                let mut c = sys.configuration();
-                for (k, x) in c.q.iter_mut().enumerate() {
-                    if k % 6 < 3 {
-                        *x += 1e-9 * (0.577 * ((k as f64 + 1.0) * (r as f64 * 1.618 + 0.3)).sin());
-                    }
-                }
-                sys.set_configuration(&c).unwrap();
-            }
+            let sys = if r > 0 { perturbed(&base, r as f64 * 1.618 + 0.3) } else { base.clone() };
             (format!("full{r}"), sys, full.clone())
         })
         .chain([("acc".to_string(), base.clone(), acc.clone())])
@@ -162,18 +165,7 @@ fn md_landing_relaxed_to_the_computed_overlap_starts_no_reseating() {
     use rayon::prelude::*;
     const N: u64 = 16;
     let t0 = std::time::Instant::now();
-    let scene = deposit_scene(&stiff_spec(), 1000).unwrap();
-    let dir = out_dir("stiff-deposit");
-    let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
-    let run = Runner::from_system(scene.build().unwrap(), scene.plan().unwrap()).unwrap();
-    run.run(&dir, &opts, &mut |_| {}).unwrap();
-    let fin = ballast::io::FinalState::read(&dir.join("final.json")).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
-    let spheres: Vec<(f64, ballast::md::V3)> = fin
-        .bodies
-        .iter()
-        .map(|b| (b.radius.unwrap(), ballast::md::V3::new(b.position[0], b.position[1], b.position[2])))
-        .collect();
+    let spheres = deposit(&stiff_spec(), "stiff-deposit");
     let smallest = spheres.iter().map(|s| s.0).fold(f64::INFINITY, f64::min);
     let base = loading_scene(&stiff_spec(), &spheres, Loading::FULL, N as u32, 1000).unwrap().build().unwrap();
     eprintln!("stiff deposit {:.1} s", t0.elapsed().as_secs_f64());
@@ -182,14 +174,7 @@ fn md_landing_relaxed_to_the_computed_overlap_starts_no_reseating() {
     computed.settlement_boundary = Some(0);
     computed.relax_to_computed = true;
     let full = Acceleration { computed_cycles: N + 1, relax_to_computed: false, ..computed.clone() };
-    let mut replica = base.clone();
-    let mut c = replica.configuration();
-    for (k, x) in c.q.iter_mut().enumerate() {
-        if k % 6 < 3 {
-            *x += 1e-9 * (0.577 * ((k as f64 + 1.0) * 1.918).sin());
-        }
-    }
-    replica.set_configuration(&c).unwrap();
+    let replica = perturbed(&base, 1.918);
     let jobs = vec![
         ("stiff-full", base.clone(), full.clone()),
         ("stiff-replica", replica, full),

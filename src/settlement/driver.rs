@@ -505,9 +505,10 @@ impl<E: Engine> Accelerated<E> {
             // One computed cycle.
             let before = cycles_at(st.sys.time(), self.frequency, st.sys.dt());
             let mut made = 0;
+            let mut last = None;
             while cycles_at(st.sys.time(), self.frequency, st.sys.dt()) == before {
                 match st.sys.step() {
-                    Ok(stats) => st.computed_overlap = E::summary(&stats).max_overlap,
+                    Ok(stats) => last = Some(stats),
                     Err(e) => {
                         failure = Some(e);
                         break;
@@ -527,6 +528,10 @@ impl<E: Engine> Accelerated<E> {
             if failure.is_some() {
                 end = "diverged";
                 break;
+            }
+            // The largest overlap at the cycle's end (a jump's relaxation target).
+            if let Some(stats) = last {
+                st.computed_overlap = E::summary(&stats).max_overlap;
             }
             st.cycle += 1;
             st.computed += 1;
