@@ -233,7 +233,7 @@ fn bounded_moves_keep_the_direction_and_hold_a_body_at_bound_zero() {
     let t = window(3, 10, 20, |b, d, n| rate(b, d) * n);
     let f = fit(&Linear, &t, 3, 2).unwrap();
     let free = extrapolate(&Linear, &t, &f, 15.0);
-    let (e, limited) = extrapolate_within(&Linear, &t, &f, 15.0, &[1e-3, 1e-3, 0.0]);
+    let (e, limited) = extrapolate_within(&Linear, &t, &f, 15.0, &[1e-3, 1e-3, 0.0], None);
     let last = t.configurations.last().unwrap();
     assert_eq!(limited, 2, "body 1 (past its bound) and body 2 (held, with a trend)");
     // Body 0: the law's move, bit for bit (scale 1).
@@ -255,8 +255,8 @@ fn bounded_moves_keep_the_direction_and_hold_a_body_at_bound_zero() {
         assert!((m - want).abs() < 1e-12 * want.max(1e-3), "{m} vs {want}");
     }
     // Unbounded (an empty slice, or infinite bounds): the law's configuration.
-    assert_eq!(extrapolate_within(&Linear, &t, &f, 15.0, &[]), (free.clone(), 0));
-    assert_eq!(extrapolate_within(&Linear, &t, &f, 15.0, &[f64::INFINITY; 3]), (free, 0));
+    assert_eq!(extrapolate_within(&Linear, &t, &f, 15.0, &[], None), (free.clone(), 0));
+    assert_eq!(extrapolate_within(&Linear, &t, &f, 15.0, &[f64::INFINITY; 3], None), (free, 0));
 }
 
 #[test]

@@ -149,6 +149,21 @@ fn bad_settlement_tables_name_the_key() {
             "law = \"shenton\"\nextrapolation_limit = nan",
             "settlement.extrapolation_limit: must be a positive fraction",
         ),
+        (
+            "law = \"shenton\"",
+            "law = \"shenton\"\nsmoothing_length = -1e-3",
+            "settlement.smoothing_length: must be a positive length (m), got -0.001",
+        ),
+        (
+            "law = \"shenton\"",
+            "law = \"shenton\"\nsmoothing_length = inf",
+            "settlement.smoothing_length: must be a positive length (m), got inf",
+        ),
+        (
+            "law = \"shenton\"",
+            "law = \"shenton\"\nsettle_cycles = 4",
+            "settlement.settle_cycles: must be at least 1 and less than computed_cycles (4), got 4",
+        ),
         ("law = \"shenton\"", "law = \"shenton\"\nspeed = 2", "unknown field `speed`"),
         ("initial_cycles = 2", "initial_cycles = 0", "settlement.initial_cycles: Shenton's law needs at least 1"),
         (
@@ -180,6 +195,54 @@ fn the_relaxation_tolerance_is_a_length_or_the_computed_overlap() {
     ] {
         assert!(t != text);
         assert!(plan(&t).relax_to_computed);
+    }
+}
+
+#[test]
+fn the_smoothing_length_is_off_unless_given() {
+    let text = std::fs::read_to_string(SCENE).unwrap();
+    let plan = |t: &str| ballast::scene::Scene::from_toml_str(t).unwrap().acceleration().unwrap().unwrap().spec;
+    assert_eq!(plan(&text).smoothing_length, None);
+    let t = text.replace("law = \"shenton\"", "law = \"shenton\"\nsmoothing_length = 0.02");
+    assert_eq!(plan(&t).smoothing_length, Some(0.02));
+}
+
+#[test]
+fn settle_cycles_leave_the_first_cycles_after_a_landing_out_of_the_window() {
+    // The linear law (eq. 16) on the last window is the line through its first
+    // and last points, so the settlement over the second jump's extrapolated
+    // cycles continues the slope from the window's first point: with
+    // `settle_cycles = 3` (k = 4) the cycles 11 and 12 after the landing at
+    // cycle 10 are not data, the window is 13–14 and the slope s(14) − s(13);
+    // by default it is 11–14, slope (s(14) − s(11))/3. Exact to rounding.
+    let text = std::fs::read_to_string(SCENE).unwrap().replace("duration = 1.5 ", "duration = 0.9 ");
+    let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
+    for (settle, first) in [(None, 11usize), (Some(3), 13)] {
+        let mut t = text.replace("law = \"shenton\"", "law = \"linear\"");
+        if let Some(n) = settle {
+            t = t.replace("law = \"linear\"", &format!("law = \"linear\"\nsettle_cycles = {n}"));
+        }
+        let dir = out_dir(&format!("settle{first}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        let scene = dir.join("scene.toml");
+        std::fs::write(&scene, t).unwrap();
+        let s = run_file(&scene, &dir.join("out"), &opts, &mut |_| {}).unwrap().unwrap();
+        // 18 cycles: 2 initial, 4 computed, 4 extrapolated, 4 computed, 4 extrapolated.
+        assert_eq!((s.total_cycles, s.computed_cycles, s.jumps), (18, 10, 2));
+        let (rows, _) = tables(&dir.join("out"));
+        let at = |cycle: usize| rows[cycle - 1].settlement_m;
+        assert!(rows[10..14].iter().all(|r| r.computed == 1), "cycles 11-14 computed");
+        let slope = (at(14) - at(first)) / (14 - first) as f64;
+        for j in 1..4 {
+            let want = at(14) + j as f64 * slope;
+            assert!(
+                (at(14 + j) - want).abs() <= 1e-12 * want.abs(),
+                "settle {settle:?}, cycle {}: {} vs {want}",
+                14 + j,
+                at(14 + j)
+            );
+        }
+        let _ = std::fs::remove_dir_all(dir);
     }
 }
 

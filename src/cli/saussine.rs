@@ -330,6 +330,15 @@ pub(crate) struct AccelerateArgs {
     /// move; default 0.25; inf: no bound.
     #[arg(long, value_name = "FRACTION", requires = "accelerate")]
     extrapolation_limit: Option<f64>,
+    /// Smooth each jump's moves: every body moved by the Gaussian-weighted mean
+    /// of its neighbours' fitted moves, with this length (m; cut at 3 times it);
+    /// default: every body on its own fit (the paper).
+    #[arg(long, value_name = "M", requires = "accelerate")]
+    smoothing_length: Option<f64>,
+    /// Computed cycles after each jump through which the landing re-seats: the
+    /// window's data start at the end of the last of them (default 1).
+    #[arg(long, value_name = "N", requires = "accelerate")]
+    settle_cycles: Option<u64>,
     /// A full run of the same sample and loading (its output folder, e.g. from
     /// `--accelerate K_I,N+1,1`, which never jumps, or a plain settle): errors.csv
     /// (settlement, accrued error after K_I, coordination) and its curve on the figure.
@@ -351,6 +360,8 @@ impl AccelerateArgs {
             growth: self.growth,
             relax_tolerance: self.relax_tolerance,
             extrapolation_limit: self.extrapolation_limit,
+            smoothing_length: self.smoothing_length,
+            settle_cycles: self.settle_cycles,
             reference: self.reference.clone(),
         }))
     }

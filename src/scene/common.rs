@@ -285,6 +285,14 @@ pub struct SettlementSection {
     /// (NSCD the equal-area radius √(A/π), MD the radius), > 0; default 0.25.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub extrapolation_limit: Option<f64>,
+    /// Smooth each jump's moves over the neighbours within a few of this
+    /// length (m, > 0); default: none, every body on its own fit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub smoothing_length: Option<f64>,
+    /// Computed cycles after each jump before the window's data start (≥ 1,
+    /// less than `computed_cycles`); default 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settle_cycles: Option<u64>,
 }
 
 /// `settlement.relax_tolerance`: a length (m) or a word (`"computed"`).
@@ -355,6 +363,10 @@ pub(crate) fn check_settlement(
     if let Some(f) = s.extrapolation_limit {
         spec.extrapolation_limit = f;
     }
+    spec.smoothing_length = s.smoothing_length;
+    if let Some(n) = s.settle_cycles {
+        spec.settle_cycles = n;
+    }
     spec.relax.method = match s.relax_method.as_deref() {
         None | Some("lbfgs") => Method::Lbfgs,
         Some("gradient_descent") => Method::GradientDescent,
@@ -412,6 +424,8 @@ pub(crate) fn write_settlement(out: &mut String, s: Option<&SettlementSection>) 
     opt(out, "probability", s.probability, float);
     opt(out, "settlement_body", s.settlement_body.as_deref(), string);
     opt(out, "extrapolation_limit", s.extrapolation_limit, float);
+    opt(out, "smoothing_length", s.smoothing_length, float);
+    opt(out, "settle_cycles", s.settle_cycles, |n| n.to_string());
 }
 
 /// A scene of either engine as a run records it (`scene.toml`): the text it was

@@ -41,6 +41,7 @@
 use super::estimate::{chernoff_cycles, extrapolate_within, fit, trend_moves, Training};
 use super::law::{Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
 use super::relax::{RelaxReport, RelaxSettings};
+use super::smooth::Smoothing;
 use crate::clock::cycles_at;
 use crate::error::{Error, Result};
 use crate::io::checkpoint::{check_origin, crc32, read_checked, write_checked, CHECKPOINT_FILE};
@@ -165,6 +166,23 @@ pub struct Acceleration {
     /// further is moved that far along it (docs/settlement-driver.md).
     #[serde(default = "default_extrapolation_limit")]
     pub extrapolation_limit: f64,
+    /// Smooth each jump's moves over the neighbours within a few of this
+    /// length (m, > 0): the Gaussian-weighted mean of [`Smoothing`], the
+    /// settlement body and the bodies without contact left out; `None` (the
+    /// paper): every body on its own fit (docs/settlement-driver.md, "Smoothed
+    /// field").
+    #[serde(default)]
+    pub smoothing_length: Option<f64>,
+    /// The computed cycles after each jump through which the landing re-seats:
+    /// the window's data start at the end of the last of them (≥ 1, less than
+    /// `computed_cycles`; default 1: the first cycle after the landing is the
+    /// window's first point, its increment not fitted).
+    #[serde(default = "default_settle_cycles")]
+    pub settle_cycles: u64,
+}
+
+fn default_settle_cycles() -> u64 {
+    1
 }
 
 fn default_extrapolation_limit() -> f64 {
@@ -192,6 +210,8 @@ impl Acceleration {
             settlement_boundary: None,
             positions: false,
             extrapolation_limit: Self::EXTRAPOLATION_LIMIT,
+            smoothing_length: None,
+            settle_cycles: 1,
         }
     }
 
@@ -218,6 +238,15 @@ impl Acceleration {
                 "extrapolation_limit: must be a positive fraction of a body's size (inf: no bound), got {}",
                 self.extrapolation_limit
             ));
+        }
+        if self.settle_cycles == 0 || self.settle_cycles >= self.computed_cycles {
+            return bad(format!(
+                "settle_cycles: must be at least 1 and less than computed_cycles ({}), got {}",
+                self.computed_cycles, self.settle_cycles
+            ));
+        }
+        if let Some(l) = self.smoothing_length.filter(|l| !(*l > 0.0 && l.is_finite())) {
+            return bad(format!("smoothing_length: must be a positive length (m), got {l}"));
         }
         self.relax.check()
     }
@@ -560,14 +589,19 @@ impl<E: Engine> Accelerated<E> {
             // The history starts at the end of the initial cycles (empty until then:
             // `start`; with none, it holds cycle 0).
             if st.cycle >= self.spec.initial_cycles {
-                // The first computed cycle after a jump starts a new segment.
-                if st.jumps > 0 && st.since_jump == 0 {
-                    st.window.push_segment(st.cycle as f64, c);
-                } else {
-                    st.window.push(st.cycle as f64, c);
+                // After a jump the first `settle_cycles − 1` computed cycles are
+                // not data (the landing re-seats in them); the next one starts a
+                // new segment.
+                let after_jump = if st.jumps > 0 { Some(st.since_jump + 1) } else { None };
+                match after_jump {
+                    Some(n) if n < self.spec.settle_cycles => {}
+                    Some(n) if n == self.spec.settle_cycles => st.window.push_segment(st.cycle as f64, c),
+                    _ => st.window.push(st.cycle as f64, c),
                 }
-                st.window_settlement.push(s);
-                st.window_boundaries.push(b);
+                if after_jump.is_none_or(|n| n >= self.spec.settle_cycles) {
+                    st.window_settlement.push(s);
+                    st.window_boundaries.push(b);
+                }
                 if st.cycle > self.spec.initial_cycles {
                     st.since_jump += 1;
                 }
@@ -683,9 +717,15 @@ impl<E: Engine> Accelerated<E> {
             .map(|(size, &n)| if n == 0 { 0.0 } else { (self.spec.extrapolation_limit * size).max(coherent) })
             .collect();
         let held = contacts.iter().filter(|&&n| n == 0).count() as u64;
+        let smoothing = self.spec.smoothing_length.map(|length| {
+            let last = window.configurations.last().expect("a fitted window has points");
+            let excluded: Vec<bool> =
+                (bodies.iter().zip(&contacts)).map(|(&b, &n)| n == 0 || Some(b) == self.spec.settlement_body).collect();
+            Smoothing::new(last, E::DIM, length, &excluded)
+        });
         for j in 1..h {
             if let Some(p) = files.positions.as_mut() {
-                p.append(&extrapolate_within(law, &window, &f, j as f64, &max_move).0)?;
+                p.append(&extrapolate_within(law, &window, &f, j as f64, &max_move, smoothing.as_ref()).0)?;
             }
             files.rows.write(&SettlementRow {
                 cycle: st.cycle + j,
@@ -697,7 +737,7 @@ impl<E: Engine> Accelerated<E> {
                 wall_time_s: wall0 + started.elapsed().as_secs_f64(),
             })?;
         }
-        let (target, limited) = extrapolate_within(law, &window, &f, h as f64, &max_move);
+        let (target, limited) = extrapolate_within(law, &window, &f, h as f64, &max_move, smoothing.as_ref());
         check_domain(&st.sys, &st.origin, &target, || format!("the extrapolation of jump {}", st.jumps + 1))?;
         // The boundaries (the MD plate) follow the same law.
         let mut series = vec![0.0; n.len()];

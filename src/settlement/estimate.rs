@@ -13,6 +13,7 @@
 //! extrapolated with the same law but enters none of the measures.
 
 use super::law::{Coefficients, ResidualLaw};
+use super::smooth::Smoothing;
 use crate::error::{Error, Result};
 use crate::run::Configuration;
 
@@ -187,7 +188,7 @@ pub fn fit(law: &dyn ResidualLaw, training: &Training, fitted: usize, dim: usize
 /// each fitted coordinate moved by its trend's increment from `N_k` to `N_k + h`,
 /// the others (an MD sphere's orientation) kept at their last computed value.
 pub fn extrapolate(law: &dyn ResidualLaw, training: &Training, fit: &Fit, h: f64) -> Configuration {
-    extrapolate_within(law, training, fit, h, &[]).0
+    extrapolate_within(law, training, fit, h, &[], None).0
 }
 
 /// The length of each body's trend move over `h` cycles after the last of the
@@ -210,35 +211,43 @@ pub fn trend_moves(law: &dyn ResidualLaw, training: &Training, fit: &Fit, h: f64
 }
 
 /// [`extrapolate`] with a bound on each body's move: the fitted increments of
-/// body `b` are scaled down together (the move keeps its direction) so that its
-/// translation from the last computed configuration is at most `max_move[b]`
-/// (m); `0` holds the body where it is. An empty `max_move` bounds nothing.
-/// Also returns how many bodies the bound moved less than their trend (held
-/// bodies with a trend included).
+/// body `b` (smoothed over its neighbours first if `smoothing` is given:
+/// [`Smoothing`]) are scaled down together (the move keeps its direction) so
+/// that its translation from the last computed configuration is at most
+/// `max_move[b]` (m); `0` holds the body where it is. An empty `max_move`
+/// bounds nothing. Also returns how many bodies the bound moved less than
+/// their trend (held bodies with a trend included).
 ///
 /// # Panics
-/// If `max_move` is neither empty nor one value per body.
+/// If `max_move` is neither empty nor one value per body, or `smoothing` was
+/// built for other bodies.
 pub fn extrapolate_within(
     law: &dyn ResidualLaw,
     training: &Training,
     fit: &Fit,
     h: f64,
     max_move: &[f64],
+    smoothing: Option<&Smoothing>,
 ) -> (Configuration, usize) {
     let last = training.configurations.last().expect("a fitted window has points");
     let n_last = *training.cycles.last().expect("a fitted window has points");
     let dof = last.dof;
     assert!(max_move.is_empty() || max_move.len() == last.len(), "one bound per body");
-    let mut out = last.clone();
-    let mut moved = vec![0.0; fit.fitted];
-    let mut limited = 0;
-    for b in 0..last.len() {
-        for (d, m) in moved.iter_mut().enumerate().take(fit.fitted) {
+    let mut moved = vec![0.0; last.len() * fit.fitted];
+    for (b, m) in moved.chunks_mut(fit.fitted).enumerate() {
+        for (d, md) in m.iter_mut().enumerate() {
             let at = b * dof + d;
             let u_last = last.q[at] - training.origin.q[at];
-            *m = law.extrapolate(&fit.coefficients[b * fit.fitted + d], n_last, u_last, h) - u_last;
+            *md = law.extrapolate(&fit.coefficients[b * fit.fitted + d], n_last, u_last, h) - u_last;
         }
-        let length = moved[..fit.dim].iter().map(|m| m * m).sum::<f64>().sqrt();
+    }
+    if let Some(s) = smoothing {
+        s.apply(&mut moved, fit.fitted, fit.dim);
+    }
+    let mut out = last.clone();
+    let mut limited = 0;
+    for (b, m) in moved.chunks(fit.fitted).enumerate() {
+        let length = m[..fit.dim].iter().map(|m| m * m).sum::<f64>().sqrt();
         let scale = match max_move.get(b) {
             Some(&bound) if length > bound => {
                 limited += 1;
@@ -246,8 +255,8 @@ pub fn extrapolate_within(
             }
             _ => 1.0,
         };
-        for (d, m) in moved.iter().enumerate().take(fit.fitted) {
-            out.q[b * dof + d] += scale * m;
+        for (d, md) in m.iter().enumerate() {
+            out.q[b * dof + d] += scale * md;
         }
     }
     (out, limited)

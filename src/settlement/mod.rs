@@ -25,6 +25,7 @@ pub mod figures;
 pub mod file;
 pub mod law;
 pub mod relax;
+pub mod smooth;
 
 pub use driver::{
     Accelerated, Acceleration, AccelerationOutcome, AccelerationProgress, AccelerationSummary, Adaptive, JumpRow, Law,
@@ -37,3 +38,4 @@ pub use estimate::{
 pub use file::run_file;
 pub use law::{law_named, Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
 pub use relax::{minimise, Functional, Method, RelaxReport, RelaxSettings};
+pub use smooth::Smoothing;

@@ -117,6 +117,11 @@ pub struct Accelerate {
     /// The largest move a jump may give a body, as a fraction of its size;
     /// `None`: [`crate::settlement::Acceleration::EXTRAPOLATION_LIMIT`].
     pub extrapolation_limit: Option<f64>,
+    /// Smooth each jump's moves over the neighbours within a few of this
+    /// length (m); `None`: every body on its own fit.
+    pub smoothing_length: Option<f64>,
+    /// Computed cycles after each jump before the window's data start; `None`: 1.
+    pub settle_cycles: Option<u64>,
     /// A full run of the same loaded sample (its folder) to measure the errors
     /// against: `errors.csv` and its curve on the settlement figure.
     pub reference: Option<PathBuf>,
@@ -144,6 +149,8 @@ impl Accelerate {
                 .map(crate::scene::common::RelaxTolerance::Length),
             settlement_body: body,
             extrapolation_limit: self.extrapolation_limit,
+            smoothing_length: self.smoothing_length,
+            settle_cycles: self.settle_cycles,
             ..Default::default()
         }
     }
