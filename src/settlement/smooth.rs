@@ -222,7 +222,7 @@ mod tests {
         // series at this ℓ is about 1e-3 of the plain sum).
         let p = lattice(12, 2);
         let s = Smoothing::new(&bodies(&p), 2, 1.5e-3, &[]);
-        let rattle = |b: usize| if (b / 12 + b % 12) % 2 == 0 { 1e-6 } else { -1e-6 };
+        let rattle = |b: usize| if (b / 12 + b % 12).is_multiple_of(2) { 1e-6 } else { -1e-6 };
         let mut moves: Vec<f64> = (0..p.len()).flat_map(|b| [0.0, -5e-6 + rattle(b), 0.0]).collect();
         s.apply(&mut moves, 3, 2);
         for b in (0..p.len()).filter(|b| (5..7).contains(&(b / 12)) && (5..7).contains(&(b % 12))) {
