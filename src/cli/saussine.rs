@@ -330,9 +330,9 @@ pub(crate) struct AccelerateArgs {
     /// move; default 0.25; inf: no bound.
     #[arg(long, value_name = "FRACTION", requires = "accelerate")]
     extrapolation_limit: Option<f64>,
-    /// Smooth each jump's moves: every body moved by the Gaussian-weighted mean
-    /// of its neighbours' fitted moves, with this length (m; cut at 3 times it);
-    /// default: every body on its own fit (the paper).
+    /// Smooth each jump's moves: every body moved by the local linear fit of its
+    /// neighbours' fitted moves, Gaussian weights of this length (m; cut at 3
+    /// times it); default: every body on its own fit (the paper).
     #[arg(long, value_name = "M", requires = "accelerate")]
     smoothing_length: Option<f64>,
     /// Computed cycles after each jump through which the landing re-seats: the

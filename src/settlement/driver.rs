@@ -167,7 +167,7 @@ pub struct Acceleration {
     #[serde(default = "default_extrapolation_limit")]
     pub extrapolation_limit: f64,
     /// Smooth each jump's moves over the neighbours within a few of this
-    /// length (m, > 0): the Gaussian-weighted mean of [`Smoothing`], the
+    /// length (m, > 0): the local linear kernel fit of [`Smoothing`], the
     /// settlement body and the bodies without contact left out; `None` (the
     /// paper): every body on its own fit (docs/settlement-driver.md, "Smoothed
     /// field").
@@ -592,13 +592,13 @@ impl<E: Engine> Accelerated<E> {
                 // After a jump the first `settle_cycles − 1` computed cycles are
                 // not data (the landing re-seats in them); the next one starts a
                 // new segment.
-                let after_jump = if st.jumps > 0 { Some(st.since_jump + 1) } else { None };
-                match after_jump {
-                    Some(n) if n < self.spec.settle_cycles => {}
-                    Some(n) if n == self.spec.settle_cycles => st.window.push_segment(st.cycle as f64, c),
-                    _ => st.window.push(st.cycle as f64, c),
-                }
+                let after_jump = (st.jumps > 0).then_some(st.since_jump + 1);
                 if after_jump.is_none_or(|n| n >= self.spec.settle_cycles) {
+                    if after_jump == Some(self.spec.settle_cycles) {
+                        st.window.push_segment(st.cycle as f64, c);
+                    } else {
+                        st.window.push(st.cycle as f64, c);
+                    }
                     st.window_settlement.push(s);
                     st.window_boundaries.push(b);
                 }

@@ -1,5 +1,5 @@
 //! A spatially smoothed extrapolation field: each body's fitted move over a
-//! jump replaced by the Gaussian-weighted mean of the moves of the bodies
+//! jump replaced by the local linear kernel fit of the moves of the bodies
 //! around it (an option of this crate, not of Karrech et al. 2007, whose §3
 //! extrapolates every body on its own fit).
 //!

@@ -89,7 +89,7 @@ fn write_load_scene(
     cycles: u32,
     start: &Start,
     stage: &Stage,
-    settlement: impl FnOnce(&crate::md::MdSystem) -> Option<crate::scene::common::SettlementSection>,
+    settlement: Option<crate::scene::common::SettlementSection>,
 ) -> Result<std::path::PathBuf> {
     let (sys, spec) = deposited(from)?;
     start.perturbation.check()?;
@@ -97,7 +97,7 @@ fn write_load_scene(
     let (path, written) = stage.write_scene("load.toml", || {
         let mut scene = karrech::loading_scene(&spec, &spheres_of(&sys), loading, cycles, stage.every)?;
         record = Some(perturb_md_scene(&mut scene, &start.perturbation, start.replica)?);
-        scene.settlement = settlement(&sys);
+        scene.settlement = settlement;
         scene.validate()?;
         Ok(scene)
     })?;
@@ -126,7 +126,7 @@ pub fn load(
     display: &dyn RunDisplay,
 ) -> Result<StageOutcome> {
     crate::io::figures::require()?; // the stage ends with its figures
-    let scene = write_load_scene(from, loading, cycles, start, stage, |_| None)?;
+    let scene = write_load_scene(from, loading, cycles, start, stage, None)?;
     let run = stage.run(&scene, display, "karrech load")?;
     Ok(StageOutcome { run, written: load_figures(&stage.out)? })
 }
@@ -150,9 +150,8 @@ pub fn load_accelerated(
     progress: &mut dyn FnMut(&crate::settlement::AccelerationProgress),
 ) -> Result<crate::settlement::AccelerationSummary> {
     crate::io::figures::require()?;
-    let path = write_load_scene(from, loading, cycles, start, stage, |_| {
-        Some(accelerate.section(Some("plate".into()), None))
-    })?;
+    let section = accelerate.section(Some("plate".into()), None);
+    let path = write_load_scene(from, loading, cycles, start, stage, Some(section))?;
     let opts = crate::run::RunOptions { figures: true, ..stage.run.clone() };
     accelerate.run_scene(&path, &stage.out, &opts, progress)
 }
