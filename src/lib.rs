@@ -63,6 +63,7 @@ pub mod geometry;
 pub mod io;
 pub mod md;
 pub mod nscd;
+pub mod plane;
 pub mod run;
 pub mod scenarios;
 pub mod scene;

@@ -11,6 +11,9 @@
 //! integrator (second kick or corrector) → servo walls. [`measure`] turns a state
 //! into the papers' quantities.
 //!
+//! [`planar`] runs the same contact laws on the 2D bodies of [`crate::plane`]
+//! (the NSCD engine's scenes) with the shadow-overlap detection.
+//!
 //! A system built in code: spheres pushed with [`Particles::add_sphere`] (mass
 //! `ρ 4/3 π r³` and inertia `2/5 m r²` computed), walls ([`Wall::new`]), a law for
 //! every pair of materials that can touch ([`LawTable`], [`PairLaw`]; a pair left
@@ -55,6 +58,7 @@ pub mod law;
 pub mod measure;
 pub mod neighbours;
 pub mod particles;
+pub mod planar;
 pub mod relax;
 pub mod system;
 pub mod walls;

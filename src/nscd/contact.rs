@@ -26,11 +26,11 @@
 //! `U_T⁺ + e_t U_T⁻`.
 
 use super::coulomb::Delassus;
-use crate::geometry::{cross, perp, Vec2};
+use crate::geometry::{perp, Vec2};
 use serde::{Deserialize, Serialize};
 
-/// Identifies a contact across steps: candidate, antagonist, feature pair.
-pub type ContactKey = (u32, u32, u32);
+pub use crate::plane::detection::ContactKey;
+pub use crate::plane::springs::{dot3, gen_dir};
 
 /// The solver's record of one contact: contiguous, everything one update needs.
 #[derive(Debug, Clone, Copy, Default)]
@@ -98,22 +98,9 @@ impl Default for ContactLaw {
     }
 }
 
-/// Dot product of two generalized 3-vectors, e.g. `h_n · u` = the normal velocity
-/// contribution of one body (m/s when `u = (v_x, v_y, ω)`).
-#[inline(always)]
-pub fn dot3(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
 #[inline(always)]
 fn wdot(h: &[f64; 3], im: &[f64; 3], g: &[f64; 3]) -> f64 {
     h[0] * im[0] * g[0] + h[1] * im[1] * g[1] + h[2] * im[2] * g[2]
-}
-
-/// Generalized direction `(d_x, d_y, r × d)`.
-#[inline(always)]
-pub fn gen_dir(r: Vec2, d: Vec2) -> [f64; 3] {
-    [d.x, d.y, cross(r, d)]
 }
 
 impl ContactRow {

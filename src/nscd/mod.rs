@@ -40,23 +40,21 @@
 //! ```
 
 pub mod apgd;
-pub mod bodies;
-pub mod broad_phase;
 pub mod contact;
 pub mod coulomb;
 pub mod criterion;
-pub mod detection;
 pub mod engine;
-pub mod loads;
 pub mod measure;
-pub mod narrow_phase;
 pub mod nlgs;
 pub mod relax;
-pub mod shadow_overlap;
 pub mod split;
 pub mod stepper;
 pub mod sublayer;
 pub mod system;
+
+// The bodies, loads and detection shared with the 2D MD engine ([`crate::plane`]),
+// under their former paths.
+pub use crate::plane::{bodies, broad_phase, detection, loads, narrow_phase, shadow_overlap};
 
 pub use bodies::{Bodies, BodyInfo};
 pub use contact::ContactLaw;

@@ -11,20 +11,8 @@ use super::sublayer::{Spring, SpringRow};
 use crate::geometry::Vec2;
 use serde::{Deserialize, Serialize};
 
-/// Default alert distance of a scene, as a fraction of the smallest inner
-/// radius of the non-fixed bodies (of all bodies if none moves) (m/m).
-pub const DEFAULT_ALERT_FRACTION: f64 = 0.01;
-
-/// [`DEFAULT_ALERT_FRACTION`] × the smallest inner radius (m) of the bodies given
-/// as `(fixed, inner radius)`: of the non-fixed ones, or of all if none moves
-/// (infinite if there is none). Scenes and [`super::Bodies::default_alert_distance`].
-pub(crate) fn default_alert_distance(bodies: impl Iterator<Item = (bool, f64)> + Clone) -> f64 {
-    let inner = |mobile_only: bool| {
-        bodies.clone().filter(|&(fixed, _)| !mobile_only || !fixed).map(|(_, r)| r).fold(f64::INFINITY, f64::min)
-    };
-    let r = if bodies.clone().any(|(fixed, _)| !fixed) { inner(true) } else { inner(false) };
-    DEFAULT_ALERT_FRACTION * r
-}
+pub(crate) use crate::plane::bodies::default_alert_distance;
+pub use crate::plane::bodies::DEFAULT_ALERT_FRACTION;
 
 /// Time-stepping parameters. [`NscdParams::default`] gives the defaults of
 /// scenes (`[simulation]` and `[nscd]` of `docs/scene-format.md`), but for the
@@ -51,7 +39,13 @@ pub struct NscdParams {
 
 impl Default for NscdParams {
     fn default() -> Self {
-        Self { dt: 1e-3, theta: 0.5, gravity: [0.0, -9.81], alert_distance: 1e-4, nlgs: NlgsSettings::default() }
+        Self {
+            dt: 1e-3,
+            theta: 0.5,
+            gravity: [0.0, -9.81],
+            alert_distance: crate::plane::bodies::EMPTY_ALERT_DISTANCE,
+            nlgs: NlgsSettings::default(),
+        }
     }
 }
 
@@ -110,25 +104,7 @@ pub struct StepStats {
     pub kinetic_energy: f64,
 }
 
-/// A contact as seen from outside, with its force over the last step.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct ContactInfo {
-    /// Body index of the candidate (the body the force acts on).
-    pub candidate: usize,
-    /// Body index of the antagonist.
-    pub antagonist: usize,
-    /// Contact point at `q_m` (m).
-    pub point: [f64; 2],
-    /// Unit normal towards the candidate, at `q_m`.
-    pub normal: [f64; 2],
-    /// Gap at `q_m` (m).
-    pub gap: f64,
-    /// Mean normal and tangential force on the candidate over the step (N).
-    pub r_n: f64,
-    /// Mean tangential force on the candidate over the step (N), along the
-    /// normal turned by +90°.
-    pub r_t: f64,
-}
+pub use crate::plane::ContactInfo;
 
 /// Reused buffers.
 #[derive(Debug, Clone, Default)]

@@ -1,5 +1,6 @@
-//! Contact detection at the intermediate configuration `q_m` (Saussine et al.
-//! 2006, §2.2–2.3): places every shape in the world, predetects pairs on the
+//! Contact detection of the 2D engines (Saussine et al. 2006, §2.2–2.3; the
+//! NSCD engine runs it at the intermediate configuration `q_m`, the 2D MD engine
+//! at every force evaluation): places every shape in the world, predetects pairs on the
 //! tile grid ([`super::broad_phase`]), and runs the narrow phase
 //! ([`super::narrow_phase`]) on each pair. Contacts come out sorted by key
 //! (candidate, antagonist, feature), so the solver order — and therefore every
@@ -17,10 +18,12 @@
 
 use super::bodies::Bodies;
 use super::broad_phase::{Aabb, Grid};
-use super::contact::ContactKey;
 use super::narrow_phase::{detect, Placed};
 use super::shadow_overlap::{ContactPoint, PolygonView};
 use crate::geometry::{rotate, Shape, Vec2};
+
+/// Identifies a contact across steps: candidate, antagonist, feature pair.
+pub type ContactKey = (u32, u32, u32);
 
 /// Reused detection buffers.
 #[derive(Debug, Clone, Default)]

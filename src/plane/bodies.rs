@@ -1,4 +1,4 @@
-//! The rigid body set of the NSCD engine, stored as flat arrays.
+//! The rigid body set of the 2D engines (NSCD and planar MD), stored as flat arrays.
 //!
 //! Each body has the generalized coordinates `q = (x, y, θ)` of its centre of
 //! mass and orientation, and velocities `u = (vx, vy, ω)` (Saussine et al. 2006,
@@ -192,7 +192,26 @@ pub fn centroid_state(
     (q, [vc.x, vc.y, spin])
 }
 
-/// The body collection, with hot arrays laid out for the solver.
+/// Default alert distance of a scene, as a fraction of the smallest inner
+/// radius of the non-fixed bodies (of all bodies if none moves) (m/m).
+pub const DEFAULT_ALERT_FRACTION: f64 = 0.01;
+
+/// [`DEFAULT_ALERT_FRACTION`] × the smallest inner radius (m) of the bodies given
+/// as `(fixed, inner radius)`: of the non-fixed ones, or of all if none moves
+/// (infinite if there is none). Scenes of both 2D engines and [`Bodies::default_alert_distance`].
+pub fn default_alert_distance(bodies: impl Iterator<Item = (bool, f64)> + Clone) -> f64 {
+    let inner = |mobile_only: bool| {
+        bodies.clone().filter(|&(fixed, _)| !mobile_only || !fixed).map(|(_, r)| r).fold(f64::INFINITY, f64::min)
+    };
+    let r = if bodies.clone().any(|(fixed, _)| !fixed) { inner(true) } else { inner(false) };
+    DEFAULT_ALERT_FRACTION * r
+}
+
+/// The alert distance (m) of a body set without bodies (and the NSCD engine's
+/// default for a system built in code): 0.1 mm.
+pub const EMPTY_ALERT_DISTANCE: f64 = 1e-4;
+
+/// The body collection, with hot arrays laid out for the solvers.
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct Bodies {
     /// Static description of each body.
@@ -252,15 +271,15 @@ impl Bodies {
     }
 
     /// The alert distance (m) a scene gets by default:
-    /// [`super::system::DEFAULT_ALERT_FRACTION`] × the smallest inner radius of the
+    /// [`DEFAULT_ALERT_FRACTION`] × the smallest inner radius of the
     /// non-fixed bodies (of all bodies if none moves); the default of
-    /// [`super::NscdParams`] (1e-4 m) if there is no body. Set it on a system built
+    /// [`EMPTY_ALERT_DISTANCE`] (1e-4 m) if there is no body. Set it on a system built
     /// in code with `sys.params.alert_distance = sys.bodies.default_alert_distance()`.
     pub fn default_alert_distance(&self) -> f64 {
         if self.is_empty() {
-            return super::NscdParams::default().alert_distance;
+            return EMPTY_ALERT_DISTANCE;
         }
-        super::system::default_alert_distance(self.info.iter().map(|b| (b.fixed, b.shape.inner_radius())))
+        default_alert_distance(self.info.iter().map(|b| (b.fixed, b.shape.inner_radius())))
     }
 
     /// Kinetic energy ½ Σ (m v² + I ω²) of all non-fixed bodies (J).
