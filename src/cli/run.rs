@@ -52,6 +52,11 @@ pub struct RunArgs {
     /// (duration = STEPS · dt; the scene copy in DIR records it).
     #[arg(long, value_name = "STEPS")]
     steps: Option<u64>,
+    /// Run a 2D scene on this engine instead of its own: `nscd` (rigid contacts)
+    /// or `md` (soft contacts, the scene's `[soft]` table: stiffness and time
+    /// step); the scene copy in DIR records it. A 3D MD scene runs on `md` only.
+    #[arg(long, value_name = "ENGINE", value_parser = ["nscd", "md"])]
+    engine: Option<String>,
 }
 
 /// `ballast run`.
@@ -68,6 +73,7 @@ pub fn main(a: RunArgs) -> Result<(), Failure> {
             (None, Some(n)) => Some(RunLength::Steps(n)),
             (None, None) => None,
         },
+        engine: a.engine,
     };
     // A scene with `[settlement]` runs the settlement-acceleration procedure.
     let bar = super::cycle_bar(a.quiet);

@@ -89,7 +89,7 @@ pub fn write_atomic(path: &Path, text: &str) -> Result<()> {
 pub struct RunInfo {
     /// Random seed of the scene.
     pub seed: u64,
-    /// Engine name (`"nscd"` or `"md"`).
+    /// Engine name (`"nscd"`, `"md"` or `"md2d"`, the planar MD engine).
     pub engine: String,
     /// Version of `ballast` that made the run.
     pub version: String,
@@ -97,6 +97,10 @@ pub struct RunInfo {
     pub steps: u64,
     /// Time step (s).
     pub dt: f64,
+    /// What the scene resolved to that the scene does not say (the planar MD
+    /// engine: its stiffness and time step, [`crate::scene::SoftModelInfo`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<serde_json::Value>,
 }
 
 impl RunInfo {

@@ -68,7 +68,7 @@ pub fn draw_run_figures(dir: &Path) -> Result<RunFigures> {
     }
     let fin = read_final(dir)?;
     match fin.engine.as_str() {
-        "nscd" => nscd_figures(dir, None),
+        "nscd" | "md2d" => nscd_figures(dir, None),
         "md" => super::md_figures::md_figures(dir),
         other => Err(Error::Scene(format!("{}: unknown engine '{other}'", dir.join(files::FINAL).display()))),
     }

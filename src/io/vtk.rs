@@ -1,5 +1,5 @@
-//! VTK snapshots for ParaView: the bodies and the contact force network of an
-//! NSCD [`System`], the spheres of an MD [`MdSystem`], and a `.pvd` collection
+//! VTK snapshots for ParaView: the bodies and the contact force network of a
+//! 2D system (NSCD [`crate::nscd::System`] or planar MD), the spheres of an MD [`MdSystem`], and a `.pvd` collection
 //! that animates them.
 //!
 //! # Files
@@ -53,7 +53,7 @@
 //!
 //! # Contacts file
 //!
-//! The force network of the last step ([`System::contact_forces`]): points are
+//! The force network of the last step ([`PlaneSystem::plane_contacts`]): points are
 //! the centres of mass of all bodies (point `i` is body `i`), and each contact is
 //! one line cell (`LINES` / `<Lines>`) from its candidate's centre of mass to
 //! its antagonist's. No point data. Cell data:
@@ -101,7 +101,7 @@ use super::io_error;
 use crate::error::Result;
 use crate::geometry::{perp, rotate, Shape, Vec2};
 use crate::md::MdSystem;
-use crate::nscd::System;
+use crate::plane::outputs::PlaneSystem;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -141,9 +141,9 @@ impl Format {
 /// vertices (m) and the cell arrays `body_id`, `fixed`, `velocity` (m/s), `spin`
 /// (rad/s) and `radius` (m); see the [module documentation](self). The format
 /// follows the extension: `.vtk` legacy, `.vtp` XML.
-pub fn write_bodies(path: &Path, sys: &System) -> Result<()> {
+pub fn write_bodies(path: &Path, sys: &impl PlaneSystem) -> Result<()> {
     let format = Format::from_path(path)?;
-    let title = format!("ballast NSCD bodies, step {}, time {:e} s", sys.step, sys.time);
+    let title = format!("ballast 2D bodies, step {}, time {:e} s", sys.plane_step(), sys.plane_time());
     write_file(path, &render(&bodies_data(sys), format, &title))
 }
 
@@ -153,9 +153,9 @@ pub fn write_bodies(path: &Path, sys: &System) -> Result<()> {
 /// (N), `gap` (m), `force` (N), `normal` and `point` (m); see the
 /// [module documentation](self). The format follows the extension: `.vtk`
 /// legacy, `.vtp` XML.
-pub fn write_contacts(path: &Path, sys: &System) -> Result<()> {
+pub fn write_contacts(path: &Path, sys: &impl PlaneSystem) -> Result<()> {
     let format = Format::from_path(path)?;
-    let title = format!("ballast NSCD contacts, step {}, time {:e} s", sys.step, sys.time);
+    let title = format!("ballast 2D contacts, step {}, time {:e} s", sys.plane_step(), sys.plane_time());
     write_file(path, &render(&contacts_data(sys), format, &title))
 }
 
@@ -266,12 +266,12 @@ impl PvdCollection {
     /// step number, 9 digits or more) for the current state of `sys`, adds them
     /// at time `sys.time` (s) and returns their paths. The `.pvd` itself is
     /// written by [`PvdCollection::write`].
-    pub fn write_snapshot(&mut self, dir: &Path, sys: &System) -> Result<(PathBuf, PathBuf)> {
-        let bodies = dir.join(format!("bodies_{:09}.vtp", sys.step));
-        let contacts = dir.join(format!("contacts_{:09}.vtp", sys.step));
+    pub fn write_snapshot(&mut self, dir: &Path, sys: &impl PlaneSystem) -> Result<(PathBuf, PathBuf)> {
+        let bodies = dir.join(format!("bodies_{:09}.vtp", sys.plane_step()));
+        let contacts = dir.join(format!("contacts_{:09}.vtp", sys.plane_step()));
         write_bodies(&bodies, sys)?;
         write_contacts(&contacts, sys)?;
-        self.push(sys.time, bodies.clone(), contacts.clone());
+        self.push(sys.plane_time(), bodies.clone(), contacts.clone());
         Ok((bodies, contacts))
     }
 
@@ -460,8 +460,8 @@ impl PolyData {
     }
 }
 
-fn bodies_data(sys: &System) -> PolyData {
-    let b = &sys.bodies;
+fn bodies_data(sys: &impl PlaneSystem) -> PolyData {
+    let b = sys.plane_bodies();
     let mut d = PolyData {
         points: Vec::new(),
         kind: CellKind::Polys,
@@ -503,8 +503,8 @@ fn bodies_data(sys: &System) -> PolyData {
     d
 }
 
-fn contacts_data(sys: &System) -> PolyData {
-    let contacts: Vec<_> = sys.contact_forces().collect();
+fn contacts_data(sys: &impl PlaneSystem) -> PolyData {
+    let contacts = sys.plane_contacts();
     let mut connectivity = Vec::with_capacity(2 * contacts.len());
     for c in &contacts {
         connectivity.extend([c.candidate, c.antagonist]);
@@ -515,7 +515,7 @@ fn contacts_data(sys: &System) -> PolyData {
         [f.x, f.y, 0.0]
     };
     PolyData {
-        points: sys.bodies.q.iter().map(|q| [q[0], q[1], 0.0]).collect(),
+        points: sys.plane_bodies().q.iter().map(|q| [q[0], q[1], 0.0]).collect(),
         kind: CellKind::Lines,
         connectivity,
         offsets: (1..=contacts.len()).map(|k| 2 * k).collect(),

@@ -131,49 +131,7 @@ pub fn solid_fraction(sys: &System, grains: &[usize], window: [f64; 4]) -> f64 {
     parts.map(|p| clipped_area(&p, window)).sum::<f64>() / area
 }
 
-/// Coordination of a set of grains.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Coordination {
-    /// Mean number of force-carrying neighbours of the non-rattler grains
-    /// (neighbours: grains or boundary bodies; a pair touching along an edge,
-    /// with two contact points, counts once).
-    pub z: f64,
-    /// Fraction of the grains that are rattlers (fewer than 2 force-carrying neighbours).
-    pub rattlers: f64,
-}
-
-/// Coordination number of `grains` over the last step: a neighbour counts when
-/// the pair's total normal force exceeds `threshold` (N).
-pub fn coordination(sys: &System, grains: &[usize], threshold: f64) -> Coordination {
-    let count = neighbour_counts(sys, threshold);
-    let active: Vec<usize> = grains.iter().map(|&i| count[i]).filter(|&k| k >= 2).collect();
-    let z = if active.is_empty() { 0.0 } else { active.iter().sum::<usize>() as f64 / active.len() as f64 };
-    let rattlers = if grains.is_empty() { 0.0 } else { 1.0 - active.len() as f64 / grains.len() as f64 };
-    Coordination { z, rattlers }
-}
-
-/// Per body (every body of the system, fixed ones too), the number of bodies it
-/// touches with a pair force `Σ r_n` (summed over the pair's contact points,
-/// mean force of the last step, N) above `threshold`.
-pub fn neighbour_counts(sys: &System, threshold: f64) -> Vec<usize> {
-    let n = sys.bodies.len();
-    // Contacts come sorted by (candidate, antagonist, feature): sum each pair's points.
-    let mut pairs: Vec<(usize, usize, f64)> = Vec::new();
-    for c in sys.contact_forces() {
-        match pairs.last_mut() {
-            Some(p) if p.0 == c.candidate && p.1 == c.antagonist => p.2 += c.r_n,
-            _ => pairs.push((c.candidate, c.antagonist, c.r_n)),
-        }
-    }
-    let mut count = vec![0usize; n];
-    for &(a, b, f) in &pairs {
-        if f > threshold {
-            count[a] += 1;
-            count[b] += 1;
-        }
-    }
-    count
-}
+pub use crate::plane::outputs::{coordination, neighbour_counts, Coordination};
 
 #[cfg(test)]
 mod tests {

@@ -46,7 +46,6 @@ pub mod criterion;
 pub mod engine;
 pub mod measure;
 pub mod nlgs;
-pub mod relax;
 pub mod split;
 pub mod stepper;
 pub mod sublayer;
@@ -54,7 +53,7 @@ pub mod system;
 
 // The bodies, loads and detection shared with the 2D MD engine ([`crate::plane`]),
 // under their former paths.
-pub use crate::plane::{bodies, broad_phase, detection, loads, narrow_phase, shadow_overlap};
+pub use crate::plane::{bodies, broad_phase, detection, loads, narrow_phase, relax, shadow_overlap};
 
 pub use bodies::{Bodies, BodyInfo};
 pub use contact::ContactLaw;

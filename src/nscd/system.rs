@@ -274,49 +274,21 @@ impl System {
 impl System {
     /// The unit vector against gravity (`+y` without gravity).
     fn up(&self) -> [f64; 2] {
-        let g = self.params.gravity;
-        let n = g[0].hypot(g[1]);
-        if n > 0.0 {
-            [-g[0] / n, -g[1] / n]
-        } else {
-            [0.0, 1.0]
-        }
+        crate::plane::bodies::up(self.params.gravity)
     }
 
     /// The lowest point of the non-fixed bodies along `−g` (m; their bounding
     /// circles), 0 if there is none.
     pub fn lowest_point(&self) -> f64 {
-        let up = self.up();
-        let low = (0..self.bodies.len())
-            .filter(|&i| !self.bodies.info[i].fixed)
-            .map(|i| {
-                let q = self.bodies.q[i];
-                q[0] * up[0] + q[1] * up[1] - self.bodies.info[i].shape.bounding_radius()
-            })
-            .fold(f64::INFINITY, f64::min);
-        if low.is_finite() {
-            low
-        } else {
-            0.0
-        }
+        self.bodies.lowest_point(self.up())
     }
 
     /// Gravitational energy `Σ m |g| h` of the non-fixed bodies (J), `h` the
     /// height of the centre of mass above [`System::gravity_reference`] (the
     /// lowest point now if no step has set it).
     pub fn gravitational_energy(&self) -> f64 {
-        let g = self.params.gravity;
-        let gn = g[0].hypot(g[1]);
-        if gn == 0.0 {
-            return 0.0;
-        }
-        let up = self.up();
         let reference = self.gravity_reference.unwrap_or_else(|| self.lowest_point());
-        let b = &self.bodies;
-        (0..b.len())
-            .filter(|&i| !b.info[i].fixed)
-            .map(|i| b.info[i].mass * gn * (b.q[i][0] * up[0] + b.q[i][1] * up[1] - reference))
-            .sum()
+        self.bodies.gravitational_energy(self.params.gravity, reference)
     }
 
     /// Elastic energy of the sublayer springs (J): `½ k_N L0 ε²` each (law (17),
@@ -374,31 +346,11 @@ impl System {
     /// clock. The message names what is wrong.
     pub fn check_state(&self) -> crate::Result<()> {
         let bad = |msg: String| Err(crate::Error::Scene(msg));
-        let b = &self.bodies;
-        let n = b.len();
-        if b.info.len() != n || b.u.len() != n || b.inv_m.len() != n {
-            return bad(format!(
-                "bodies: {} positions, {} velocities, {} inverse masses, {} descriptions",
-                n,
-                b.u.len(),
-                b.inv_m.len(),
-                b.info.len()
-            ));
-        }
-        if let Some(i) = (0..n).find(|&i| b.q[i].iter().chain(&b.u[i]).chain(&b.inv_m[i]).any(|x| !x.is_finite())) {
-            return bad(format!("body {i}: a position, velocity or inverse mass is not finite"));
-        }
+        crate::plane::outputs::check_bodies(&self.bodies, self.materials, &self.springs)?;
         if self.laws.len() != self.materials * self.materials {
             return bad(format!("{} contact laws for {} materials", self.laws.len(), self.materials));
         }
-        if let Some(i) = (0..n).find(|&i| b.info[i].material >= self.materials) {
-            return bad(format!("body {i}: material {} of {}", b.info[i].material, self.materials));
-        }
-        for (k, s) in self.springs.iter().enumerate() {
-            if s.a >= n || s.b.is_some_and(|j| j >= n) {
-                return bad(format!("spring {k}: body out of range ({n} bodies)"));
-            }
-        }
+        let n = self.bodies.len();
         if self.impulses.len() != self.contacts.len() {
             return bad(format!("{} warm-start impulses for {} contacts", self.impulses.len(), self.contacts.len()));
         }
@@ -422,32 +374,9 @@ impl System {
     /// energy.
     pub fn check_same_model(&self, fresh: &System) -> crate::Result<()> {
         let bad = |what: String| Err(crate::Error::Scene(format!("{what} differs from the scene's")));
-        if self.bodies.len() != fresh.bodies.len() {
-            return bad(format!("the number of bodies ({})", self.bodies.len()));
-        }
-        for (i, (a, b)) in self.bodies.info.iter().zip(&fresh.bodies.info).enumerate() {
-            if !same(a, b) {
-                return bad(format!("body {i} ('{}')", crate::scene::clip(&b.name)));
-            }
-        }
-        if self.springs.len() != fresh.springs.len() {
-            return bad(format!("the number of springs ({})", self.springs.len()));
-        }
-        for (k, (a, b)) in self.springs.iter().zip(&fresh.springs).enumerate() {
-            let a = super::Spring { impulse: 0.0, ..a.clone() };
-            let b = super::Spring { impulse: 0.0, ..b.clone() };
-            if !same(&a, &b) {
-                return bad(format!("spring {k}"));
-            }
-        }
+        crate::plane::outputs::check_same_bodies((&self.bodies, &self.springs), (&fresh.bodies, &fresh.springs))?;
         if self.materials != fresh.materials || !same(&self.laws, &fresh.laws) {
             return bad("the contact laws".into());
-        }
-        if let Some(i) = (0..self.bodies.len()).find(|&i| !same(&self.bodies.inv_m[i], &fresh.bodies.inv_m[i])) {
-            return bad(format!(
-                "the inverse masses of body {i} ('{}')",
-                crate::scene::clip(&fresh.bodies.info[i].name)
-            ));
         }
         if self.params != fresh.params {
             return bad("the [nscd] parameters or time step".into());
@@ -469,7 +398,27 @@ impl System {
     }
 }
 
-/// Whether `a` and `b` have the same serde form (static data of a model).
-pub(crate) fn same<T: Serialize>(a: &T, b: &T) -> bool {
-    serde_json::to_value(a).ok() == serde_json::to_value(b).ok()
+pub(crate) use crate::plane::outputs::same;
+
+impl System {
+    /// Removes the overlaps of the current configuration, moving the bodies as
+    /// little as possible in the metric of their masses ([`crate::plane::relax`]),
+    /// until the largest overlap is at most `settings.tolerance`; then writes the
+    /// result back as [`System::set_configuration`] does (velocities zeroed, warm
+    /// start forgotten). On an error the configuration is unchanged.
+    ///
+    /// # Errors
+    /// [`crate::Error::Scene`] for settings out of range or a held body that does not exist.
+    pub fn relax(
+        &mut self,
+        settings: &crate::settlement::RelaxSettings,
+    ) -> crate::Result<crate::settlement::RelaxReport> {
+        let (report, q) = crate::plane::relax::project(&self.bodies, settings)?;
+        let mut c = crate::run::Engine::configuration(self);
+        for (k, &i) in c.bodies.clone().iter().enumerate() {
+            c.body_mut(k).copy_from_slice(&q[i]);
+        }
+        self.set_configuration(&c)?;
+        Ok(report)
+    }
 }

@@ -291,4 +291,46 @@ impl Bodies {
             .map(|(b, u)| 0.5 * (b.mass * (u[0] * u[0] + u[1] * u[1]) + b.inertia * u[2] * u[2]))
             .sum()
     }
+
+    /// The lowest point of the non-fixed bodies along `up` (m; their bounding
+    /// circles), 0 if there is none.
+    pub fn lowest_point(&self, up: [f64; 2]) -> f64 {
+        let low = (0..self.len())
+            .filter(|&i| !self.info[i].fixed)
+            .map(|i| {
+                let q = self.q[i];
+                q[0] * up[0] + q[1] * up[1] - self.info[i].shape.bounding_radius()
+            })
+            .fold(f64::INFINITY, f64::min);
+        if low.is_finite() {
+            low
+        } else {
+            0.0
+        }
+    }
+
+    /// Gravitational energy `Σ m |g| h` of the non-fixed bodies (J) under
+    /// `gravity` (m/s²), `h` the height of the centre of mass above `reference`
+    /// (m, along [`up`]).
+    pub fn gravitational_energy(&self, gravity: [f64; 2], reference: f64) -> f64 {
+        let gn = gravity[0].hypot(gravity[1]);
+        if gn == 0.0 {
+            return 0.0;
+        }
+        let up = up(gravity);
+        (0..self.len())
+            .filter(|&i| !self.info[i].fixed)
+            .map(|i| self.info[i].mass * gn * (self.q[i][0] * up[0] + self.q[i][1] * up[1] - reference))
+            .sum()
+    }
+}
+
+/// The unit vector against `gravity` (`+y` without gravity).
+pub fn up(gravity: [f64; 2]) -> [f64; 2] {
+    let n = gravity[0].hypot(gravity[1]);
+    if n > 0.0 {
+        [-gravity[0] / n, -gravity[1] / n]
+    } else {
+        [0.0, 1.0]
+    }
 }

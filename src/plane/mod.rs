@@ -11,6 +11,8 @@ pub mod broad_phase;
 pub mod detection;
 pub mod loads;
 pub mod narrow_phase;
+pub mod outputs;
+pub mod relax;
 pub mod shadow_overlap;
 pub mod springs;
 

@@ -27,7 +27,7 @@ pub use runner::{
 
 use crate::error::Result;
 use crate::scene::common::RecordedText;
-use crate::scene::{MdScene, Scene};
+use crate::scene::{scene_on, MdScene, Scene, SceneKind};
 use std::path::Path;
 
 /// Runs the scene file at `scene_path` (either engine: `[simulation] engine`)
@@ -45,8 +45,8 @@ pub fn run_file(
 ) -> Result<RunOutcome> {
     let text = Scene::read_text(scene_path)?;
     let name = scene_path.display().to_string();
-    match crate::scene::engine_of_named(&text, &name)?.as_str() {
-        "md" => {
+    match SceneKind::of(&text, &name, opts.engine.as_deref())? {
+        SceneKind::Md => {
             let mut scene = MdScene::from_toml_str_named(&text, &name)?;
             let text = scene.text_with_length(text, opts.length)?;
             let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts.clone() };
@@ -54,8 +54,18 @@ pub fn run_file(
             let restart: Restart<crate::md::MdSystem> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
             Runner::from_scene(system, plan, scene_path, text, Some(restart)).run(out, &opts, progress)
         }
-        _ => {
-            let mut scene = Scene::from_toml_str_named(&text, &name)?;
+        SceneKind::PlanarMd => {
+            let (mut scene, text) = scene_on(&text, &name, SceneKind::PlanarMd, opts.engine.is_some())?;
+            let (system, info) = scene.build_planar()?;
+            let text = scene.text_with_length(text, crate::scene::planar_length(opts.length, system.params.dt))?;
+            let plan = scene.plan_planar(system.params.dt)?;
+            let model = serde_json::to_value(info).map_err(|e| crate::Error::Io(std::io::Error::other(e)))?;
+            let restart: Restart<crate::md::planar::PlanarSystem> =
+                Box::new(move |sys| scene.with_bodies(&sys.bodies).to_toml_string());
+            Runner::from_scene(system, plan, scene_path, text, Some(restart)).with_model(model).run(out, opts, progress)
+        }
+        SceneKind::Nscd => {
+            let (mut scene, text) = scene_on(&text, &name, SceneKind::Nscd, opts.engine.is_some())?;
             let text = scene.text_with_length(text, opts.length)?;
             let (system, plan) = (scene.build()?, scene.plan()?);
             let restart: Restart<crate::nscd::System> = Box::new(move |sys| scene.with_state(sys).to_toml_string());

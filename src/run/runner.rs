@@ -108,6 +108,10 @@ pub struct RunOptions {
     /// tries); the scene copy in the output folder records it. `None`: the
     /// scene's own.
     pub length: Option<RunLength>,
+    /// A 2D scene run on this engine instead of its own (`ballast run --engine`):
+    /// `"nscd"` or `"md"` (the planar MD engine); the scene copy in the output
+    /// folder records it. `None`: the scene's own.
+    pub engine: Option<String>,
 }
 
 /// The length of a run that replaces a scene's `[simulation] duration`
@@ -132,6 +136,7 @@ impl Default for RunOptions {
             threads: default_threads(),
             figures: false,
             length: None,
+            engine: None,
         }
     }
 }
@@ -214,6 +219,8 @@ pub struct Runner<E: Engine> {
     plan: RunPlan,
     origin: Origin,
     restart: Option<Restart<E>>,
+    /// What the scene resolved to that the system does not say, for `run.json`.
+    model: Option<serde_json::Value>,
 }
 
 /// The state of a run in progress.
@@ -233,7 +240,14 @@ impl<E: Engine> Runner<E> {
     /// `text`; `restart` writes a system's state as a scene to restart from
     /// (`final_scene.toml`).
     pub fn from_scene(system: E, plan: RunPlan, path: &Path, text: String, restart: Option<Restart<E>>) -> Self {
-        Self { system, plan, origin: Origin::Scene { path: path.to_path_buf(), text }, restart }
+        Self { system, plan, origin: Origin::Scene { path: path.to_path_buf(), text }, restart, model: None }
+    }
+
+    /// The same run, with `model` (what the scene resolved to: the planar MD
+    /// engine's derived stiffness and time step) recorded in `run.json`.
+    pub fn with_model(mut self, model: serde_json::Value) -> Self {
+        self.model = Some(model);
+        self
     }
 
     /// A run of a system built in code. Its serde form and the plan's are written
@@ -246,7 +260,7 @@ impl<E: Engine> Runner<E> {
         }
         let json = serde_json::to_string(&Input { plan: &plan, system: &system })
             .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-        Ok(Self { system, plan, origin: Origin::Code { json }, restart: None })
+        Ok(Self { system, plan, origin: Origin::Code { json }, restart: None, model: None })
     }
 
     /// The plan of the run.
@@ -487,6 +501,7 @@ impl<E: Engine> Runner<E> {
             version: env!("CARGO_PKG_VERSION").to_string(),
             steps: self.plan.steps,
             dt: self.system.dt(),
+            model: self.model.clone(),
         };
         info.write(out)?;
         Ok(())

@@ -147,6 +147,7 @@ pub fn pentagon_deposit(spec: &DepositSpec) -> Result<Scene> {
         tangential_restitution: None,
     };
     validated(Scene {
+        soft: None,
         simulation: Simulation {
             engine: "nscd".into(),
             dt: spec.dt,

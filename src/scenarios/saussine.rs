@@ -318,6 +318,7 @@ pub fn sample_scene(spec: &SampleSpec) -> Result<Scene> {
         })
         .collect();
     validated(Scene {
+        soft: None,
         simulation: Simulation {
             engine: "nscd".into(),
             dt: spec.dt,

@@ -9,11 +9,11 @@
 //! ([`centroid_state`]). Bodies are made by [`BodyInfo::new`], as in code.
 
 use super::format::Scene;
-use super::validate::{check, shape_of};
+use super::validate::{check, shape_of, Checked};
 use crate::error::Result;
 use crate::geometry::{perp, rotate, Vec2};
 use crate::nscd::bodies::centroid_state;
-use crate::nscd::{BodyInfo, ContactLaw, Imposed, NscdParams, Spring, System};
+use crate::nscd::{Bodies, BodyInfo, ContactLaw, Imposed, NscdParams, Spring, System};
 
 impl Scene {
     /// Validates the scene and builds the NSCD system at time 0.
@@ -36,9 +36,16 @@ impl Scene {
             };
             sys.set_law(material(&c.between[0]), material(&c.between[1]), law);
         }
+        (sys.bodies, sys.springs) = self.build_bodies(&checked)?;
+        Ok(sys)
+    }
+
+    /// The bodies and springs of a validated scene (`checked`), as both 2D engines take them.
+    pub(crate) fn build_bodies(&self, checked: &Checked) -> Result<(Bodies, Vec<Spring>)> {
+        let (mut bodies, mut springs) = (Bodies::default(), Vec::new());
         let centroids: Vec<Vec2> = checked.bodies.iter().map(|b| b.centroid).collect();
         let thickness = self.simulation.thickness();
-        for (spec, body) in self.bodies.iter().zip(checked.bodies) {
+        for (spec, body) in self.bodies.iter().zip(checked.bodies.iter().cloned()) {
             let density = self.materials[body.material].density;
             let mut info = BodyInfo::new(spec.name.clone(), body.shape, body.material, density, thickness)?;
             if let Some(imp) = &spec.imposed {
@@ -52,11 +59,11 @@ impl Scene {
                 info = info.into_fixed();
             }
             let (q, u) = centroid_state(body.centroid, spec.position, spec.angle(), spec.velocity(), spec.spin());
-            sys.bodies.push(info, q, u);
+            bodies.push(info, q, u);
         }
-        for (spec, s) in self.springs.iter().zip(checked.springs) {
+        for (spec, s) in self.springs.iter().zip(checked.springs.iter()) {
             let rel = |i: usize, p: [f64; 2]| [p[0] - centroids[i].x, p[1] - centroids[i].y];
-            sys.springs.push(Spring {
+            springs.push(Spring {
                 a: s.a,
                 point_a: rel(s.a, s.point_a),
                 b: s.b,
@@ -72,7 +79,7 @@ impl Scene {
                 impulse: 0.0,
             });
         }
-        Ok(sys)
+        Ok((bodies, springs))
     }
 
     /// The same scene with every non-fixed body's `position`, `angle`,
@@ -87,6 +94,11 @@ impl Scene {
     /// warm start are not kept. If `sys` has fewer bodies than the scene, only
     /// the first ones are updated.
     pub fn with_state(&self, sys: &System) -> Scene {
+        self.with_bodies(&sys.bodies)
+    }
+
+    /// As [`Scene::with_state`], from the bodies of either 2D engine.
+    pub fn with_bodies(&self, bodies: &Bodies) -> Scene {
         let mut out = self.clone();
         let rest: Vec<Option<f64>> = match check(self) {
             Ok(c) => c.springs.iter().map(|s| Some(s.rest_length)).collect(),
@@ -98,10 +110,10 @@ impl Scene {
             }
         }
         for (i, body) in out.bodies.iter_mut().enumerate() {
-            if body.is_fixed() || i >= sys.bodies.len() {
+            if body.is_fixed() || i >= bodies.len() {
                 continue;
             }
-            let (q, u) = (sys.bodies.q[i], sys.bodies.u[i]);
+            let (q, u) = (bodies.q[i], bodies.u[i]);
             let (s, c) = q[2].sin_cos();
             let rc = rotate(centroid(body), c, s);
             let v = Vec2::new(u[0], u[1]) - u[2] * perp(rc);

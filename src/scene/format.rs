@@ -25,6 +25,10 @@ pub struct Scene {
     /// `[nscd]`: settings of the NSCD engine (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub nscd: Option<NscdSection>,
+    /// `[soft]`: stiffness and time step of the planar MD engine (optional; an
+    /// NSCD run ignores it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub soft: Option<super::soft::SoftSection>,
     /// `[output]`: output settings (optional).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output: Option<OutputSection>,

@@ -28,11 +28,16 @@ pub mod common;
 mod format;
 pub mod md;
 mod parse;
+mod soft;
 mod validate;
 mod write;
 
 pub use format::*;
 pub use md::MdScene;
+pub use soft::{
+    planar_length, scene_on, SceneKind, SoftDt, SoftModelInfo, SoftSection, DEFAULT_OVERLAP_RATIO,
+    DEFAULT_TANGENTIAL_RATIO,
+};
 pub use validate::{MAX_LENGTH, MAX_SIDES, MAX_STEPS, MIN_SIZE};
 
 use crate::error::{Error, Result};

@@ -247,7 +247,11 @@ fn check_drive(ctx: &str, d: Drive) -> Result<()> {
 /// Checks the whole scene, one section after the other, and resolves names,
 /// shapes and defaults.
 pub(crate) fn check(scene: &Scene) -> Result<Checked> {
-    super::common::check_simulation(&scene.simulation, "nscd", 2)?;
+    let engine = if scene.is_planar_md() { "md" } else { "nscd" };
+    super::common::check_simulation(&scene.simulation, engine, 2)?;
+    if let Some(soft) = &scene.soft {
+        super::soft::check_soft(soft)?;
+    }
     let ns = scene.nscd.clone().unwrap_or_default();
     let (theta, nlgs) = check_nscd(&ns)?;
     let materials = check_materials(scene)?;

@@ -129,6 +129,19 @@ pub(crate) fn to_toml(scene: &Scene) -> String {
         opt(&mut out, "stall_max_iterations", n.stall_max_iterations, |i| i.to_string());
         opt(&mut out, "alert_distance", n.alert_distance, float);
     }
+    if let Some(soft) = &scene.soft {
+        out.push_str("\n[soft]\n");
+        opt(&mut out, "model", soft.model.as_deref(), string);
+        opt(&mut out, "normal_stiffness", soft.normal_stiffness, float);
+        opt(&mut out, "max_overlap_ratio", soft.max_overlap_ratio, float);
+        opt(&mut out, "tangential_ratio", soft.tangential_ratio, float);
+        opt(&mut out, "dt", soft.dt.as_ref(), |dt| match dt {
+            super::soft::SoftDt::Seconds(s) => float(*s),
+            super::soft::SoftDt::Word(w) => string(w),
+        });
+        opt(&mut out, "dt_fraction", soft.dt_fraction, float);
+        opt(&mut out, "alert_distance", soft.alert_distance, float);
+    }
     super::common::write_output(&mut out, scene.output.as_ref());
     crate::scene::common::write_settlement(&mut out, scene.settlement.as_ref());
     for m in &scene.materials {

@@ -461,13 +461,22 @@ pub struct Accelerated<E: Engine> {
     target: u64,
     seed: u64,
     origin: Origin,
+    /// What the scene resolved to, for `run.json` ([`Accelerated::with_model`]).
+    model: Option<serde_json::Value>,
 }
 
 impl<E: Engine> Accelerated<E> {
     /// A run of `system` loaded at `frequency` (Hz) to `target` cycles, from the
     /// scene whose text is `text` (recorded as `scene.toml`, its CRC-32 checked on `--resume`).
     pub fn from_scene(system: E, spec: Acceleration, frequency: f64, target: u64, seed: u64, text: String) -> Self {
-        Self { system, spec, frequency, target, seed, origin: Origin::Scene { text } }
+        Self { system, spec, frequency, target, seed, origin: Origin::Scene { text }, model: None }
+    }
+
+    /// The same run, with `model` (what the scene resolved to: the planar MD
+    /// engine's derived stiffness and time step) recorded in `run.json`.
+    pub fn with_model(mut self, model: serde_json::Value) -> Self {
+        self.model = Some(model);
+        self
     }
 
     /// A run of a system built in code (its serde form and the settings are recorded).
@@ -477,7 +486,7 @@ impl<E: Engine> Accelerated<E> {
     pub fn from_system(system: E, spec: Acceleration, frequency: f64, target: u64) -> Result<Self> {
         let json = serde_json::to_string(&(&spec, frequency, target, &system))
             .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-        Ok(Self { system, spec, frequency, target, seed: 0, origin: Origin::Code { json } })
+        Ok(Self { system, spec, frequency, target, seed: 0, origin: Origin::Code { json }, model: None })
     }
 
     fn source_crc32(&self) -> u32 {
@@ -828,6 +837,7 @@ impl<E: Engine> Accelerated<E> {
             version: env!("CARGO_PKG_VERSION").into(),
             steps,
             dt: self.system.dt(),
+            model: self.model.clone(),
         }
         .write(out)?;
         let origin = self.system.configuration();

@@ -6,7 +6,7 @@ use super::driver::{Accelerated, AccelerationProgress, AccelerationSummary};
 use crate::error::Result;
 use crate::run::RunOptions;
 use crate::scene::common::RecordedText;
-use crate::scene::{MdScene, Scene};
+use crate::scene::{scene_on, MdScene, Scene, SceneKind};
 use std::path::Path;
 
 /// Runs the settlement-acceleration procedure of the scene file at `path` into
@@ -25,8 +25,8 @@ pub fn run_file(
 ) -> Result<Option<AccelerationSummary>> {
     let text = Scene::read_text(path)?;
     let name = path.display().to_string();
-    match crate::scene::engine_of_named(&text, &name)?.as_str() {
-        "md" => {
+    match SceneKind::of(&text, &name, opts.engine.as_deref())? {
+        SceneKind::Md => {
             let mut scene = MdScene::from_toml_str_named(&text, &name)?;
             if scene.settlement.is_none() {
                 return Ok(None);
@@ -38,8 +38,21 @@ pub fn run_file(
                 Accelerated::from_scene(scene.build()?, plan.spec, plan.frequency, plan.cycles, scene.seed(), text);
             Ok(Some(run.run(out, &opts, progress)?.summary))
         }
-        _ => {
-            let mut scene = Scene::from_toml_str_named(&text, &name)?;
+        SceneKind::PlanarMd => {
+            let (mut scene, text) = scene_on(&text, &name, SceneKind::PlanarMd, opts.engine.is_some())?;
+            if scene.settlement.is_none() {
+                return Ok(None);
+            }
+            let (system, info) = scene.build_planar()?;
+            let text = scene.text_with_length(text, crate::scene::planar_length(opts.length, system.params.dt))?;
+            let Some(plan) = scene.acceleration()? else { return Ok(None) };
+            let model = serde_json::to_value(info).map_err(|e| crate::Error::Io(std::io::Error::other(e)))?;
+            let run = Accelerated::from_scene(system, plan.spec, plan.frequency, plan.cycles, scene.seed(), text)
+                .with_model(model);
+            Ok(Some(run.run(out, opts, progress)?.summary))
+        }
+        SceneKind::Nscd => {
+            let (mut scene, text) = scene_on(&text, &name, SceneKind::Nscd, opts.engine.is_some())?;
             if scene.settlement.is_none() {
                 return Ok(None);
             }

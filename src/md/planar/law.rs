@@ -17,7 +17,10 @@
 //! Coulomb limit `μ F_n`. The dashpots come from the restitution coefficient `e`
 //! of a central impact: `α = −ln e / √(π² + ln² e)` for `linear` (exact),
 //! [`crate::md::law::hertz_alpha_for_restitution`] for `hertz`, the same ratio
-//! for the tangential dashpot, `γ = 2 α √(m* k)`.
+//! for the tangential dashpot, `γ = 2 α √(m* k)`. The ratio is at most 1, critical
+//! damping: a restitution below that of a critically damped impact (0 for
+//! `linear`; the NSCD default of a pair without a `[[contact]]` entry is 0) gets
+//! `α = 1`, no rebound without an infinitely stiff dashpot.
 //!
 //! **Points of a polygon–polygon contact share its stiffness.** The shadow
 //! overlap gives one point for a corner in an edge and two for edges in contact
@@ -64,7 +67,8 @@ pub struct SoftLaw {
     pub normal_stiffness: f64,
     /// `ρ = k_t / k_n` (dimensionless, ≥ 0).
     pub tangential_ratio: f64,
-    /// Restitution coefficient of a central impact, in `(0, 1]`.
+    /// Restitution coefficient of a central impact, in `[0, 1]` (module doc: at
+    /// most critical damping).
     pub restitution: f64,
     /// Coulomb friction coefficient (static = dynamic), ≥ 0.
     pub friction: f64,
@@ -85,8 +89,8 @@ impl SoftLaw {
         if !(self.tangential_ratio.is_finite() && self.tangential_ratio >= 0.0) {
             return bad("tangential_ratio", self.tangential_ratio, ">= 0 and finite");
         }
-        if !(self.restitution > 0.0 && self.restitution <= 1.0) {
-            return bad("restitution", self.restitution, "in (0, 1]");
+        if !(0.0..=1.0).contains(&self.restitution) {
+            return bad("restitution", self.restitution, "in [0, 1]");
         }
         if !(self.friction.is_finite() && self.friction >= 0.0) {
             return bad("friction", self.friction, ">= 0 and finite");
@@ -94,12 +98,16 @@ impl SoftLaw {
         Ok(())
     }
 
-    /// The damping ratio `α` of both dashpots (module doc).
+    /// The damping ratio `α` of both dashpots (module doc), at most 1 (critical).
     pub fn damping_ratio(&self) -> f64 {
-        match self.model {
+        if self.restitution <= 0.0 {
+            return 1.0;
+        }
+        let alpha = match self.model {
             SoftModel::Linear => linear_alpha_for_restitution(self.restitution),
             SoftModel::Hertz => hertz_alpha_for_restitution(self.restitution),
-        }
+        };
+        alpha.min(1.0)
     }
 
     /// The law of one contact point carrying `share` of the pair's stiffness

@@ -27,7 +27,9 @@
 //! # Ok::<(), ballast::Error>(())
 //! ```
 
+pub mod engine;
 pub mod law;
+pub mod stiffness;
 pub mod system;
 
 pub use law::{SoftLaw, SoftModel};

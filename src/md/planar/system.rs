@@ -59,11 +59,17 @@ struct Point {
     normal: [f64; 2],
 }
 
-/// What one force evaluation measured.
+/// What one step measured (its force evaluation at the end of the step).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct PlanarStepStats {
-    /// Contact points carrying a force.
+    /// Time at the end of the step (s).
+    pub time: f64,
+    /// Overlapping contact points.
     pub contacts: usize,
+    /// Overlapping contact points whose normal force is positive.
+    pub active_contacts: usize,
+    /// Sum of the overlaps (m).
+    pub total_overlap: f64,
     /// Largest overlap (m).
     pub max_overlap: f64,
     /// Mean overlap of the contact points (m), 0 without contacts.
@@ -92,8 +98,13 @@ pub struct PlanarSystem {
     time_origin: f64,
     step_origin: u64,
     step: u64,
+    /// Height (m, along −g) of the zero of the gravitational energy: the lowest
+    /// point of the mobile bodies at the first step.
+    pub gravity_reference: Option<f64>,
     /// Contact points of the last evaluation, sorted by key.
     points: Vec<Point>,
+    /// Their elastic energy (J).
+    contact_energy: f64,
     /// Generalized forces `(F_x, F_y, M)` of the last evaluation (N, N, N·m);
     /// empty before the first.
     f: Vec<[f64; 3]>,
@@ -110,6 +121,7 @@ struct Workspace {
     backup_u: Vec<[f64; 3]>,
     backup_f: Vec<[f64; 3]>,
     backup_points: Vec<Point>,
+    backup_energy: f64,
 }
 
 impl PlanarSystem {
@@ -125,7 +137,9 @@ impl PlanarSystem {
             time_origin: 0.0,
             step_origin: 0,
             step: 0,
+            gravity_reference: None,
             points: Vec::new(),
+            contact_energy: 0.0,
             f: Vec::new(),
             work: Workspace::default(),
         }
@@ -191,16 +205,130 @@ impl PlanarSystem {
         })
     }
 
-    /// Gravitational potential energy `−Σ m g · x` of the non-fixed bodies (J).
+    /// Gravitational energy `Σ m |g| h` of the non-fixed bodies (J), `h` the height
+    /// of the centre of mass above [`PlanarSystem::gravity_reference`] (the lowest
+    /// point now if no step has set it).
     pub fn gravitational_energy(&self) -> f64 {
-        let g = self.params.gravity;
-        self.bodies
-            .info
-            .iter()
-            .zip(&self.bodies.q)
-            .filter(|(b, _)| !b.fixed)
-            .map(|(b, q)| -b.mass * (g[0] * q[0] + g[1] * q[1]))
-            .sum()
+        let up = crate::plane::bodies::up(self.params.gravity);
+        let reference = self.gravity_reference.unwrap_or_else(|| self.bodies.lowest_point(up));
+        self.bodies.gravitational_energy(self.params.gravity, reference)
+    }
+
+    /// Elastic energy of the springs (J).
+    pub fn spring_energy(&self) -> f64 {
+        self.springs.iter().map(|s| s.elastic_energy(&self.bodies.q)).sum()
+    }
+
+    /// Elastic energy of the contact points at the last force evaluation (J).
+    pub fn contact_energy(&self) -> f64 {
+        self.contact_energy
+    }
+
+    /// Potential energy `E_p` (J): gravitational plus the springs' and the contacts'.
+    pub fn potential_energy(&self) -> f64 {
+        self.gravitational_energy() + self.spring_energy() + self.contact_energy()
+    }
+
+    /// Moves the bodies of `c` to its positions `(x, y, θ)`, sets every velocity to
+    /// zero (an imposed component to its value now) and forgets the contact
+    /// memory and the forces, so that the next step starts from this
+    /// configuration as a system built there would. The clock goes on.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if `c` has not 3 coordinates per body, names an unknown or
+    /// fixed body or holds a non-finite value; the system is then unchanged.
+    pub fn set_configuration(&mut self, c: &crate::run::Configuration) -> Result<()> {
+        c.check(3, self.bodies.len())?;
+        if let Some(&i) = c.bodies.iter().find(|&&i| self.bodies.info[i].fixed) {
+            return Err(Error::Scene(format!(
+                "configuration: body {i} ('{}') is fixed",
+                crate::scene::clip(&self.bodies.info[i].name)
+            )));
+        }
+        for (k, &i) in c.bodies.iter().enumerate() {
+            self.bodies.q[i].copy_from_slice(c.body(k));
+        }
+        self.bodies.u.iter_mut().for_each(|u| *u = [0.0; 3]);
+        self.impose(self.time());
+        self.points.clear();
+        self.contact_energy = 0.0;
+        self.f.clear();
+        Ok(())
+    }
+
+    /// Removes the overlaps beyond `settings.tolerance` by the mass-metric
+    /// projection of both 2D engines ([`crate::plane::relax`]), then writes the
+    /// result back as [`PlanarSystem::set_configuration`] does.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] for settings out of range or a held body that does not exist.
+    pub fn relax(&mut self, settings: &crate::settlement::RelaxSettings) -> Result<crate::settlement::RelaxReport> {
+        let (report, q) = crate::plane::relax::project(&self.bodies, settings)?;
+        let mobile = crate::plane::outputs::mobile_bodies(&self.bodies);
+        let mut c = crate::plane::outputs::configuration_of(&self.bodies, &mobile);
+        for (k, &i) in mobile.iter().enumerate() {
+            c.body_mut(k).copy_from_slice(&q[i]);
+        }
+        self.set_configuration(&c)?;
+        Ok(report)
+    }
+
+    /// Checks that the state holds together (a state read from a checkpoint):
+    /// bodies and springs ([`crate::plane::outputs::check_bodies`]), laws, contact
+    /// keys sorted and in range, forces, parameters and clock.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming what is wrong.
+    pub fn check_state(&self) -> Result<()> {
+        let bad = |msg: String| Err(Error::Scene(msg));
+        crate::plane::outputs::check_bodies(&self.bodies, self.materials, &self.springs)?;
+        let m2 = self.materials * self.materials;
+        if self.laws.len() != m2 || self.point_laws.len() != m2 {
+            return bad(format!("{} soft laws for {} materials", self.laws.len(), self.materials));
+        }
+        let n = self.bodies.len();
+        if self.points.iter().any(|p| p.key.0 as usize >= n || p.key.1 as usize >= n)
+            || self.points.windows(2).any(|w| w[0].key >= w[1].key)
+        {
+            return bad("contact points: bodies out of range or keys not sorted".into());
+        }
+        if !(self.f.is_empty() || self.f.len() == n) || self.f.iter().flatten().any(|x| !x.is_finite()) {
+            return bad(format!("forces: {} entries for {n} bodies, or not finite", self.f.len()));
+        }
+        check_params(&self.params)?;
+        if self.step < self.step_origin {
+            return bad(format!("clock: step {} before its origin {}", self.step, self.step_origin));
+        }
+        Ok(())
+    }
+
+    /// Checks that `self` is a state of the model `fresh` (built from the same
+    /// scene): bodies, springs, laws, parameters, clock origin.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] "… differs from the scene's".
+    pub fn check_same_model(&self, fresh: &Self) -> Result<()> {
+        use crate::plane::outputs::same;
+        let bad = |what: &str| Err(Error::Scene(format!("{what} differs from the scene's")));
+        crate::plane::outputs::check_same_bodies((&self.bodies, &self.springs), (&fresh.bodies, &fresh.springs))?;
+        if self.materials != fresh.materials || !same(&self.laws, &fresh.laws) {
+            return bad("the soft laws");
+        }
+        if self.params != fresh.params {
+            return bad("the [soft] parameters or time step");
+        }
+        if self.time_origin.to_bits() != fresh.time_origin.to_bits() || self.step_origin != fresh.step_origin {
+            return bad("the clock's origin");
+        }
+        let up = crate::plane::bodies::up(fresh.params.gravity);
+        let reference = match fresh.gravity_reference {
+            None if self.step > fresh.step => Some(fresh.bodies.lowest_point(up)),
+            r => r,
+        };
+        if !same(&self.gravity_reference, &reference) {
+            return bad("the zero of the gravitational energy");
+        }
+        Ok(())
     }
 
     /// One velocity-Verlet step (module doc).
@@ -212,6 +340,9 @@ impl PlanarSystem {
     /// system is back at the start of the step.
     pub fn step(&mut self) -> Result<PlanarStepStats> {
         let n = self.bodies.len();
+        if self.gravity_reference.is_none() {
+            self.gravity_reference = Some(self.bodies.lowest_point(crate::plane::bodies::up(self.params.gravity)));
+        }
         if self.f.len() != n {
             self.f = vec![[0.0; 3]; n];
             self.evaluate(self.time())?;
@@ -221,6 +352,7 @@ impl PlanarSystem {
         w.backup_u.clone_from(&self.bodies.u);
         w.backup_f.clone_from(&self.f);
         w.backup_points.clone_from(&self.points);
+        w.backup_energy = self.contact_energy;
         let h = self.params.dt;
         let t0 = self.time();
         self.kick(0.5 * h);
@@ -235,6 +367,7 @@ impl PlanarSystem {
             self.impose(t1);
             self.check()?;
             stats.kinetic_energy = self.bodies.kinetic_energy();
+            stats.time = t1;
             Ok(stats)
         });
         if outcome.is_err() {
@@ -243,6 +376,7 @@ impl PlanarSystem {
             self.bodies.u.clone_from(&w.backup_u);
             self.f.clone_from(&w.backup_f);
             self.points.clone_from(&w.backup_points);
+            self.contact_energy = w.backup_energy;
             self.step -= 1;
         }
         outcome
@@ -312,7 +446,7 @@ impl PlanarSystem {
         w.next.clear();
         let dt = self.params.dt;
         let mut old = self.points.iter().peekable();
-        let mut overlap_sum = 0.0;
+        let mut contact_energy = 0.0;
         for &(key, cp) in &w.detector.found {
             if cp.gap >= 0.0 {
                 continue;
@@ -339,8 +473,7 @@ impl PlanarSystem {
                     ib.material
                 ))
             })?;
-            let polygons = !matches!(ia.shape, Shape::Disc(_)) && !matches!(ib.shape, Shape::Disc(_));
-            let law = &laws[polygons as usize];
+            let law = &laws[usize::from(share(&ia.shape, &ib.shape) < 1.0)];
             while old.peek().is_some_and(|p| p.key < key) {
                 old.next();
             }
@@ -377,15 +510,45 @@ impl PlanarSystem {
             fbod[1] -= fv.y;
             fbod[2] -= cross(rb, fv);
             stats.contacts += 1;
+            stats.active_contacts += usize::from(c.normal > 0.0);
+            stats.total_overlap += delta;
             stats.max_overlap = stats.max_overlap.max(delta);
-            overlap_sum += delta;
             stats.elastic_energy += c.energy;
+            contact_energy += c.energy;
             w.next.push(Point { key, hist, point: [cp.point.x, cp.point.y], normal: [cp.normal.x, cp.normal.y] });
         }
         if stats.contacts > 0 {
-            stats.mean_overlap = overlap_sum / stats.contacts as f64;
+            stats.mean_overlap = stats.total_overlap / stats.contacts as f64;
         }
         std::mem::swap(&mut self.points, &mut w.next);
+        self.contact_energy = contact_energy;
         Ok(stats)
     }
+}
+
+/// The share of a pair's stiffness one contact point carries: 1/2 between two
+/// polygons (or compound parts), 1 with a disc ([`super::law`]).
+fn share(a: &Shape, b: &Shape) -> f64 {
+    if matches!(a, Shape::Disc(_)) || matches!(b, Shape::Disc(_)) {
+        1.0
+    } else {
+        0.5
+    }
+}
+
+/// Checks the parameters' ranges (one-line errors naming the field).
+///
+/// # Errors
+/// [`Error::Scene`].
+pub fn check_params(p: &PlanarParams) -> Result<()> {
+    if !(p.dt.is_finite() && p.dt > 0.0) {
+        return Err(Error::Scene(format!("soft: dt must be positive and finite, got {} s", p.dt)));
+    }
+    if p.gravity.iter().any(|g| !g.is_finite()) {
+        return Err(Error::Scene("simulation.gravity: not finite".into()));
+    }
+    if !(p.alert_distance.is_finite() && p.alert_distance >= 0.0) {
+        return Err(Error::Scene(format!("soft: alert_distance must be >= 0, got {} m", p.alert_distance)));
+    }
+    Ok(())
 }

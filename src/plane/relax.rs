@@ -1,5 +1,8 @@
-//! Relaxation of an NSCD configuration (the settlement driver's step after an
-//! extrapolation; Karrech et al. 2007, §4, carried over to rigid bodies).
+//! Relaxation of a 2D configuration (the settlement driver's step after an
+//! extrapolation; Karrech et al. 2007, §4, carried over to rigid bodies), for
+//! both 2D engines: the NSCD engine, whose rigid bodies have no contact
+//! potential, and the planar MD engine, whose soft contacts are relaxed the same
+//! way so that the two methods restart from configurations made alike.
 //!
 //! Rigid bodies have no contact potential, so the paper's functional (29) has
 //! nothing to balance gravity with: minimised, a frictionless rigid assembly
@@ -24,16 +27,16 @@
 //! (docs/relaxation.md). The sublayer springs are left out: they act on the
 //! next steps, not on the geometry.
 
-use super::contact::gen_dir;
 use super::detection::Detector;
-use super::System;
+use super::springs::gen_dir;
+use super::Bodies;
 use crate::error::{Error, Result};
 use crate::geometry::Vec2;
 use crate::settlement::relax::{minimise, Functional, RelaxReport, RelaxSettings};
 
 /// The penalised projection of a configuration (module doc).
 pub struct Projection<'a> {
-    sys: &'a System,
+    bodies: &'a Bodies,
     /// Free degrees of freedom: (body, coordinate).
     vars: Vec<(usize, usize)>,
     /// Variable of each body's coordinate, `usize::MAX` if not free.
@@ -50,8 +53,8 @@ pub struct Projection<'a> {
 impl<'a> Projection<'a> {
     /// The projection of the current configuration of `sys`, every free degree of
     /// freedom of the bodies not in `held` moving, with penalty stiffness `stiffness` (N/m).
-    pub fn new(sys: &'a System, held: &[usize], stiffness: f64) -> Self {
-        let b = &sys.bodies;
+    pub fn new(bodies: &'a Bodies, held: &[usize], stiffness: f64) -> Self {
+        let b = bodies;
         let mut vars = Vec::new();
         let mut var_of = vec![[usize::MAX; 3]; b.len()];
         for (i, slots) in var_of.iter_mut().enumerate() {
@@ -67,7 +70,7 @@ impl<'a> Projection<'a> {
         }
         let target = vars.iter().map(|&(i, d)| b.q[i][d]).collect();
         let mass = vars.iter().map(|&(i, d)| 1.0 / b.inv_m[i][d]).collect();
-        Self { sys, vars, var_of, target, mass, stiffness, q: b.q.clone(), detector: Detector::default() }
+        Self { bodies, vars, var_of, target, mass, stiffness, q: b.q.clone(), detector: Detector::default() }
     }
 
     /// The free coordinates of the current configuration (m, rad).
@@ -90,12 +93,12 @@ impl<'a> Projection<'a> {
     fn detect(&mut self, x: &[f64]) {
         self.place(x);
         // Only overlapping pairs matter: alert distance 0.
-        self.detector.run(&self.sys.bodies, &self.q, 0.0);
+        self.detector.run(self.bodies, &self.q, 0.0);
     }
 
     /// The heaviest free body's mass (kg).
     pub fn heaviest(&self) -> f64 {
-        self.vars.iter().filter(|(_, d)| *d < 2).map(|&(i, _)| self.sys.bodies.info[i].mass).fold(0.0, f64::max)
+        self.vars.iter().filter(|(_, d)| *d < 2).map(|&(i, _)| self.bodies.info[i].mass).fold(0.0, f64::max)
     }
 }
 
@@ -142,53 +145,40 @@ impl Functional for Projection<'_> {
     }
 }
 
-impl System {
-    /// Removes the overlaps of the current configuration, moving the bodies as
-    /// little as possible in the metric of their masses (module doc), until the
-    /// largest overlap is at most `settings.tolerance`; then writes the result
-    /// back as [`System::set_configuration`] does (velocities zeroed, warm start
-    /// forgotten). On an error the configuration is unchanged.
-    ///
-    /// # Errors
-    /// [`Error::Scene`] for settings out of range or a held body that does not exist.
-    pub fn relax(&mut self, settings: &RelaxSettings) -> Result<RelaxReport> {
-        settings.check()?;
-        if let Some(&i) = settings.held.iter().find(|&&i| i >= self.bodies.len()) {
-            return Err(Error::Scene(format!(
-                "relaxation: held body {i} does not exist ({} bodies)",
-                self.bodies.len()
-            )));
-        }
-        let mut projection = Projection::new(self, &settings.held, 0.0);
-        let mut x = projection.start();
-        let before = projection.max_overlap(&x)?;
-        projection.stiffness =
-            10.0 * projection.heaviest().max(f64::MIN_POSITIVE) * (before / settings.tolerance).max(1.0);
-        let mut report = minimise(&mut projection, &mut x, settings)?;
-        let mut raises = 0;
-        while !report.converged && raises < 3 && report.iterations < settings.max_iterations {
-            raises += 1;
-            projection.stiffness *= 10.0;
-            let left =
-                RelaxSettings { max_iterations: settings.max_iterations - report.iterations, ..settings.clone() };
-            let next = minimise(&mut projection, &mut x, &left)?;
-            report.iterations += next.iterations;
-            report.evaluations += next.evaluations;
-            // A raised stiffness is a new functional: its own sequence.
-            report.functional = next.functional;
-            report.max_overlap_after = next.max_overlap_after;
-            report.converged = next.converged;
-            report.reason = next.reason;
-        }
-        projection.place(&x);
-        report.max_overlap_before = before;
-        report.largest_move = x.iter().zip(projection.start()).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-        let q = projection.positions().to_vec();
-        let mut c = crate::run::Engine::configuration(self);
-        for (k, &i) in c.bodies.clone().iter().enumerate() {
-            c.body_mut(k).copy_from_slice(&q[i]);
-        }
-        self.set_configuration(&c)?;
-        Ok(report)
+/// Removes the overlaps of the configuration of `bodies`, moving them as little
+/// as possible in the metric of their masses (module doc), until the largest
+/// overlap is at most `settings.tolerance`: the report and the positions of
+/// every body, which the engine writes back (velocities zeroed, contact memory
+/// forgotten). `bodies` is not changed.
+///
+/// # Errors
+/// [`Error::Scene`] for settings out of range or a held body that does not exist.
+pub fn project(bodies: &Bodies, settings: &RelaxSettings) -> Result<(RelaxReport, Vec<[f64; 3]>)> {
+    settings.check()?;
+    if let Some(&i) = settings.held.iter().find(|&&i| i >= bodies.len()) {
+        return Err(Error::Scene(format!("relaxation: held body {i} does not exist ({} bodies)", bodies.len())));
     }
+    let mut projection = Projection::new(bodies, &settings.held, 0.0);
+    let mut x = projection.start();
+    let before = projection.max_overlap(&x)?;
+    projection.stiffness = 10.0 * projection.heaviest().max(f64::MIN_POSITIVE) * (before / settings.tolerance).max(1.0);
+    let mut report = minimise(&mut projection, &mut x, settings)?;
+    let mut raises = 0;
+    while !report.converged && raises < 3 && report.iterations < settings.max_iterations {
+        raises += 1;
+        projection.stiffness *= 10.0;
+        let left = RelaxSettings { max_iterations: settings.max_iterations - report.iterations, ..settings.clone() };
+        let next = minimise(&mut projection, &mut x, &left)?;
+        report.iterations += next.iterations;
+        report.evaluations += next.evaluations;
+        // A raised stiffness is a new functional: its own sequence.
+        report.functional = next.functional;
+        report.max_overlap_after = next.max_overlap_after;
+        report.converged = next.converged;
+        report.reason = next.reason;
+    }
+    projection.place(&x);
+    report.max_overlap_before = before;
+    report.largest_move = x.iter().zip(projection.start()).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    Ok((report, projection.positions().to_vec()))
 }
