@@ -312,26 +312,7 @@ impl System {
     /// [`crate::Error::Scene`] if `c` has not 3 coordinates per body, names an unknown
     /// or fixed body or holds a non-finite value; the system is then unchanged.
     pub fn set_configuration(&mut self, c: &crate::run::Configuration) -> crate::Result<()> {
-        c.check(3, self.bodies.len())?;
-        if let Some(&i) = c.bodies.iter().find(|&&i| self.bodies.info[i].fixed) {
-            return Err(crate::Error::Scene(format!(
-                "configuration: body {i} ('{}') is fixed",
-                crate::scene::clip(&self.bodies.info[i].name)
-            )));
-        }
-        for (k, &i) in c.bodies.iter().enumerate() {
-            self.bodies.q[i].copy_from_slice(c.body(k));
-        }
-        for (info, u) in self.bodies.info.iter().zip(self.bodies.u.iter_mut()) {
-            *u = [0.0; 3];
-            if !info.fixed {
-                for (d, v) in u.iter_mut().enumerate() {
-                    if let Some(f) = info.imposed.dof[d] {
-                        *v = f.at(self.time);
-                    }
-                }
-            }
-        }
+        self.bodies.place(c, self.time)?;
         self.contacts.clear();
         self.impulses.clear();
         for s in &mut self.springs {

@@ -323,6 +323,37 @@ impl Bodies {
             .map(|i| self.info[i].mass * gn * (self.q[i][0] * up[0] + self.q[i][1] * up[1] - reference))
             .sum()
     }
+
+    /// Moves the bodies of `c` to its positions `(x, y, θ)` and sets every
+    /// velocity to zero, an imposed component to its value at `time` (s): the
+    /// write-back of both 2D engines, which then forget their contact memory.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] if `c` has not 3 coordinates per body, names an unknown
+    /// or fixed body or holds a non-finite value; the bodies are then unchanged.
+    pub fn place(&mut self, c: &crate::run::Configuration, time: f64) -> Result<()> {
+        c.check(3, self.len())?;
+        if let Some(&i) = c.bodies.iter().find(|&&i| self.info[i].fixed) {
+            return Err(Error::Scene(format!(
+                "configuration: body {i} ('{}') is fixed",
+                crate::scene::clip(&self.info[i].name)
+            )));
+        }
+        for (k, &i) in c.bodies.iter().enumerate() {
+            self.q[i].copy_from_slice(c.body(k));
+        }
+        for (info, u) in self.info.iter().zip(self.u.iter_mut()) {
+            *u = [0.0; 3];
+            if !info.fixed {
+                for (v, f) in u.iter_mut().zip(&info.imposed.dof) {
+                    if let Some(f) = f {
+                        *v = f.at(time);
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The unit vector against `gravity` (`+y` without gravity).

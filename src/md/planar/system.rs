@@ -238,18 +238,7 @@ impl PlanarSystem {
     /// [`Error::Scene`] if `c` has not 3 coordinates per body, names an unknown or
     /// fixed body or holds a non-finite value; the system is then unchanged.
     pub fn set_configuration(&mut self, c: &crate::run::Configuration) -> Result<()> {
-        c.check(3, self.bodies.len())?;
-        if let Some(&i) = c.bodies.iter().find(|&&i| self.bodies.info[i].fixed) {
-            return Err(Error::Scene(format!(
-                "configuration: body {i} ('{}') is fixed",
-                crate::scene::clip(&self.bodies.info[i].name)
-            )));
-        }
-        for (k, &i) in c.bodies.iter().enumerate() {
-            self.bodies.q[i].copy_from_slice(c.body(k));
-        }
-        self.bodies.u.iter_mut().for_each(|u| *u = [0.0; 3]);
-        self.impose(self.time());
+        self.bodies.place(c, self.time())?;
         self.points.clear();
         self.contact_energy = 0.0;
         self.f.clear();
