@@ -20,6 +20,17 @@ const REDUCTIONS: &[(&str, &[(&str, &str)])] = &[
     // 10 cycles: 2 initial, 4 computed, a jump of 4 (20 steps would hold no cycle).
     ("run examples/settlement_sleeper.toml", &[("--steps", "2500"), ("--quiet", "")]),
     ("figures", &[]),
+    (
+        "compare",
+        &[
+            ("--overlaps", "1e-1"),
+            ("--cycles", "1"),
+            ("--dt", "1e-3"),
+            ("--bars", "0"),
+            ("--replicas", "2"),
+            ("--quiet", ""),
+        ],
+    ),
     ("deposit", &[("--grains", "16"), ("--width", "0.1")]),
     ("saussine sample", &[("--grains", "60"), ("--dt", "1e-4"), ("--quiet", "")]),
     ("saussine settle", &[("--cycles", "1"), ("--dt", "1e-3"), ("--bars", "0"), ("--quiet", "")]),

@@ -7,8 +7,10 @@
 //! - `figures`: the figures of a finished run folder ([`figures`]);
 //! - `deposit`: the scene of a loose pentagon deposit ([`deposit`]);
 //! - `saussine …`: the experiments of Saussine et al. (2006) ([`saussine`]);
+//! - `compare`: NSCD versus MD on the same loaded sample ([`compare`]);
 //! - `karrech …`, `luding …`: the ready-made MD tests ([`md_tests`]).
 
+mod compare;
 mod deposit;
 mod figures;
 mod md_tests;
@@ -43,6 +45,9 @@ enum Command {
     /// The numerical experiments of Saussine et al. (2006): sample, loaded scenes, studies.
     #[command(subcommand)]
     Saussine(Box<saussine::SaussineCommand>),
+    /// NSCD versus soft-contact MD on the same loaded 2D sample: MD at each overlap ratio,
+    /// replicas from perturbed starts, side by side; compare.csv, compare.md, settlement figure.
+    Compare(Box<compare::CompareArgs>),
     /// The MD sample of Karrech et al. (2007), Table 1: deposit, cyclic plate load.
     #[command(subcommand)]
     Karrech(md_tests::KarrechCommand),
@@ -83,6 +88,7 @@ pub fn main() -> ExitCode {
         Command::Figures(args) => figures::main(args),
         Command::Deposit(args) => deposit::main(args),
         Command::Saussine(cmd) => saussine::main(*cmd),
+        Command::Compare(args) => compare::main(*args),
         Command::Karrech(cmd) => md_tests::karrech_main(cmd),
         Command::Luding(cmd) => md_tests::luding_main(cmd),
     };

@@ -280,7 +280,7 @@ pub struct StudyArgs {
 }
 
 impl StudyArgs {
-    fn options(&self) -> StudyOptions {
+    pub(crate) fn options(&self) -> StudyOptions {
         StudyOptions {
             out: self.out.clone(),
             jobs: self.jobs,

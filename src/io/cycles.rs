@@ -11,7 +11,12 @@
 //! `settlement_at_min_load_m` (`y0 − y` at the step of the cycle where the
 //! magnitude of the body's load is smallest), `mean_grain_speed_m_s` (speed of
 //! the other non-fixed bodies, averaged over bodies and steps), `contacts`,
-//! `iterations` (means per step), `max_overlap_m` (largest over the cycle).
+//! `iterations` (means per step), `max_overlap_m` (largest over the cycle),
+//! `mean_overlap_m` (the mean overlap of the force-carrying contacts, the
+//! `mean_overlap_m` of `series.csv`, averaged over the cycle's steps) and `coordination` (at the cycle's end: the mean number of
+//! force-carrying neighbours of the non-rattler grains other than the followed
+//! body, [`crate::plane::outputs::coordination`]). The last two were added on
+//! 2026-12-03; an older file reads them as NaN.
 //!
 //! MD ([`MdCycleRow`]; the residual displacements of Karrech et al. 2007 §3,
 //! taken at the end of each cycle, where the load is back to its base value):
@@ -53,6 +58,10 @@ pub struct NscdCycleState {
     pub sum_iterations: f64,
     /// Largest overlap (interpenetration) of any contact over the cycle's steps (m).
     pub max_overlap: f64,
+    /// Sum over the steps of the mean overlap of the force-carrying contacts (m);
+    /// 0 in a checkpoint written before it existed.
+    #[serde(default)]
+    pub sum_mean_overlap: f64,
     /// Positions `(x, y, θ)` of every body at the end of the first cycle (for the
     /// displacement field from cycle 1 to the end of the run).
     pub first_cycle_q: Option<Vec<[f64; 3]>>,
@@ -77,6 +86,7 @@ impl NscdCycleState {
             sum_contacts: 0.0,
             sum_iterations: 0.0,
             max_overlap: 0.0,
+            sum_mean_overlap: 0.0,
             first_cycle_q: None,
         }
     }
@@ -152,10 +162,25 @@ pub struct NscdCycleRow {
     pub iterations: f64,
     /// Column `max_overlap_m`: largest contact overlap over the cycle (m).
     pub max_overlap_m: f64,
+    /// Column `mean_overlap_m`: mean overlap of the force-carrying contacts (NSCD:
+    /// those with an impulse or an overlap; MD: the overlapping points), averaged
+    /// over the cycle's steps (m); NaN when read from a file without it.
+    #[serde(default = "nan")]
+    pub mean_overlap_m: f64,
+    /// Column `coordination`: at the cycle's end, the mean number of neighbours
+    /// pressing on each non-rattler grain (the mobile bodies other than the
+    /// followed one; a pair counts once; dimensionless); NaN when read from a
+    /// file without it.
+    #[serde(default = "nan")]
+    pub coordination: f64,
+}
+
+fn nan() -> f64 {
+    f64::NAN
 }
 
 /// The columns of [`NscdCycleRow`].
-pub const NSCD_CYCLE_COLUMNS: [&str; 8] = [
+pub const NSCD_CYCLE_COLUMNS: [&str; 10] = [
     "cycle",
     "time_s",
     "settlement_mean_m",
@@ -164,6 +189,8 @@ pub const NSCD_CYCLE_COLUMNS: [&str; 8] = [
     "contacts",
     "iterations",
     "max_overlap_m",
+    "mean_overlap_m",
+    "coordination",
 ];
 
 /// What an MD run keeps for its cycles.

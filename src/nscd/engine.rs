@@ -133,7 +133,16 @@ impl Engine for System {
     }
 
     fn cycle_step(&self, c: &mut NscdCycleState, stats: &StepStats) {
-        outputs::cycle_step(self, c, stats.contacts, stats.iterations, stats.max_overlap);
+        outputs::cycle_step(
+            self,
+            c,
+            outputs::CycleStepStats {
+                contacts: stats.contacts,
+                iterations: stats.iterations,
+                max_overlap: stats.max_overlap,
+                mean_overlap: stats.mean_overlap,
+            },
+        );
     }
 
     fn cycle_end(&self, c: &mut NscdCycleState, cycle: u64) -> NscdCycleRow {

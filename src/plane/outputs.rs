@@ -96,16 +96,23 @@ pub fn cycle_start(sys: &impl PlaneSystem, body: Option<usize>) -> Result<NscdCy
     Ok(NscdCycleState::new(body, q[1]))
 }
 
-/// Adds a step (`contacts` detected, `iterations` of its solver, `max_overlap` m)
-/// to the cycle under way: the followed body's position and the load minimum,
-/// the other mobile bodies' mean speed.
-pub fn cycle_step(
-    sys: &impl PlaneSystem,
-    c: &mut NscdCycleState,
-    contacts: usize,
-    iterations: usize,
-    max_overlap: f64,
-) {
+/// What one step adds to the cycle under way, besides the bodies' state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CycleStepStats {
+    /// Contacts detected.
+    pub contacts: usize,
+    /// Sweeps of the solver (0 for an explicit engine).
+    pub iterations: usize,
+    /// Largest overlap (m).
+    pub max_overlap: f64,
+    /// Mean overlap of the force-carrying contacts (m).
+    pub mean_overlap: f64,
+}
+
+/// Adds a step to the cycle under way: the followed body's position and the
+/// load minimum, the other mobile bodies' mean speed, the step's `stats`.
+pub fn cycle_step(sys: &impl PlaneSystem, c: &mut NscdCycleState, stats: CycleStepStats) {
+    let CycleStepStats { contacts, iterations, max_overlap, mean_overlap } = stats;
     let bodies = sys.plane_bodies();
     let y = bodies.q[c.body][1];
     let load: [f64; 2] = bodies.info[c.body].loads.iter().fold([0.0, 0.0], |f, l| {
@@ -130,6 +137,7 @@ pub fn cycle_step(
     c.sum_contacts += contacts as f64;
     c.sum_iterations += iterations as f64;
     c.max_overlap = c.max_overlap.max(max_overlap);
+    c.sum_mean_overlap += mean_overlap;
 }
 
 /// Closes cycle `cycle` at the current step: its row; the accumulators start again.
@@ -144,6 +152,11 @@ pub fn cycle_end(sys: &impl PlaneSystem, c: &mut NscdCycleState, cycle: u64) -> 
         contacts: c.sum_contacts / k,
         iterations: c.sum_iterations / k,
         max_overlap_m: c.max_overlap,
+        mean_overlap_m: c.sum_mean_overlap / k,
+        coordination: {
+            let grains: Vec<usize> = mobile_bodies(sys.plane_bodies()).into_iter().filter(|&i| i != c.body).collect();
+            coordination(sys, &grains, 0.0).z
+        },
     };
     if c.first_cycle_q.is_none() {
         c.first_cycle_q = Some(sys.plane_bodies().q.clone());

@@ -112,20 +112,44 @@ pub const PAPER_POLICIES: [(&str, f64); 8] = [
     ("quad", 1e-7),
 ];
 
-/// One run of a study: its label, the loading and where it goes, and which
-/// replica of its setting it is.
-struct Job {
-    label: String,
-    spec: LoadingSpec,
-    sample: PathBuf,
-    replica: u64,
-    perturbation: Perturbation,
+/// Where the scene of a study's run comes from.
+#[derive(Clone)]
+pub(super) enum Source {
+    /// The deposited sample at `sample`, loaded by [`loaded_scene`] with `spec`.
+    Loaded {
+        /// The loading.
+        spec: Box<LoadingSpec>,
+        /// The sample's scene file.
+        sample: PathBuf,
+    },
+    /// A scene made by the study (the unperturbed start of its setting).
+    Ready(Box<Scene>),
+}
+
+/// One run of a study: its label, its scene and which replica of its setting it is.
+pub(super) struct Job {
+    pub(super) label: String,
+    pub(super) source: Source,
+    pub(super) replica: u64,
+    pub(super) perturbation: Perturbation,
+}
+
+impl Job {
+    /// Replica 0 of the sample at `sample` loaded with `spec`.
+    fn loaded(label: String, spec: LoadingSpec, sample: &Path, perturbation: Perturbation) -> Self {
+        Self {
+            label,
+            source: Source::Loaded { spec: Box::new(spec), sample: sample.to_path_buf() },
+            replica: 0,
+            perturbation,
+        }
+    }
 }
 
 /// The runs of `settings` (replica 0 each): unchanged for one replica, else
 /// `replicas.count` runs per setting labelled `<setting>/replica-<r>`, setting
 /// after setting.
-fn replicate(settings: Vec<Job>, replicas: &Replicas) -> Vec<Job> {
+pub(super) fn replicate(settings: Vec<Job>, replicas: &Replicas) -> Vec<Job> {
     if replicas.count == 1 {
         return settings;
     }
@@ -134,8 +158,7 @@ fn replicate(settings: Vec<Job>, replicas: &Replicas) -> Vec<Job> {
         .flat_map(|job| {
             (0..replicas.count).map(move |r| Job {
                 label: format!("{}/replica-{r}", job.label),
-                spec: job.spec.clone(),
-                sample: job.sample.clone(),
+                source: job.source.clone(),
                 replica: r,
                 perturbation: replicas.perturbation,
             })
@@ -144,24 +167,24 @@ fn replicate(settings: Vec<Job>, replicas: &Replicas) -> Vec<Job> {
 }
 
 impl Job {
-    fn scene(&self, study: &Path) -> PathBuf {
+    pub(super) fn scene(&self, study: &Path) -> PathBuf {
         study.join("scenes").join(format!("{}.toml", self.label))
     }
-    fn dir(&self, study: &Path) -> PathBuf {
+    pub(super) fn dir(&self, study: &Path) -> PathBuf {
         study.join("runs").join(&self.label)
     }
 }
 
 /// What a finished (or diverged) run left: its report, series and cycles.
-struct Outcome {
-    status: String,
-    report: Option<RunReport>,
-    series: Vec<SeriesRow>,
-    cycles: Vec<CycleRow>,
+pub(super) struct Outcome {
+    pub(super) status: String,
+    pub(super) report: Option<RunReport>,
+    pub(super) series: Vec<SeriesRow>,
+    pub(super) cycles: Vec<CycleRow>,
 }
 
 /// The cycles of the runs `outcomes`.
-fn cycles_of<'a>(outcomes: &[&'a Outcome]) -> Vec<&'a [CycleRow]> {
+pub(super) fn cycles_of<'a>(outcomes: &[&'a Outcome]) -> Vec<&'a [CycleRow]> {
     outcomes.iter().map(|o| o.cycles.as_slice()).collect()
 }
 
@@ -189,8 +212,16 @@ fn mean_curve(outcomes: &[&Outcome], label: String, f: fn(&SeriesRow) -> f64, sc
 }
 
 /// The mean settlement per cycle of each setting (`(label, its runs)`), each
-/// with its 95 % band, in `DIR/settlement_ensemble`.
-fn settlement_figure(out: &Path, title: &str, settings: &[(String, Vec<&Outcome>)], seating: u64) -> Result<()> {
+/// with its 95 % band, in `DIR/<name>` (PNG and SVG), behind them the curves
+/// `behind` (e.g. every replica, thin).
+pub(super) fn settlement_figure(
+    out: &Path,
+    name: &str,
+    title: &str,
+    settings: &[(String, Vec<&Outcome>)],
+    seating: u64,
+    behind: &[Series],
+) -> Result<()> {
     let curves: Vec<Series> = settings
         .iter()
         .map(|(label, runs)| {
@@ -213,14 +244,15 @@ fn settlement_figure(out: &Path, title: &str, settings: &[(String, Vec<&Outcome>
             }
         })
         .collect();
+    let all: Vec<Series> = behind.iter().cloned().chain(curves).collect();
     figures::line_chart(
-        &out.join("settlement_ensemble"),
+        &out.join(name),
         &axes(title, "cycles", "settlement at the load minimum (mm)", false, false),
-        &curves,
+        &all,
     )
 }
 
-fn label_number(x: f64) -> String {
+pub(super) fn label_number(x: f64) -> String {
     format!("{x:e}").replace('.', "p")
 }
 
@@ -241,7 +273,7 @@ pub(crate) fn run_threads(pool: usize) -> usize {
 
 /// Writes the scenes of `jobs`, runs them `study.jobs` at a time and reads
 /// back their outcomes; the failed runs are added to `failed`.
-fn run_jobs(
+pub(super) fn run_jobs(
     jobs: &[Job],
     study: &StudyOptions,
     display: &dyn RunDisplay,
@@ -255,17 +287,22 @@ fn run_jobs(
     // All scenes first, so that an invalid one stops the study before any run.
     let mut samples: Vec<(PathBuf, Scene)> = Vec::new();
     for job in jobs {
-        let sample = match samples.iter().find(|(p, _)| p == &job.sample) {
-            Some((_, s)) => s.clone(),
-            None => {
-                let s = Scene::load(&job.sample)?;
-                samples.push((job.sample.clone(), s.clone()));
-                s
+        let (mut loaded, from) = match &job.source {
+            Source::Loaded { spec, sample: path } => {
+                let sample = match samples.iter().find(|(p, _)| p == path) {
+                    Some((_, s)) => s.clone(),
+                    None => {
+                        let s = Scene::load(path)?;
+                        samples.push((path.clone(), s.clone()));
+                        s
+                    }
+                };
+                (loaded_scene(&sample, spec)?, format!(", from {}", path.display()))
             }
+            Source::Ready(scene) => ((**scene).clone(), String::new()),
         };
-        let mut loaded = loaded_scene(&sample, &job.spec)?;
         let record = perturb_scene(&mut loaded, &job.perturbation, job.replica)?;
-        let what = format!("{} of the study in {}, from {}", job.label, out.display(), job.sample.display());
+        let what = format!("{} of the study in {}{from}", job.label, out.display());
         let scene = job.scene(out);
         if let Some(parent) = scene.parent() {
             io::create_output_dir(parent)?;
@@ -392,7 +429,7 @@ fn run_columns(o: &Outcome) -> RunColumns {
 }
 
 /// Writes a study table: the columns `key` then `rest`, one row per item.
-fn write_table<R: Serialize>(path: &Path, key: &[&str], rest: &[&str], rows: &[R]) -> Result<()> {
+pub(super) fn write_table<R: Serialize>(path: &Path, key: &[&str], rest: &[&str], rows: &[R]) -> Result<()> {
     let header: Vec<&str> = key.iter().chain(rest).copied().collect();
     let mut t = TableWriter::create(path, &header)?;
     for r in rows {
@@ -402,7 +439,7 @@ fn write_table<R: Serialize>(path: &Path, key: &[&str], rest: &[&str], rows: &[R
 }
 
 /// The report of a study whose summary table is `DIR/name`.
-fn report(out: &Path, name: &str, failed: Vec<(String, String)>) -> Result<StudyReport> {
+pub(super) fn report(out: &Path, name: &str, failed: Vec<(String, String)>) -> Result<StudyReport> {
     Ok(StudyReport { table: SummaryTable::read(&out.join(name))?, runs: out.join("runs"), failed })
 }
 
@@ -468,12 +505,13 @@ pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn R
     let base = spec.loading.for_sample(&sample_scene)?;
     let settings: Vec<Job> = runs
         .iter()
-        .map(|(policy, tol)| Job {
-            label: format!("{policy}_{}", label_number(*tol)),
-            spec: LoadingSpec { criterion: policy.clone(), tolerance: *tol, ..base.clone() },
-            sample: sample_path.to_path_buf(),
-            replica: 0,
-            perturbation: spec.replicas.perturbation,
+        .map(|(policy, tol)| {
+            Job::loaded(
+                format!("{policy}_{}", label_number(*tol)),
+                LoadingSpec { criterion: policy.clone(), tolerance: *tol, ..base.clone() },
+                sample_path,
+                spec.replicas.perturbation,
+            )
         })
         .collect();
     let jobs = replicate(settings, &spec.replicas);
@@ -539,7 +577,14 @@ pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn R
     )?;
     let labelled: Vec<(String, Vec<&Outcome>)> =
         runs.iter().zip(per_setting).map(|((p, t), o)| (format!("{p} {t:e}"), o)).collect();
-    settlement_figure(out, "Settlement of the sleeper per convergence setting", &labelled, seating)?;
+    settlement_figure(
+        out,
+        "settlement_ensemble",
+        "Settlement of the sleeper per convergence setting",
+        &labelled,
+        seating,
+        &[],
+    )?;
     report(out, "convergence.csv", failed)
 }
 
@@ -583,13 +628,12 @@ pub fn steps(spec: &StepsSpec, study: &StudyOptions, display: &dyn RunDisplay) -
     for &a in inclinations {
         let base = Loading { inclination_deg: a, ..spec.loading.clone() }.for_sample(&sample_scene)?;
         for &dt in dts {
-            settings.push(Job {
-                label: format!("incl_{}_dt_{}", label_number(a), label_number(dt)),
-                spec: LoadingSpec { dt, ..base.clone() },
-                sample: sample_path.to_path_buf(),
-                replica: 0,
-                perturbation: spec.replicas.perturbation,
-            });
+            settings.push(Job::loaded(
+                format!("incl_{}_dt_{}", label_number(a), label_number(dt)),
+                LoadingSpec { dt, ..base.clone() },
+                sample_path,
+                spec.replicas.perturbation,
+            ));
             keys.push((a, dt));
         }
     }
@@ -648,7 +692,14 @@ pub fn steps(spec: &StepsSpec, study: &StudyOptions, display: &dyn RunDisplay) -
     )?;
     let labelled: Vec<(String, Vec<&Outcome>)> =
         keys.iter().zip(per_setting).map(|((a, dt), o)| (format!("{a}°, dt = {dt:e} s"), o)).collect();
-    settlement_figure(out, "Settlement of the sleeper per time step and inclination", &labelled, seating)?;
+    settlement_figure(
+        out,
+        "settlement_ensemble",
+        "Settlement of the sleeper per time step and inclination",
+        &labelled,
+        seating,
+        &[],
+    )?;
     report(out, "steps.csv", failed)
 }
 
@@ -752,13 +803,12 @@ pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisp
         let sample_path = out.join("samples").join(format!("seed_{seed}")).join("sample.toml");
         let sample_scene = Scene::load(&sample_path).map_err(output_error)?;
         for (&k, loading) in factors.iter().zip(&loadings) {
-            jobs.push(Job {
-                label: format!("seed_{seed}_k_{}", label_number(k)),
-                spec: loading.for_sample(&sample_scene)?,
-                sample: sample_path.clone(),
-                replica: 0,
-                perturbation: Perturbation::default(),
-            });
+            jobs.push(Job::loaded(
+                format!("seed_{seed}_k_{}", label_number(k)),
+                loading.for_sample(&sample_scene)?,
+                &sample_path,
+                Perturbation::default(),
+            ));
             keys.push((seed, k));
         }
     }

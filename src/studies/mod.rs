@@ -39,6 +39,7 @@
 //! ```
 
 pub mod campaigns;
+pub mod compare;
 mod display;
 pub mod karrech;
 pub mod luding;

@@ -696,6 +696,8 @@ mod tests {
             contacts: 0.0,
             iterations: 0.0,
             max_overlap_m: 0.0,
+            mean_overlap_m: 0.0,
+            coordination: 0.0,
         }
     }
 

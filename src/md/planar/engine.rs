@@ -132,7 +132,16 @@ impl Engine for PlanarSystem {
     }
 
     fn cycle_step(&self, c: &mut NscdCycleState, stats: &PlanarStepStats) {
-        outputs::cycle_step(self, c, stats.contacts, 0, stats.max_overlap);
+        outputs::cycle_step(
+            self,
+            c,
+            outputs::CycleStepStats {
+                contacts: stats.contacts,
+                iterations: 0,
+                max_overlap: stats.max_overlap,
+                mean_overlap: stats.mean_overlap,
+            },
+        );
     }
 
     fn cycle_end(&self, c: &mut NscdCycleState, cycle: u64) -> NscdCycleRow {
