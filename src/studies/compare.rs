@@ -216,6 +216,10 @@ fn settings(spec: &CompareSpec) -> Result<Vec<Setting>> {
             Error::Scene(m) if m.starts_with("soft.max_overlap_ratio") => {
                 Error::Scene(format!("--overlaps: {ratio:e}: {m}"))
             }
+            Error::Scene(m) if m.starts_with("soft.model") => Error::Scene(m.replacen("soft.model", "--model", 1)),
+            Error::Scene(m) if m.starts_with("soft.dt_fraction") => {
+                Error::Scene(m.replacen("soft.dt_fraction", "--dt-fraction", 1))
+            }
             e => e,
         })?;
         let (_, info) = md.build_planar()?;
