@@ -332,10 +332,14 @@ pub fn compare(spec: &CompareSpec, study: &StudyOptions, display: &dyn RunDispla
         .iter()
         .zip(&per_setting)
         .map(|(s, o)| {
-            let name = match s.ratio {
+            let mut name = match s.ratio {
                 None => "NSCD".to_string(),
                 Some(r) => format!("MD, overlap ratio {r:e}"),
             };
+            let failed = o.iter().filter(|o| o.status != "ok").count();
+            if failed > 0 {
+                name.push_str(&format!(", {failed} of {} failed", o.len()));
+            }
             (name, o.clone())
         })
         .collect();
