@@ -328,17 +328,16 @@ pub fn compare(spec: &CompareSpec, study: &StudyOptions, display: &dyn RunDispla
         .collect();
     write_file(&out.join("compare.md"), &markdown(&summaries, spec))?;
 
-    let labelled: Vec<(String, Vec<&Outcome>)> = settings
+    let labelled: Vec<(String, Vec<&Outcome>)> = summaries
         .iter()
         .zip(&per_setting)
         .map(|(s, o)| {
-            let mut name = match s.ratio {
+            let mut name = match s.overlap_ratio {
                 None => "NSCD".to_string(),
                 Some(r) => format!("MD, overlap ratio {r:e}"),
             };
-            let failed = o.iter().filter(|o| o.status != "ok").count();
-            if failed > 0 {
-                name.push_str(&format!(", {failed} of {} failed", o.len()));
+            if s.failed > 0 {
+                name.push_str(&format!(", {} of {} failed", s.failed, o.len()));
             }
             (name, o.clone())
         })
