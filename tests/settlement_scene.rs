@@ -164,6 +164,11 @@ fn bad_settlement_tables_name_the_key() {
             "law = \"shenton\"\nsettle_cycles = 4",
             "settlement.settle_cycles: must be at least 1 and less than computed_cycles (4), got 4",
         ),
+        (
+            "law = \"shenton\"",
+            "law = \"shenton\"\nsettle_rate = 0.0",
+            "settlement.settle_rate: must be a positive factor on the predicted rate, got 0",
+        ),
         ("law = \"shenton\"", "law = \"shenton\"\nspeed = 2", "unknown field `speed`"),
         ("initial_cycles = 2", "initial_cycles = 0", "settlement.initial_cycles: Shenton's law needs at least 1"),
         (
@@ -244,6 +249,80 @@ fn settle_cycles_leave_the_first_cycles_after_a_landing_out_of_the_window() {
         }
         let _ = std::fs::remove_dir_all(dir);
     }
+}
+
+#[test]
+fn settle_rate_keeps_re_seating_cycles_out_of_the_window_until_the_rate_falls() {
+    // The rule, recomputed from the tables: after a landing the window opens at
+    // the first computed cycle (from the `settle_cycles`-th on) whose increment,
+    // averaged with the previous one since the landing, is at most `settle_rate`
+    // times |landing_rate_m| of the jump (or after `computed_cycles` extra
+    // cycles). Those cycles are computed in addition to the k after the landing, which
+    // the linear law (eq. 16) then fits from its first point: the slope over
+    // the next extrapolated cycles is (s(last) − s(first)) / (last − first),
+    // exact to rounding. A huge factor never re-seats past the fixed count (the
+    // default run, bit for bit); a tiny one always re-seats k extra cycles.
+    let text = std::fs::read_to_string(SCENE).unwrap().replace("law = \"shenton\"", "law = \"linear\"");
+    let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
+    let run = |name: &str, extra: &str| {
+        let dir = out_dir(name);
+        std::fs::create_dir_all(&dir).unwrap();
+        let scene = dir.join("scene.toml");
+        std::fs::write(&scene, text.replace("law = \"linear\"", &format!("law = \"linear\"\n{extra}"))).unwrap();
+        let s = run_file(&scene, &dir.join("out"), &opts, &mut |_| {}).unwrap().unwrap();
+        let t = tables(&dir.join("out"));
+        let _ = std::fs::remove_dir_all(dir);
+        (s, t)
+    };
+    let (base, base_tables) = run("rate-none", "");
+    let (never, never_tables) = run("rate-huge", "settle_rate = 1e30");
+    assert_eq!(never_tables, base_tables);
+    assert_eq!(never.settlement_m.to_bits(), base.settlement_m.to_bits());
+    let k = 4u64; // the example's computed_cycles
+    let mut mid = false;
+    for (name, extra, factor) in [
+        ("rate-tiny", "settle_rate = 1e-30", 1e-30),
+        ("rate-one", "settle_rate = 1.0", 1.0),
+        ("rate-two", "settle_cycles = 2\nsettle_rate = 2.0", 2.0),
+    ] {
+        let settle = if name == "rate-two" { 2 } else { 1 };
+        let (s, (rows, jumps)) = run(name, extra);
+        assert!(jumps.len() >= 2, "{name}: {} jumps", jumps.len());
+        let at = |cycle: u64| rows[cycle as usize - 1].settlement_m;
+        for pair in jumps.windows(2) {
+            let (landed, next) = (&pair[0], &pair[1]);
+            // Recompute the re-seating of the cycles after `landed`.
+            let mut n = 0;
+            let mut previous: Option<f64> = None;
+            let first = loop {
+                n += 1;
+                let cycle = landed.to_cycle + n;
+                assert_eq!(rows[cycle as usize - 1].computed, 1, "{name}: cycle {cycle}");
+                let inc = at(cycle) - at(cycle - 1);
+                let mean = previous.map_or(inc, |p| 0.5 * (p + inc));
+                previous = Some(inc);
+                if n >= settle && (mean <= factor * landed.landing_rate_m.abs() || n - settle >= k) {
+                    break cycle;
+                }
+            };
+            // The rule ended the re-seating itself: past the fixed count, before the cap.
+            mid |= next.settling_cycles >= settle && next.settling_cycles < settle - 1 + k;
+            assert_eq!(next.settling_cycles, first - landed.to_cycle - 1, "{name}: jump {}", next.jump);
+            assert_eq!(next.from_cycle, first + k - settle, "{name}: jump {}", next.jump);
+            if name == "rate-tiny" {
+                assert_eq!(next.settling_cycles, k, "{name}: every landing re-seats k cycles");
+            }
+            let last = next.from_cycle;
+            let slope = (at(last) - at(first)) / (last - first) as f64;
+            for j in 1..next.extrapolated_cycles.min(3) {
+                let want = at(last) + j as f64 * slope;
+                let got = at(last + j);
+                assert!((got - want).abs() <= 1e-12 * want.abs(), "{name}, cycle {}: {got} vs {want}", last + j);
+            }
+        }
+        assert!(s.computed_cycles > base.computed_cycles || name != "rate-tiny");
+    }
+    assert!(mid, "no landing's re-seating ended between the fixed count and the cap");
 }
 
 #[test]

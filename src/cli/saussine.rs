@@ -339,6 +339,12 @@ pub(crate) struct AccelerateArgs {
     /// window's data start at the end of the last of them (default 1).
     #[arg(long, value_name = "N", requires = "accelerate")]
     settle_cycles: Option<u64>,
+    /// Keep re-seating past --settle-cycles while the settlement's increment
+    /// (mean of the last two computed cycles) exceeds this factor times the
+    /// per-cycle rate the jump's fit predicted at the landing; those cycles are
+    /// computed in addition to the window's, at most K of them (default: none).
+    #[arg(long, value_name = "FACTOR", requires = "accelerate")]
+    settle_rate: Option<f64>,
     /// A full run of the same sample and loading (its output folder, e.g. from
     /// `--accelerate K_I,N+1,1`, which never jumps, or a plain settle): errors.csv
     /// (settlement, accrued error after K_I, coordination) and its curve on the figure.
@@ -362,6 +368,7 @@ impl AccelerateArgs {
             extrapolation_limit: self.extrapolation_limit,
             smoothing_length: self.smoothing_length,
             settle_cycles: self.settle_cycles,
+            settle_rate: self.settle_rate,
             reference: self.reference.clone(),
         }))
     }

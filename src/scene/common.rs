@@ -293,6 +293,11 @@ pub struct SettlementSection {
     /// less than `computed_cycles`); default 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub settle_cycles: Option<u64>,
+    /// Keep re-seating past `settle_cycles` while the settlement's increment
+    /// exceeds this factor (> 0) times the rate predicted at the landing;
+    /// default: none, a fixed count.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settle_rate: Option<f64>,
 }
 
 /// `settlement.relax_tolerance`: a length (m) or a word (`"computed"`).
@@ -367,6 +372,7 @@ pub(crate) fn check_settlement(
     if let Some(n) = s.settle_cycles {
         spec.settle_cycles = n;
     }
+    spec.settle_rate = s.settle_rate;
     spec.relax.method = match s.relax_method.as_deref() {
         None | Some("lbfgs") => Method::Lbfgs,
         Some("gradient_descent") => Method::GradientDescent,
@@ -426,6 +432,7 @@ pub(crate) fn write_settlement(out: &mut String, s: Option<&SettlementSection>) 
     opt(out, "extrapolation_limit", s.extrapolation_limit, float);
     opt(out, "smoothing_length", s.smoothing_length, float);
     opt(out, "settle_cycles", s.settle_cycles, |n| n.to_string());
+    opt(out, "settle_rate", s.settle_rate, float);
 }
 
 /// A scene of either engine as a run records it (`scene.toml`): the text it was

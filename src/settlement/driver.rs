@@ -179,6 +179,14 @@ pub struct Acceleration {
     /// window's first point, its increment not fitted).
     #[serde(default = "default_settle_cycles")]
     pub settle_cycles: u64,
+    /// Keep re-seating past `settle_cycles` while the settlement's increment
+    /// (mean of the last two computed cycles since the landing) exceeds this
+    /// factor times the per-cycle rate the jump's fit predicted at its landing;
+    /// these cycles are computed in addition to the window's (at most
+    /// `computed_cycles` of them after a landing). `None`: a fixed count
+    /// (docs/settlement-driver.md, "A window starts one cycle after a landing").
+    #[serde(default)]
+    pub settle_rate: Option<f64>,
 }
 
 fn default_settle_cycles() -> u64 {
@@ -212,6 +220,7 @@ impl Acceleration {
             extrapolation_limit: Self::EXTRAPOLATION_LIMIT,
             smoothing_length: None,
             settle_cycles: 1,
+            settle_rate: None,
         }
     }
 
@@ -244,6 +253,9 @@ impl Acceleration {
                 "settle_cycles: must be at least 1 and less than computed_cycles ({}), got {}",
                 self.computed_cycles, self.settle_cycles
             ));
+        }
+        if let Some(f) = self.settle_rate.filter(|f| !(*f > 0.0 && f.is_finite())) {
+            return bad(format!("settle_rate: must be a positive factor on the predicted rate, got {f}"));
         }
         if let Some(l) = self.smoothing_length.filter(|l| !(*l > 0.0 && l.is_finite())) {
             return bad(format!("smoothing_length: must be a positive length (m), got {l}"));
@@ -329,6 +341,13 @@ pub struct JumpRow {
     /// with a trend included).
     #[serde(default)]
     pub limited_bodies: u64,
+    /// Computed cycles after the previous landing left out of this window (the
+    /// re-seating: `settle_cycles − 1`, more with `settle_rate`; 0 for the first jump).
+    #[serde(default)]
+    pub settling_cycles: u64,
+    /// The settlement's per-cycle rate the fit predicts at this jump's landing (m per cycle).
+    #[serde(default)]
+    pub landing_rate_m: f64,
 }
 
 impl JumpRow {
@@ -353,6 +372,8 @@ impl JumpRow {
         "relax_wall_time_s",
         "held_bodies",
         "limited_bodies",
+        "settling_cycles",
+        "landing_rate_m",
     ];
 }
 
@@ -438,6 +459,16 @@ struct State<E> {
     /// The largest overlap at the end of the last computed cycle (m).
     #[serde(default)]
     computed_overlap: f64,
+    /// The settlement's per-cycle rate the last jump's fit predicted at its landing (m).
+    #[serde(default)]
+    landing_rate: f64,
+    /// Computed cycles since the last landing left out of the window.
+    #[serde(default)]
+    settling: u64,
+    /// The settlement's increment over the last computed cycle, if it followed
+    /// a computed cycle since the last landing (m).
+    #[serde(default)]
+    last_increment: Option<f64>,
     wall_time_s: f64,
     /// Bytes, rows and CRC-32 of `settlement.csv` and `jumps.csv`.
     tables: [(u64, u64, u32); 2],
@@ -582,6 +613,7 @@ impl<E: Engine> Accelerated<E> {
             let bounds = st.sys.boundaries();
             let s = st.settlement(&c, &bounds, vertical, self.spec.settlement_boundary);
             let b = coordinates(&bounds);
+            let increment = s - st.last_settlement;
             st.last_settlement = s;
             if let Some(p) = files.positions.as_mut() {
                 p.append(&c)?;
@@ -599,21 +631,29 @@ impl<E: Engine> Accelerated<E> {
             // `start`; with none, it holds cycle 0).
             if st.cycle >= self.spec.initial_cycles {
                 // After a jump the first `settle_cycles − 1` computed cycles are
-                // not data (the landing re-seats in them); the next one starts a
-                // new segment.
+                // not data (the landing re-seats in them), nor, with
+                // `settle_rate`, the next ones while the settlement still runs
+                // ahead of the landing's rate; the next one starts a new segment.
                 let after_jump = (st.jumps > 0).then_some(st.since_jump + 1);
-                if after_jump.is_none_or(|n| n >= self.spec.settle_cycles) {
-                    if after_jump == Some(self.spec.settle_cycles) {
-                        st.window.push_segment(st.cycle as f64, c);
-                    } else {
-                        st.window.push(st.cycle as f64, c);
+                let extra = after_jump == Some(self.spec.settle_cycles) && self.still_settling(&st, increment);
+                match after_jump {
+                    Some(n) if n < self.spec.settle_cycles || extra => st.settling += 1,
+                    _ => {
+                        if after_jump == Some(self.spec.settle_cycles) {
+                            st.window.push_segment(st.cycle as f64, c);
+                        } else {
+                            st.window.push(st.cycle as f64, c);
+                        }
+                        st.window_settlement.push(s);
+                        st.window_boundaries.push(b);
                     }
-                    st.window_settlement.push(s);
-                    st.window_boundaries.push(b);
                 }
-                if st.cycle > self.spec.initial_cycles {
+                if st.cycle > self.spec.initial_cycles && !extra {
                     st.since_jump += 1;
                 }
+            }
+            if st.jumps > 0 {
+                st.last_increment = Some(increment);
             }
             // A jump when the window is long enough and cycles are left.
             let left = self.target - st.cycle;
@@ -679,6 +719,24 @@ impl<E: Engine> Accelerated<E> {
         Ok(AccelerationOutcome { summary, system: st.sys, out: out.to_path_buf() })
     }
 
+    /// Whether the landing still re-seats in the computed cycle whose settlement
+    /// increment is `increment` (m), the `settle_cycles`-th after it or later:
+    /// with `settle_rate`, while the mean increment of the last two computed
+    /// cycles since the landing exceeds `settle_rate` times the rate the jump's
+    /// fit predicted there, for at most `computed_cycles` cycles past the fixed count.
+    fn still_settling(&self, st: &State<E>, increment: f64) -> bool {
+        let Some(factor) = self.spec.settle_rate else { return false };
+        let extra = (st.settling + 1).saturating_sub(self.spec.settle_cycles);
+        if extra >= self.spec.computed_cycles {
+            return false;
+        }
+        let mean = match st.last_increment {
+            Some(previous) => 0.5 * (previous + increment),
+            None => increment,
+        };
+        mean > factor * st.landing_rate.abs()
+    }
+
     /// Fits the window, extrapolates, writes back and relaxes; the rows of the
     /// extrapolated cycles and the jump's row. Leaves the window as it is when
     /// the adaptive bound asks for more computed cycles.
@@ -714,6 +772,8 @@ impl<E: Engine> Accelerated<E> {
         let (n, segments) = (&window.cycles, &window.segments);
         let n_last = *n.last().expect("a window has points");
         let sc = law.fit(n, settlements, segments);
+        let landing_rate = law.extrapolate(&sc, n_last, st.last_settlement, h as f64)
+            - law.extrapolate(&sc, n_last, st.last_settlement, (h - 1) as f64);
         // Bounded moves: a body without a force-carrying contact is held, the
         // others move at most `extrapolation_limit` of their size or
         // `MEDIAN_MOVES` times the median trend move, whichever is larger
@@ -813,7 +873,12 @@ impl<E: Engine> Accelerated<E> {
             relax_wall_time_s: relax_wall,
             held_bodies: held,
             limited_bodies: limited as u64,
+            settling_cycles: st.settling,
+            landing_rate_m: landing_rate,
         })?;
+        st.landing_rate = landing_rate;
+        st.settling = 0;
+        st.last_increment = None;
         // The next window starts at the end of the first computed cycle after
         // the landing (the relaxed configuration re-seats in that cycle).
         st.since_jump = 0;
@@ -876,6 +941,9 @@ impl<E: Engine> Accelerated<E> {
             origin,
             last_settlement: 0.0,
             computed_overlap: 0.0,
+            landing_rate: 0.0,
+            settling: 0,
+            last_increment: None,
             wall_time_s: 0.0,
             tables: [(0, 0, 0); 2],
             positions_crc32: 0,

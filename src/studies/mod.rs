@@ -123,6 +123,9 @@ pub struct Accelerate {
     pub smoothing_length: Option<f64>,
     /// Computed cycles after each jump before the window's data start; `None`: 1.
     pub settle_cycles: Option<u64>,
+    /// Keep re-seating while the settlement runs ahead of this factor times the
+    /// landing's predicted rate; `None`: a fixed count.
+    pub settle_rate: Option<f64>,
     /// A full run of the same loaded sample (its folder) to measure the errors
     /// against: `errors.csv` and its curve on the settlement figure.
     pub reference: Option<PathBuf>,
@@ -152,6 +155,7 @@ impl Accelerate {
             extrapolation_limit: self.extrapolation_limit,
             smoothing_length: self.smoothing_length,
             settle_cycles: self.settle_cycles,
+            settle_rate: self.settle_rate,
             ..Default::default()
         }
     }
