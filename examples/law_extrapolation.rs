@@ -17,13 +17,13 @@
 use ballast::settlement::{law_named, SettlementRow};
 use std::path::Path;
 
+const USAGE: &str = "usage: law_extrapolation N K_I LAW FULL_DIR [FULL_DIR …]";
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let [n, ki, law, dirs @ ..] = args.as_slice() else {
-        return Err("usage: law_extrapolation N K_I LAW FULL_DIR [FULL_DIR …]".into());
-    };
+    let [n, ki, law, dirs @ ..] = args.as_slice() else { return Err(USAGE.into()) };
     if dirs.is_empty() {
-        return Err("usage: law_extrapolation N K_I LAW FULL_DIR [FULL_DIR …]".into());
+        return Err(USAGE.into());
     }
     let (target, ki): (u64, u64) = (n.parse()?, ki.parse()?);
     let law = law_named(law)?;

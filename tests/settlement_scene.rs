@@ -3,7 +3,7 @@
 //! one-line errors naming the key.
 
 use ballast::run::RunOptions;
-use ballast::settlement::{run_file, JumpRow, SettlementRow};
+use ballast::settlement::{run_file, AccelerationSummary, JumpRow, SettlementRow};
 use std::path::{Path, PathBuf};
 
 const SCENE: &str = "examples/settlement_sleeper.toml";
@@ -21,6 +21,20 @@ fn tables(dir: &Path) -> (Vec<SettlementRow>, Vec<JumpRow>) {
     rows.iter_mut().for_each(|r| r.wall_time_s = 0.0);
     jumps.iter_mut().for_each(|j| j.relax_wall_time_s = 0.0);
     (rows, jumps)
+}
+
+/// Runs the scene `text` (a single-threaded run, no checkpoints) in a fresh
+/// folder named after `name`: its summary and tables, the folder removed.
+fn run_text(name: &str, text: &str) -> (AccelerationSummary, (Vec<SettlementRow>, Vec<JumpRow>)) {
+    let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
+    let dir = out_dir(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("scene.toml");
+    std::fs::write(&scene, text).unwrap();
+    let s = run_file(&scene, &dir.join("out"), &opts, &mut |_| {}).unwrap().unwrap();
+    let t = tables(&dir.join("out"));
+    let _ = std::fs::remove_dir_all(dir);
+    (s, t)
 }
 
 #[test]
@@ -221,20 +235,14 @@ fn settle_cycles_leave_the_first_cycles_after_a_landing_out_of_the_window() {
     // cycle 10 are not data, the window is 13–14 and the slope s(14) − s(13);
     // by default it is 11–14, slope (s(14) − s(11))/3. Exact to rounding.
     let text = std::fs::read_to_string(SCENE).unwrap().replace("duration = 1.5 ", "duration = 0.9 ");
-    let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
     for (settle, first) in [(None, 11usize), (Some(3), 13)] {
         let mut t = text.replace("law = \"shenton\"", "law = \"linear\"");
         if let Some(n) = settle {
             t = t.replace("law = \"linear\"", &format!("law = \"linear\"\nsettle_cycles = {n}"));
         }
-        let dir = out_dir(&format!("settle{first}"));
-        std::fs::create_dir_all(&dir).unwrap();
-        let scene = dir.join("scene.toml");
-        std::fs::write(&scene, t).unwrap();
-        let s = run_file(&scene, &dir.join("out"), &opts, &mut |_| {}).unwrap().unwrap();
+        let (s, (rows, _)) = run_text(&format!("settle{first}"), &t);
         // 18 cycles: 2 initial, 4 computed, 4 extrapolated, 4 computed, 4 extrapolated.
         assert_eq!((s.total_cycles, s.computed_cycles, s.jumps), (18, 10, 2));
-        let (rows, _) = tables(&dir.join("out"));
         let at = |cycle: usize| rows[cycle - 1].settlement_m;
         assert!(rows[10..14].iter().all(|r| r.computed == 1), "cycles 11-14 computed");
         let slope = (at(14) - at(first)) / (14 - first) as f64;
@@ -247,7 +255,6 @@ fn settle_cycles_leave_the_first_cycles_after_a_landing_out_of_the_window() {
                 at(14 + j)
             );
         }
-        let _ = std::fs::remove_dir_all(dir);
     }
 }
 
@@ -263,16 +270,8 @@ fn settle_rate_keeps_re_seating_cycles_out_of_the_window_until_the_rate_falls() 
     // exact to rounding. A huge factor never re-seats past the fixed count (the
     // default run, bit for bit); a tiny one always re-seats k extra cycles.
     let text = std::fs::read_to_string(SCENE).unwrap().replace("law = \"shenton\"", "law = \"linear\"");
-    let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
     let run = |name: &str, extra: &str| {
-        let dir = out_dir(name);
-        std::fs::create_dir_all(&dir).unwrap();
-        let scene = dir.join("scene.toml");
-        std::fs::write(&scene, text.replace("law = \"linear\"", &format!("law = \"linear\"\n{extra}"))).unwrap();
-        let s = run_file(&scene, &dir.join("out"), &opts, &mut |_| {}).unwrap().unwrap();
-        let t = tables(&dir.join("out"));
-        let _ = std::fs::remove_dir_all(dir);
-        (s, t)
+        run_text(name, &text.replace("law = \"linear\"", &format!("law = \"linear\"\n{extra}")))
     };
     let (base, base_tables) = run("rate-none", "");
     let (never, never_tables) = run("rate-huge", "settle_rate = 1e30");
@@ -280,12 +279,11 @@ fn settle_rate_keeps_re_seating_cycles_out_of_the_window_until_the_rate_falls() 
     assert_eq!(never.settlement_m.to_bits(), base.settlement_m.to_bits());
     let k = 4u64; // the example's computed_cycles
     let mut mid = false;
-    for (name, extra, factor) in [
-        ("rate-tiny", "settle_rate = 1e-30", 1e-30),
-        ("rate-one", "settle_rate = 1.0", 1.0),
-        ("rate-two", "settle_cycles = 2\nsettle_rate = 2.0", 2.0),
+    for (name, extra, settle, factor) in [
+        ("rate-tiny", "settle_rate = 1e-30", 1, 1e-30),
+        ("rate-one", "settle_rate = 1.0", 1, 1.0),
+        ("rate-two", "settle_cycles = 2\nsettle_rate = 2.0", 2, 2.0),
     ] {
-        let settle = if name == "rate-two" { 2 } else { 1 };
         let (s, (rows, jumps)) = run(name, extra);
         assert!(jumps.len() >= 2, "{name}: {} jumps", jumps.len());
         let at = |cycle: u64| rows[cycle as usize - 1].settlement_m;

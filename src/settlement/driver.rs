@@ -772,8 +772,8 @@ impl<E: Engine> Accelerated<E> {
         let (n, segments) = (&window.cycles, &window.segments);
         let n_last = *n.last().expect("a window has points");
         let sc = law.fit(n, settlements, segments);
-        let landing_rate = law.extrapolate(&sc, n_last, st.last_settlement, h as f64)
-            - law.extrapolate(&sc, n_last, st.last_settlement, (h - 1) as f64);
+        // The fitted settlement's increment over the jump's last cycle.
+        let landing_rate = law.trend(&sc, n_last + h as f64) - law.trend(&sc, n_last + (h - 1) as f64);
         // Bounded moves: a body without a force-carrying contact is held, the
         // others move at most `extrapolation_limit` of their size or
         // `MEDIAN_MOVES` times the median trend move, whichever is larger
