@@ -460,6 +460,12 @@ impl MdSystem {
         self.threads.max(1)
     }
 
+    /// What the two-thread team of the step's phases did so far: joins run side
+    /// by side, taken back by the caller, or run in turn (zero on one thread).
+    pub fn team_stats(&self) -> crate::team::TeamStats {
+        self.team.stats()
+    }
+
     /// Changes the time step (s) from now on, keeping the clock exact.
     pub fn set_dt(&mut self, dt: f64) {
         self.time_origin = self.time;

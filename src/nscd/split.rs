@@ -20,7 +20,9 @@
 //! never on the number of threads: a run gives the same numbers on one core or
 //! two. With two threads each sweep of the right half runs on the helper of a
 //! [`Team`], started once and spinning between sweeps (a sweep lasts tens of
-//! microseconds, far less than a sleep and wake-up).
+//! microseconds, far less than a sleep and wake-up); the caller sweeps the right
+//! half itself when the helper has not started it, and the team sweeps both in
+//! turn while it measures two threads slower than one on a shared machine.
 //!
 //! Nothing is allocated once the buffers have grown to the problem's size.
 
@@ -247,6 +249,11 @@ impl SplitWorkspace {
             Self::exchange(left, right, iface, side, slot, false);
             merge(merge(l, r), i)
         })
+    }
+
+    /// What the two-thread team's joins did so far (zero on one thread).
+    pub(crate) fn team_stats(&self) -> crate::team::TeamStats {
+        self.team.stats()
     }
 
     /// Writes the velocities and impulses back in the caller's order.

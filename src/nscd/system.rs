@@ -246,6 +246,12 @@ impl System {
         self.ws.threads = threads;
     }
 
+    /// What the two-thread team of the split sweeps did so far: joins run side by
+    /// side, taken back by the caller, or run in turn (zero on one thread).
+    pub fn team_stats(&self) -> crate::team::TeamStats {
+        self.ws.split.team_stats()
+    }
+
     /// The NLGS problem of the last step, restarted cold: `u = u_free` and all
     /// impulses zero. Benchmarks time sweeps on it.
     pub fn nlgs_problem(&self) -> super::nlgs::NlgsProblem {
