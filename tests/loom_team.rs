@@ -111,6 +111,36 @@ fn join_returns_both_halves() {
 }
 
 #[test]
+fn each_half_runs_exactly_once() {
+    // The helper takes the second half, or the caller takes it back once its own
+    // half is done (a helper that has not started it costs nothing): loom goes
+    // through both, and through the race between them; either way the half runs
+    // once, and its write is seen by the caller after the join.
+    static OUTCOMES: [AtomicUsize; 2] = [AtomicUsize::new(0), AtomicUsize::new(0)];
+    model("each_half_runs_exactly_once", || {
+        let team = Team::new(2);
+        let runs = loom::sync::atomic::AtomicUsize::new(0);
+        let probe = Probe::new();
+        let (a, b) = team.join(
+            || 1,
+            || {
+                runs.fetch_add(1, loom::sync::atomic::Ordering::Relaxed);
+                probe.set(7);
+                2
+            },
+        );
+        assert_eq!((a, b), (1, 2));
+        assert_eq!(probe.get(), 7);
+        assert_eq!(runs.load(loom::sync::atomic::Ordering::Relaxed), 1);
+        let stats = team.stats();
+        assert_eq!(stats.on_helper + stats.taken_back, 1);
+        OUTCOMES[usize::from(stats.taken_back == 1)].fetch_add(1, Ordering::Relaxed);
+    });
+    // The model went through both: the helper ran the half, the caller took it back.
+    assert!(OUTCOMES.iter().all(|n| n.load(Ordering::Relaxed) > 0), "{OUTCOMES:?}");
+}
+
+#[test]
 fn two_successive_joins() {
     // Between the two, the helper goes back to waiting (spin, then the sleep
     // path); the second job is posted wherever it is, and the job slot is
@@ -155,11 +185,13 @@ fn a_panic_in_b_reaches_the_caller_and_the_team_goes_on() {
 }
 
 #[test]
-fn a_panic_in_a_waits_for_b() {
+fn a_panic_in_a_waits_for_b_or_takes_it_back() {
     // The wait-on-drop guard: `join` unwinds only once the helper is done with
-    // the job (which borrows this frame); then the team is dropped.
+    // the job (which borrows this frame), or once the caller has taken back a
+    // job the helper had not started (then `b` never runs, not even later: the
+    // probe is unchanged once the helper has ended).
     quiet_booms();
-    model("a_panic_in_a_waits_for_b", || {
+    model("a_panic_in_a_waits_for_b_or_takes_it_back", || {
         let team = Team::new(2);
         let probe = Probe::new();
         let r = catch_unwind(AssertUnwindSafe(|| {
@@ -172,8 +204,13 @@ fn a_panic_in_a_waits_for_b() {
         }));
         let payload = r.expect_err("the panic of a must reach the caller");
         assert_eq!(message(&*payload), "boom a");
-        assert_eq!(probe.get(), 2);
+        let seen = probe.get();
+        assert!(seen == 0 || seen == 2, "{seen}");
+        let stats = team.stats();
         drop(team);
+        assert_eq!(probe.get(), seen, "b ran after the join had unwound");
+        // An unwinding join is not counted (the choice is not updated).
+        assert_eq!(stats.joins, 0);
     });
 }
 

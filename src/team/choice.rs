@@ -41,6 +41,12 @@
 #[cfg(not(feature = "loom"))]
 use std::time::{Duration, Instant};
 
+/// What the choice reads the time from: `Instant` (nothing in the loom model).
+#[cfg(not(feature = "loom"))]
+pub(super) type Clock = Instant;
+#[cfg(feature = "loom")]
+pub(super) type Clock = ();
+
 /// How the halves of a join run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum Mode {
@@ -71,6 +77,7 @@ pub(super) enum Outcome {
     TakenBack,
     /// Run by the helper; the caller's half took `own` and it then waited
     /// `waited` for the helper (seconds).
+    #[cfg_attr(feature = "loom", allow(dead_code))] // the model times nothing
     Helper { own: f64, waited: f64 },
 }
 
@@ -155,9 +162,8 @@ impl Choice {
         }
     }
 
-    /// The mode of the join that starts now.
-    pub(super) fn start(&mut self) -> Ticket {
-        let start = Instant::now();
+    /// The mode of the join that starts `start` (now, but for the tests).
+    pub(super) fn start(&mut self, start: Instant) -> Ticket {
         if let Phase::Exploit { until } = self.phase {
             if start >= until {
                 self.stats.trials += 1;
@@ -180,10 +186,9 @@ impl Choice {
         }
     }
 
-    /// Records how the join of `ticket` went.
-    pub(super) fn finish(&mut self, ticket: Ticket, outcome: Outcome) {
+    /// Records how the join of `ticket` went; it ended `now`.
+    pub(super) fn finish(&mut self, ticket: Ticket, outcome: Outcome, now: Instant) {
         self.count(outcome);
-        let now = Instant::now();
         let from = self.last_end.map_or(ticket.start, |end| end.max(ticket.start - GAP.min(ticket.start - end)));
         self.last_end = Some(now);
         match &mut self.phase {
@@ -236,11 +241,11 @@ impl Choice {
         Choice { stats: TeamStats::default() }
     }
 
-    pub(super) fn start(&mut self) -> Ticket {
+    pub(super) fn start(&mut self, _now: Clock) -> Ticket {
         Ticket { mode: Mode::SideBySide }
     }
 
-    pub(super) fn finish(&mut self, _ticket: Ticket, outcome: Outcome) {
+    pub(super) fn finish(&mut self, _ticket: Ticket, outcome: Outcome, _now: Clock) {
         self.count(outcome);
     }
 }
@@ -261,21 +266,18 @@ impl Choice {
 mod tests {
     use super::*;
 
-    /// Runs joins whose duration depends on the mode until `joins` are done,
-    /// returning the stats.
-    fn drive(choice: &mut Choice, joins: usize, cost: impl Fn(Mode) -> Duration) {
+    /// Runs `joins` joins whose duration depends on the mode, one after the
+    /// other on a synthetic clock that starts at `*now`.
+    fn drive(choice: &mut Choice, now: &mut Instant, joins: usize, cost: impl Fn(Mode) -> Duration) {
         for _ in 0..joins {
-            let t = choice.start();
+            let t = choice.start(*now);
             let d = cost(t.mode);
-            let until = Instant::now() + d;
-            while Instant::now() < until {
-                std::hint::spin_loop();
-            }
+            *now += d;
             let outcome = match t.mode {
                 Mode::InTurn => Outcome::InTurn,
                 Mode::SideBySide => Outcome::Helper { own: d.as_secs_f64(), waited: 0.0 },
             };
-            choice.finish(t, outcome);
+            choice.finish(t, outcome, *now);
         }
     }
 
@@ -284,25 +286,31 @@ mod tests {
         // In turn twice as fast as side by side (a helper sharing the caller's
         // core): the first trial switches, the later ones keep it.
         let mut c = Choice::new();
-        c.phase = Phase::Exploit { until: Instant::now() };
-        drive(&mut c, 200, |m| Duration::from_micros(if m == Mode::InTurn { 100 } else { 200 }));
+        let mut now = Instant::now() + MIN_PERIOD;
+        drive(&mut c, &mut now, 200, |m| Duration::from_micros(if m == Mode::InTurn { 100 } else { 200 }));
         assert_eq!(c.current, Mode::InTurn);
-        assert_eq!(c.stats.switches, 1);
+        assert_eq!((c.stats.trials, c.stats.switches), (1, 1));
+        // Later trials keep it: 40 ms of joins to the second trial, 80 to the third.
+        drive(&mut c, &mut now, 2000, |m| Duration::from_micros(if m == Mode::InTurn { 100 } else { 200 }));
+        assert_eq!((c.stats.trials, c.stats.switches), (3, 1));
+        assert_eq!(c.period, 4 * MIN_PERIOD);
         // Side by side faster again: the next trial switches back.
-        c.phase = Phase::Exploit { until: Instant::now() };
-        drive(&mut c, 200, |m| Duration::from_micros(if m == Mode::InTurn { 200 } else { 100 }));
+        now += c.period;
+        drive(&mut c, &mut now, 200, |m| Duration::from_micros(if m == Mode::InTurn { 200 } else { 100 }));
         assert_eq!(c.current, Mode::SideBySide);
-        assert_eq!(c.stats.switches, 2);
-        assert_eq!(c.stats.joins, 400);
+        assert_eq!((c.stats.trials, c.stats.switches), (4, 2));
+        assert_eq!(c.stats.joins, 2400);
+        assert_eq!(c.stats.in_turn + c.stats.on_helper, 2400);
     }
 
     #[test]
     fn equal_modes_choose_one_thread_and_the_period_grows() {
         // Side by side is kept only if it is faster by the margin.
         let mut c = Choice::new();
+        let mut now = Instant::now();
         for _ in 0..3 {
-            c.phase = Phase::Exploit { until: Instant::now() };
-            drive(&mut c, 200, |_| Duration::from_micros(100));
+            now += c.period;
+            drive(&mut c, &mut now, 200, |_| Duration::from_micros(100));
         }
         assert_eq!(c.current, Mode::InTurn);
         assert_eq!(c.stats.switches, 1);
@@ -313,10 +321,11 @@ mod tests {
     #[test]
     fn a_long_wait_for_the_helper_brings_the_trial_forward() {
         let mut c = Choice::new();
-        c.phase = Phase::Exploit { until: Instant::now() + Duration::from_secs(60) };
-        let t = c.start();
-        c.finish(t, Outcome::Helper { own: 1e-5, waited: 1e-3 });
-        let t = c.start();
+        let now = Instant::now();
+        let t = c.start(now);
+        assert_eq!(t.mode, Mode::SideBySide);
+        c.finish(t, Outcome::Helper { own: 1e-5, waited: 1e-3 }, now + Duration::from_micros(1010));
+        let t = c.start(now + Duration::from_micros(1020));
         assert!(matches!(c.phase, Phase::Trial { .. }));
         assert_eq!(t.mode, Mode::InTurn);
     }

@@ -126,9 +126,9 @@ impl Team {
         let s = Arc::clone(&shared);
         let thread = thread::Builder::new().name("ballast-helper".into()).spawn(move || helper(&s));
         match thread {
-            Ok(t) => Team {
-                helper: Some(Helper { shared, thread: Some(t), choice: std::sync::Mutex::new(Choice::new()) }),
-            },
+            Ok(t) => {
+                Team { helper: Some(Helper { shared, thread: Some(t), choice: std::sync::Mutex::new(Choice::new()) }) }
+            }
             // No thread to be had: run on the caller alone.
             Err(_) => Team::default(),
         }
@@ -166,7 +166,7 @@ impl Team {
         };
         // Released when this returns or unwinds, after the choice is updated.
         let _busy = Busy(&h.shared);
-        let ticket = h.choice().start();
+        let ticket = h.choice().start(now());
         let rest = ticket.mode == Mode::InTurn;
         if h.shared.rest.load(Ordering::Relaxed) != rest {
             h.shared.rest.store(rest, Ordering::Relaxed);
@@ -177,10 +177,18 @@ impl Team {
         } else {
             side_by_side(h, a, b)
         };
-        h.choice().finish(ticket, outcome);
+        h.choice().finish(ticket, outcome, now());
         r
     }
 }
+
+/// The time the mode choice reads.
+#[cfg(not(feature = "loom"))]
+fn now() -> choice::Clock {
+    std::time::Instant::now()
+}
+#[cfg(feature = "loom")]
+fn now() -> choice::Clock {}
 
 /// Posts `b` to the helper, runs `a`, then takes `b` back if the helper has not
 /// taken it, or waits for the helper to finish it.
@@ -430,6 +438,20 @@ mod tests {
             let sums: Vec<u64> = t.into_iter().map(|h| h.join().unwrap()).collect();
             assert_eq!(sums, vec![124_750, 249_500]);
         });
+    }
+
+    #[test]
+    fn every_join_is_counted_once() {
+        // Whether the helper ran the second half, the caller took it back, or the
+        // team ran it in turn, each join is one of the three.
+        let team = Team::new(2);
+        for i in 0..2000u64 {
+            assert_eq!(team.join(|| i, || 2 * i), (i, 2 * i));
+        }
+        let s = team.stats();
+        assert_eq!(s.joins, 2000);
+        assert_eq!(s.on_helper + s.taken_back + s.in_turn, 2000);
+        assert_eq!(Team::new(1).stats(), super::TeamStats::default());
     }
 
     #[test]
