@@ -19,14 +19,14 @@
 //! wait is long (the helper was descheduled while running it) or the machine is
 //! so shared that two threads lose against one, the team measures it and runs
 //! its joins in turn on the caller, with the helper asleep, until a later trial
-//! finds side by side faster again ([`choice`]).
+//! finds side by side faster again (`team/choice.rs`).
 //!
 //! Who runs a half never changes what it computes: the numbers are the same on
 //! one thread or two, in either mode.
 //!
 //! A team without a helper (one thread) runs both halves in order on the caller.
 //!
-//! The hand-over is checked by a loom model of this very code ([`sync`],
+//! The hand-over is checked by a loom model of this very code (`team/sync.rs`,
 //! `tests/loom_team.rs`): `cargo test --features loom --test loom_team`.
 
 mod choice;
