@@ -27,7 +27,8 @@
 //! twice, so the trials cost a few per cent of the first second and a fraction
 //! of a per cent after. A parallel join whose caller waited for the helper for
 //! much longer than its own half took (the helper was descheduled holding its
-//! half) brings the next trial forward.
+//! half) brings the next trial forward, to no sooner than `MIN_PERIOD` after
+//! the last one.
 //!
 //! A join's time in a trial runs from the end of the previous join (at most
 //! [`GAP`] before its start) to its own end: the serial work between joins
@@ -128,8 +129,8 @@ pub(super) const GAP: Duration = Duration::from_millis(1);
 #[cfg(not(feature = "loom"))]
 #[derive(Debug)]
 enum Phase {
-    /// The current mode until the next trial.
-    Exploit { until: Instant },
+    /// The current mode from `since` until the next trial.
+    Exploit { since: Instant, until: Instant },
     /// Block `block` (0–3) of a trial: joins counted in this block, joins each
     /// block after the first runs, and the time of each block.
     Trial { block: usize, joins: u32, target: u32, time: [Duration; 4] },
@@ -155,7 +156,10 @@ impl Choice {
     pub(super) fn new() -> Self {
         Choice {
             current: Mode::SideBySide,
-            phase: Phase::Exploit { until: Instant::now() + MIN_PERIOD },
+            phase: {
+                let since = Instant::now();
+                Phase::Exploit { since, until: since + MIN_PERIOD }
+            },
             period: MIN_PERIOD,
             last_end: None,
             stats: TeamStats::default(),
@@ -164,7 +168,7 @@ impl Choice {
 
     /// The mode of the join that starts `start` (now, but for the tests).
     pub(super) fn start(&mut self, start: Instant) -> Ticket {
-        if let Phase::Exploit { until } = self.phase {
+        if let Phase::Exploit { until, .. } = self.phase {
             if start >= until {
                 self.stats.trials += 1;
                 self.phase = Phase::Trial { block: 0, joins: 0, target: 0, time: [Duration::ZERO; 4] };
@@ -189,14 +193,17 @@ impl Choice {
     /// Records how the join of `ticket` went; it ended `now`.
     pub(super) fn finish(&mut self, ticket: Ticket, outcome: Outcome, now: Instant) {
         self.count(outcome);
-        let from = self.last_end.map_or(ticket.start, |end| end.max(ticket.start - GAP.min(ticket.start - end)));
+        let from = self.last_end.map_or(ticket.start, |end| end.max(ticket.start.checked_sub(GAP).unwrap_or(end)));
         self.last_end = Some(now);
         match &mut self.phase {
-            Phase::Exploit { until } => {
-                // The helper was descheduled holding its half: look again soon.
+            Phase::Exploit { since, until } => {
+                // The helper was descheduled holding its half: look again soon,
+                // but not sooner than MIN_PERIOD after the last trial (a helper
+                // whose half is much longer than the caller's would otherwise
+                // call a trial at every join).
                 if let Outcome::Helper { own, waited } = outcome {
                     if waited > 2.0 * own + 1e-4 {
-                        *until = (*until).min(now);
+                        *until = (*until).min(now.max(*since + MIN_PERIOD));
                     }
                 }
             }
@@ -227,7 +234,7 @@ impl Choice {
                     } else {
                         self.period = (2 * self.period).min(MAX_PERIOD);
                     }
-                    self.phase = Phase::Exploit { until: now + self.period };
+                    self.phase = Phase::Exploit { since: now, until: now + self.period };
                 }
             }
         }
@@ -322,10 +329,18 @@ mod tests {
     fn a_long_wait_for_the_helper_brings_the_trial_forward() {
         let mut c = Choice::new();
         let now = Instant::now();
-        let t = c.start(now);
-        assert_eq!(t.mode, Mode::SideBySide);
-        c.finish(t, Outcome::Helper { own: 1e-5, waited: 1e-3 }, now + Duration::from_micros(1010));
-        let t = c.start(now + Duration::from_micros(1020));
+        c.phase = Phase::Exploit { since: now, until: now + Duration::from_secs(60) };
+        let long = |c: &mut Choice, at: Instant| {
+            let t = c.start(at);
+            assert_eq!(t.mode, Mode::SideBySide);
+            c.finish(t, Outcome::Helper { own: 1e-5, waited: 1e-3 }, at + Duration::from_micros(1010));
+        };
+        // Within MIN_PERIOD of the last trial: the trial comes at MIN_PERIOD.
+        long(&mut c, now);
+        assert!(matches!(c.phase, Phase::Exploit { until, .. } if until == now + MIN_PERIOD));
+        // Later: at once.
+        long(&mut c, now + 2 * MIN_PERIOD);
+        let t = c.start(now + 2 * MIN_PERIOD + Duration::from_millis(2));
         assert!(matches!(c.phase, Phase::Trial { .. }));
         assert_eq!(t.mode, Mode::InTurn);
     }
