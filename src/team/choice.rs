@@ -338,9 +338,11 @@ mod tests {
         // Within MIN_PERIOD of the last trial: the trial comes at MIN_PERIOD.
         long(&mut c, now);
         assert!(matches!(c.phase, Phase::Exploit { until, .. } if until == now + MIN_PERIOD));
-        // Later: at once.
-        long(&mut c, now + 2 * MIN_PERIOD);
-        let t = c.start(now + 2 * MIN_PERIOD + Duration::from_millis(2));
+        // Long after the last trial: at once.
+        let later = now + 3 * MIN_PERIOD;
+        c.phase = Phase::Exploit { since: now, until: later + Duration::from_secs(60) };
+        long(&mut c, later);
+        let t = c.start(later + Duration::from_millis(2));
         assert!(matches!(c.phase, Phase::Trial { .. }));
         assert_eq!(t.mode, Mode::InTurn);
     }
