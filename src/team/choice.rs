@@ -76,10 +76,10 @@ pub(super) enum Outcome {
     /// Posted, then taken back by the caller because the helper had not
     /// started it.
     TakenBack,
-    /// Run by the helper; the caller's half took `own` and it then waited
-    /// `waited` for the helper (seconds).
+    /// Run by the helper; the caller's own half ended at `own_end`, and from
+    /// then to the join's end it waited for the helper.
     #[cfg_attr(feature = "loom", allow(dead_code))] // the model times nothing
-    Helper { own: f64, waited: f64 },
+    Helper { own_end: Clock },
 }
 
 /// Counts of a team's joins since it was made (see [`super::Team::stats`]).
@@ -108,23 +108,24 @@ pub(super) struct Ticket {
     start: Instant,
 }
 
-/// The inside-join time of a trial's first block.
+/// How long a trial's first block lasts (its joins and the gaps before them).
 #[cfg(not(feature = "loom"))]
-pub(super) const BLOCK: Duration = Duration::from_millis(4);
+const BLOCK: Duration = Duration::from_millis(4);
 /// The fewest joins of a trial's block.
 #[cfg(not(feature = "loom"))]
-pub(super) const MIN_JOINS: u32 = 16;
-/// The first and the longest time between two trials.
+const MIN_JOINS: u32 = 16;
+/// The first time between two trials (and the shortest).
 #[cfg(not(feature = "loom"))]
-pub(super) const MIN_PERIOD: Duration = Duration::from_millis(40);
+const MIN_PERIOD: Duration = Duration::from_millis(40);
+/// The longest time between two trials.
 #[cfg(not(feature = "loom"))]
-pub(super) const MAX_PERIOD: Duration = Duration::from_millis(2560);
+const MAX_PERIOD: Duration = Duration::from_millis(2560);
 /// Side by side must be this much faster than in turn to be chosen.
 #[cfg(not(feature = "loom"))]
-pub(super) const MARGIN: f64 = 0.05;
+const MARGIN: f64 = 0.05;
 /// The longest gap before a join that is timed with it.
 #[cfg(not(feature = "loom"))]
-pub(super) const GAP: Duration = Duration::from_millis(1);
+const GAP: Duration = Duration::from_millis(1);
 
 #[cfg(not(feature = "loom"))]
 #[derive(Debug)]
@@ -201,8 +202,8 @@ impl Choice {
                 // but not sooner than MIN_PERIOD after the last trial (a helper
                 // whose half is much longer than the caller's would otherwise
                 // call a trial at every join).
-                if let Outcome::Helper { own, waited } = outcome {
-                    if waited > 2.0 * own + 1e-4 {
+                if let Outcome::Helper { own_end } = outcome {
+                    if now - own_end > 2 * (own_end - ticket.start) + Duration::from_micros(100) {
                         *until = (*until).min(now.max(*since + MIN_PERIOD));
                     }
                 }
@@ -220,13 +221,12 @@ impl Choice {
                 *joins = 0;
                 *block += 1;
                 if *block == 4 {
-                    let other = (time[0] + time[3]).as_secs_f64();
-                    let current = (time[1] + time[2]).as_secs_f64();
-                    let side_by_side = match self.current {
-                        Mode::SideBySide => current < (1.0 - MARGIN) * other,
-                        Mode::InTurn => other < (1.0 - MARGIN) * current,
+                    let (other, current) = ((time[0] + time[3]).as_secs_f64(), (time[1] + time[2]).as_secs_f64());
+                    let (side_by_side, in_turn) = match self.current {
+                        Mode::SideBySide => (current, other),
+                        Mode::InTurn => (other, current),
                     };
-                    let best = if side_by_side { Mode::SideBySide } else { Mode::InTurn };
+                    let best = if side_by_side < (1.0 - MARGIN) * in_turn { Mode::SideBySide } else { Mode::InTurn };
                     if best != self.current {
                         self.current = best;
                         self.period = MIN_PERIOD;
@@ -282,7 +282,7 @@ mod tests {
             *now += d;
             let outcome = match t.mode {
                 Mode::InTurn => Outcome::InTurn,
-                Mode::SideBySide => Outcome::Helper { own: d.as_secs_f64(), waited: 0.0 },
+                Mode::SideBySide => Outcome::Helper { own_end: *now },
             };
             choice.finish(t, outcome, *now);
         }
@@ -333,7 +333,8 @@ mod tests {
         let long = |c: &mut Choice, at: Instant| {
             let t = c.start(at);
             assert_eq!(t.mode, Mode::SideBySide);
-            c.finish(t, Outcome::Helper { own: 1e-5, waited: 1e-3 }, at + Duration::from_micros(1010));
+            let own_end = at + Duration::from_micros(10);
+            c.finish(t, Outcome::Helper { own_end }, own_end + Duration::from_millis(1));
         };
         // Within MIN_PERIOD of the last trial: the trial comes at MIN_PERIOD.
         long(&mut c, now);

@@ -232,12 +232,8 @@ where
             t.thread().unpark();
         }
     }
-    #[cfg(not(feature = "loom"))]
-    let clock = std::time::Instant::now();
     let mut wait = Wait { shared: s, number, settled: false };
     let ra = a();
-    #[cfg(not(feature = "loom"))]
-    let own = clock.elapsed();
     if wait.take_back() {
         // The helper never read the job: clear its slot, and run `b` here.
         // SAFETY: this thread won job `number`; the helper touches the slot
@@ -247,11 +243,8 @@ where
         let b = b.expect("a job taken back before it ran still holds its half");
         return ((ra, b()), Outcome::TakenBack);
     }
+    let outcome = Outcome::Helper { own_end: now() };
     wait.finish();
-    #[cfg(not(feature = "loom"))]
-    let outcome = Outcome::Helper { own: own.as_secs_f64(), waited: (clock.elapsed() - own).as_secs_f64() };
-    #[cfg(feature = "loom")]
-    let outcome = Outcome::Helper { own: 0.0, waited: 0.0 };
     let rb = result.lock().ok().and_then(|mut r| r.take());
     match rb {
         Some(Ok(rb)) => ((ra, rb), outcome),
