@@ -5,8 +5,9 @@
 //! problems, so the ratios are paired.
 //!
 //! `cargo run --release --example nlgs_measure -- SCENE STEPS EVERY SETTING...`
-//! with SETTING = `POLICY:TOLERANCE:MEASURE[:MAX_SWEEPS]` (e.g. `quad:1e-4:sweep
-//! quad:1e-4:check quad:1e-7:check:20000`).
+//! with SETTING = `[SOLVER/]POLICY:TOLERANCE:MEASURE[:MAX_SWEEPS][@OMEGA]` (e.g. `quad:1e-4:sweep
+//! quad:1e-4:check apgd/quad:1e-5:check quad:1e-5:check@1.3 quad:1e-7:check:20000`;
+//! SOLVER `nlgs`, the default, or `apgd`; OMEGA the over-relaxation, default 1).
 //! Writes one CSV row per sampled step and setting on standard output and the totals
 //! on standard error. One thread: the ratios are of one core's work.
 //!
@@ -18,6 +19,7 @@
 //! a settlement accumulates (velocities are unique where impulses are not in a
 //! hyperstatic packing).
 
+use ballast::nscd::nlgs::Solver;
 use ballast::nscd::{Measure, Policy};
 use ballast::scene::Scene;
 use serde::Serialize;
@@ -35,9 +37,17 @@ struct Row {
     sleeper_dy_m: f64,
 }
 
-type Setting = (Policy, f64, Measure, Option<usize>);
+type Setting = (Solver, Policy, f64, Measure, Option<usize>, f64);
 
 fn parse(setting: &str) -> Result<Setting, String> {
+    let (setting, omega) = match setting.split_once('@') {
+        Some((rest, w)) => (rest, w.parse::<f64>().map_err(|e| format!("{w}: {e}"))?),
+        None => (setting, 1.0),
+    };
+    let (solver, setting) = match setting.split_once('/') {
+        Some((name, rest)) => (Solver::from_name(name).ok_or(format!("{name}: unknown solver"))?, rest),
+        None => (Solver::Nlgs, setting),
+    };
     let parts: Vec<&str> = setting.split(':').collect();
     let (policy, tolerance, measure, max) = match parts[..] {
         [p, t, m] => (p, t, m, None),
@@ -56,13 +66,15 @@ fn parse(setting: &str) -> Result<Setting, String> {
         "check" => Measure::Check,
         m => return Err(format!("{m}: unknown measure")),
     };
-    Ok((policy, tolerance.parse().map_err(|e| format!("{tolerance}: {e}"))?, measure, max))
+    Ok((solver, policy, tolerance.parse().map_err(|e| format!("{tolerance}: {e}"))?, measure, max, omega))
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [scene, steps, every, settings @ ..] = &args[..] else {
-        return Err("usage: nlgs_measure SCENE STEPS EVERY POLICY:TOLERANCE:MEASURE[:MAX_SWEEPS]...".into());
+        return Err(
+            "usage: nlgs_measure SCENE STEPS EVERY [SOLVER/]POLICY:TOLERANCE:MEASURE[:MAX_SWEEPS][@OMEGA]...".into()
+        );
     };
     let (steps, every): (u64, u64) = (steps.parse()?, every.parse()?);
     let settings = settings.iter().map(|s| parse(s).map(|p| (s.clone(), p))).collect::<Result<Vec<_>, _>>()?;
@@ -71,9 +83,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let mut sys = Scene::load(scene)?.build()?;
     sys.set_threads(1);
-    let configure = |sys: &mut ballast::nscd::System, (policy, tolerance, measure, max): Setting| {
+    let configure = |sys: &mut ballast::nscd::System, (solver, policy, tolerance, measure, max, omega): Setting| {
         let n = &mut sys.params.nlgs;
-        (n.policy, n.tolerance, n.measure) = (policy, tolerance, measure);
+        (n.solver, n.policy, n.tolerance, n.measure, n.relaxation) = (solver, policy, tolerance, measure, omega);
         if let Some(max) = max {
             n.max_iterations = max;
         }

@@ -211,6 +211,37 @@ fn every_policy_reaches_the_equilibrium_of_a_column() {
     }
 }
 
+/// Over-relaxed sweeps (`relaxation`) keep the law's fixed point: a column of
+/// blocks on the floor (hyperstatic: two corner contacts per interface) reaches
+/// the reaction = weight equilibrium and rest at every ω tried, and the same
+/// column with ω = 1 matches it. An ω outside (0, 2) is refused naming the key.
+#[test]
+fn over_relaxed_sweeps_reach_the_same_equilibrium() {
+    for omega in [1.0, 1.3, 1.8] {
+        let mut s = system(1e-3, 0.5, 0.0);
+        s.params.nlgs.policy = Policy::Quad;
+        s.params.nlgs.tolerance = 1e-8;
+        s.params.nlgs.relaxation = omega;
+        let f = floor(&mut s);
+        let ids: Vec<usize> =
+            (0..4).map(|k| rect(&mut s, 0.05, 0.05, 0.0, 0.05 * (k as f64 + 0.5), 0.0, false)).collect();
+        run(&mut s, 200);
+        let weight: f64 = ids.iter().map(|&i| s.bodies.info[i].mass * G).sum();
+        let r = s.contact_resultant(f);
+        // As in `every_policy_reaches_the_equilibrium_of_a_column`: 1e-8 on the
+        // impulses bounds the reaction error far below 1e-5 of the weight.
+        assert!((-r[1] - weight).abs() < 1e-5 * weight, "omega {omega}: {} vs {weight}", -r[1]);
+        let v = ids.iter().map(|&i| s.bodies.u[i][1].abs()).fold(0.0, f64::max);
+        // At rest: the last step's velocity error is the tolerance's, ≪ g h = 1e-2 m/s.
+        assert!(v < 1e-6, "omega {omega}: |vy| {v}");
+    }
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/block_on_floor.toml")).unwrap();
+    let bad = text.replace("[output]", "[nscd]\nrelaxation = 2.0\n\n[output]");
+    assert!(bad.contains("relaxation"), "the example has an [output] table");
+    let err = ballast::scene::Scene::from_toml_str(&bad).and_then(|s| s.build().map(|_| ())).unwrap_err();
+    assert!(err.to_string().contains("nscd.relaxation"), "{err}");
+}
+
 /// The domain-split NLGS (`nscd::split`) on the settled 536-pentagon pile (≈ 900
 /// rows, above the split threshold): two threads give bit for bit the numbers of
 /// one; the split order differs from the unsplit one (so the split really ran)

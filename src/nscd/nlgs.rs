@@ -40,6 +40,12 @@ pub struct NlgsSettings {
     pub max_factor: f64,
     /// Alternate forward and backward sweeps (symmetric Gauss–Seidel); default false.
     pub symmetric: bool,
+    /// Over-relaxation factor `ω` of the sweeps, in (0, 2) (dimensionless): each
+    /// row's change is scaled by `ω` and projected back on its law
+    /// ([`Pass::Relaxed`]); 1: plain Gauss–Seidel, the default. Safeguarded: a step
+    /// whose per-sweep norm rises above twice its lowest goes on with `ω = 1`.
+    #[serde(default = "default_relaxation")]
+    pub relaxation: f64,
     /// Problems of at least this many rows (contacts + springs) are solved split
     /// in two halves swept side by side ([`super::split`]); 0: never; default
     /// [`DEFAULT_SPLIT_MIN_ROWS`].
@@ -126,6 +132,10 @@ impl OnStall {
 /// Default of [`NlgsSettings::stall_max_iterations`].
 pub const DEFAULT_STALL_MAX_ITERATIONS: usize = 10_000;
 
+fn default_relaxation() -> f64 {
+    1.0
+}
+
 fn default_stall_max_iterations() -> usize {
     DEFAULT_STALL_MAX_ITERATIONS
 }
@@ -158,6 +168,7 @@ impl Default for NlgsSettings {
             max_iterations: 1000,
             max_factor: 4.0,
             symmetric: false,
+            relaxation: 1.0,
             split_min_rows: DEFAULT_SPLIT_MIN_ROWS,
             measure: Measure::default(),
             solver: Solver::default(),
@@ -216,10 +227,14 @@ pub fn apply_impulses(u: &mut [[f64; 3]], inv_m: &[[f64; 3]], rows: &[ContactRow
 }
 
 /// What one pass over the rows does.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Pass {
     /// A Gauss–Seidel sweep in key order.
     Forward,
+    /// A Gauss–Seidel sweep in key order, each row's change scaled by `ω` (the
+    /// factor, in (0, 2)) and the result projected back on its law
+    /// (`P_N ≥ 0`, `|P_T| ≤ μ P_N`; a compression-only spring `P ≥ 0`).
+    Relaxed(f64),
     /// A Gauss–Seidel sweep in reverse key order.
     Backward,
     /// LMGC90's check: every row solved from the current velocities, nothing updated.
@@ -236,10 +251,22 @@ pub fn sweep(
     backwards: bool,
 ) -> SweepNorms {
     if backwards {
-        sweep_in::<true>(u, inv_m, rows.iter_mut().rev(), springs.iter_mut().rev())
+        sweep_in::<true>(u, inv_m, rows.iter_mut().rev(), springs.iter_mut().rev(), 1.0)
     } else {
-        sweep_in::<true>(u, inv_m, rows.iter_mut(), springs.iter_mut())
+        sweep_in::<true>(u, inv_m, rows.iter_mut(), springs.iter_mut(), 1.0)
     }
+}
+
+/// One forward sweep with over-relaxation `omega` ([`Pass::Relaxed`]).
+#[inline(never)]
+pub fn sweep_relaxed(
+    u: &mut [[f64; 3]],
+    inv_m: &[[f64; 3]],
+    rows: &mut [ContactRow],
+    springs: &mut [SpringRow],
+    omega: f64,
+) -> SweepNorms {
+    sweep_in::<true>(u, inv_m, rows.iter_mut(), springs.iter_mut(), omega)
 }
 
 /// The check pass of LMGC90 (Jean's violation, `i_check` of its NLGS): every row
@@ -248,7 +275,7 @@ pub fn sweep(
 /// solutions, i.e. the fixed-point residual of the current iterate.
 #[inline(never)]
 pub fn check(u: &mut [[f64; 3]], inv_m: &[[f64; 3]], rows: &mut [ContactRow], springs: &mut [SpringRow]) -> SweepNorms {
-    sweep_in::<false>(u, inv_m, rows.iter_mut(), springs.iter_mut())
+    sweep_in::<false>(u, inv_m, rows.iter_mut(), springs.iter_mut(), 1.0)
 }
 
 /// One pass of the given kind.
@@ -263,17 +290,20 @@ pub fn pass(
     match kind {
         Pass::Forward => sweep(u, inv_m, rows, springs, false),
         Pass::Backward => sweep(u, inv_m, rows, springs, true),
+        Pass::Relaxed(omega) => sweep_relaxed(u, inv_m, rows, springs, omega),
         Pass::Check => check(u, inv_m, rows, springs),
     }
 }
 
-/// A pass over the rows; with `UPDATE` false (the check) nothing is written.
+/// A pass over the rows; with `UPDATE` false (the check) nothing is written;
+/// `omega` ≠ 1 over-relaxes each row's change and projects it on the law.
 #[inline(always)]
 fn sweep_in<'r, 's, const UPDATE: bool>(
     u: &mut [[f64; 3]],
     inv_m: &[[f64; 3]],
     rows: impl Iterator<Item = &'r mut ContactRow>,
     springs: impl Iterator<Item = &'s mut SpringRow>,
+    omega: f64,
 ) -> SweepNorms {
     let mut norms = SweepNorms::default();
     for s in springs {
@@ -282,7 +312,13 @@ fn sweep_in<'r, 's, const UPDATE: bool>(
         if s.b != u32::MAX {
             un -= dot3(&s.hn_b, &u[b]);
         }
-        let p = s.solve(un - s.w * s.p);
+        let mut p = s.solve(un - s.w * s.p);
+        if omega != 1.0 {
+            p = s.p + omega * (p - s.p);
+            if s.compression_only {
+                p = p.max(0.0);
+            }
+        }
         let dp = p - s.p;
         if UPDATE && dp != 0.0 {
             s.p = p;
@@ -313,7 +349,11 @@ fn sweep_in<'r, 's, const UPDATE: bool>(
         let [pn, pt] = r.p;
         let u0n = un - (w.nn * pn + w.nt * pt);
         let u0t = ut - (w.nt * pn + w.tt * pt) + r.shift_t;
-        let [qn, qt] = solve(w, [u0n, u0t], r.s_open, r.c_closed, r.mu);
+        let [mut qn, mut qt] = solve(w, [u0n, u0t], r.s_open, r.c_closed, r.mu);
+        if omega != 1.0 {
+            qn = (pn + omega * (qn - pn)).max(0.0);
+            qt = (pt + omega * (qt - pt)).clamp(-r.mu * qn, r.mu * qn);
+        }
         let (dn, dt) = (qn - pn, qt - pt);
         let changed = dn != 0.0 || dt != 0.0;
         if UPDATE && changed {
@@ -377,11 +417,23 @@ fn iterate(settings: &NlgsSettings, mut pass: impl FnMut(Pass) -> SweepNorms) ->
     let mut previous_wpp = 0.0;
     let mut report = NlgsReport::default();
     let cap = s.sweep_cap();
+    let (mut omega, mut lowest) = (s.relaxation, f64::INFINITY);
     for it in 1..=cap {
-        let kind = if s.symmetric && it % 2 == 0 { Pass::Backward } else { Pass::Forward };
+        let kind = if s.symmetric && it % 2 == 0 {
+            Pass::Backward
+        } else if omega != 1.0 {
+            Pass::Relaxed(omega)
+        } else {
+            Pass::Forward
+        };
         let norms = pass(kind);
         let (mut value, mut ok) = evaluate(s.policy, s.tolerance, s.max_factor, &norms, previous_wpp);
         previous_wpp = norms.sum_wpp;
+        // The safeguard of over-relaxation: plain sweeps once the norm rises well above its lowest.
+        lowest = lowest.min(value);
+        if omega != 1.0 && value > 2.0 * lowest {
+            omega = 1.0;
+        }
         if checked {
             // The sweep's norm predicts the check's through the last measured ratio;
             // the check runs when the prediction meets the tolerance, and at the cap.

@@ -74,6 +74,9 @@ pub struct NscdSection {
     /// Alternate forward and backward NLGS sweeps (symmetric Gauss–Seidel); default false.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub symmetric: Option<bool>,
+    /// Over-relaxation factor `ω` of the NLGS sweeps, in (0, 2); default 1 (none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relaxation: Option<f64>,
     /// Where the convergence norms are measured: `"sweep"` (during the updating
     /// sweep) or `"check"` (a separate pass after it that updates nothing, as LMGC90).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -343,6 +343,10 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
     if ns.stall_max_iterations.is_some() && on_stall != OnStall::Extend {
         return err("nscd.stall_max_iterations: only used with on_stall = \"extend\"".to_string());
     }
+    let relaxation = ns.relaxation.unwrap_or(defaults.nlgs.relaxation);
+    if !(relaxation > 0.0 && relaxation < 2.0) {
+        return err(format!("nscd.relaxation: must be in (0, 2), got {}", num(relaxation)));
+    }
     if let Some(a) = ns.alert_distance {
         non_negative("nscd.alert_distance", a)?;
         if a > MAX_LENGTH {
@@ -356,6 +360,7 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
         max_iterations,
         max_factor,
         symmetric: ns.symmetric.unwrap_or(false),
+        relaxation,
         split_min_rows: defaults.nlgs.split_min_rows,
         measure,
         solver,
