@@ -54,13 +54,7 @@ fn parse(setting: &str) -> Result<Setting, String> {
         [p, t, m, x] => (p, t, m, Some(x.parse::<usize>().map_err(|e| format!("{x}: {e}"))?)),
         _ => return Err(format!("{setting}: expected POLICY:TOLERANCE:MEASURE[:MAX_SWEEPS]")),
     };
-    let policy = match policy {
-        "strict" => Policy::Strict,
-        "quad" => Policy::Quad,
-        "quad_max" => Policy::QuadMax,
-        "energy" => Policy::Energy,
-        p => return Err(format!("{p}: unknown policy")),
-    };
+    let policy = Policy::from_name(policy).ok_or(format!("{policy}: unknown policy"))?;
     let measure = match measure {
         "sweep" => Measure::Sweep,
         "check" => Measure::Check,

@@ -208,7 +208,7 @@ fn settled_column(policy: Policy, omega: f64) -> (System, usize, Vec<usize>) {
 
 #[test]
 fn every_policy_reaches_the_equilibrium_of_a_column() {
-    for policy in [Policy::Strict, Policy::Quad, Policy::QuadMax, Policy::Energy] {
+    for policy in Policy::ALL {
         let (s, f, ids) = settled_column(policy, 1.0);
         let weight: f64 = ids.iter().map(|&i| s.bodies.info[i].mass * G).sum();
         let r = s.contact_resultant(f);

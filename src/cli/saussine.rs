@@ -182,7 +182,7 @@ pub struct LoadingArgs {
     /// Time step (s).
     #[arg(long, default_value_t = Loading::default().dt)]
     pub dt: f64,
-    /// Convergence policy: strict, quad, quad_max, energy (default: the cheapest measured to
+    /// Convergence policy: strict, quad, quad_max, energy, velocity (default: the cheapest measured to
     /// keep the max overlap below 1 % of the smallest grain over 1000 cycles; it under-predicts the
     /// settlement accrued after the seating by about half on a small sample: for accrual rates use
     /// quad_max 1e-4 or tighter, BENCHMARKS.md).

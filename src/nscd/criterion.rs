@@ -19,7 +19,18 @@
 //!   dense, heavily loaded packing `quad` alone stops before its reaction has
 //!   built up (worst right after the sleeper unloads); the maxima catch it;
 //! - `energy` (ours; the paper cites an energy criterion without defining it):
-//!   relative change of `Σ P·WP` over a sweep.
+//!   relative change of `Σ P·WP` over a sweep;
+//! - `velocity` (ours, issue 31): an estimate of the error left in the local
+//!   velocities, which are unique in a hyperstatic packing where the impulses are
+//!   not, and are what the settlement integrates. A sweep's largest velocity
+//!   correction `δ = max |ΔU|` (`MaxmDV`'s numerator) is a step of a sequence that
+//!   contracts by `q` per sweep, so the distance left to its limit is the geometric
+//!   tail `δ q / (1 − q)`; `q` is measured over windows of
+//!   [`VELOCITY_WINDOW`] sweeps (the ratio of their largest `δ`, to the power
+//!   1/window, at most 0.9999) and the value is `δ q/(1 − q) / sqrt(⟨|WP|²⟩)`, the
+//!   error relative to the velocity the impulses make. At NLGS's stall (q ≈ 0.999)
+//!   the raw change per sweep underestimates the error a thousandfold, which is what
+//!   the factor corrects. Measured during the sweeps, like `energy`.
 //!
 //! Where the norms are measured ([`Measure`]). LMGC90 measures them in a separate
 //! *check* pass that solves every row from the current iterate and updates nothing
@@ -54,26 +65,37 @@ pub enum Policy {
     /// Relative change of `Σ P·WP` over a sweep below the tolerance (ours; the
     /// paper cites an energy criterion without defining it).
     Energy,
+    /// The estimated error left in the local velocities, relative to the velocity
+    /// the impulses make, below the tolerance (ours; module text).
+    Velocity,
 }
 
 impl Policy {
     /// Every policy, in the order scenes list them.
-    pub const ALL: [Policy; 4] = [Policy::Strict, Policy::Quad, Policy::QuadMax, Policy::Energy];
+    pub const ALL: [Policy; 5] = [Policy::Strict, Policy::Quad, Policy::QuadMax, Policy::Energy, Policy::Velocity];
 
     /// The policy named `name` (as [`Policy::name`] writes it).
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|p| p.name() == name)
     }
 
-    /// The policy's name in scenes and reports (`strict`, `quad`, `quad_max`, `energy`),
-    /// as serde writes it.
+    /// The policy's name in scenes and reports (`strict`, `quad`, `quad_max`, `energy`,
+    /// `velocity`), as serde writes it.
     pub fn name(self) -> &'static str {
         match self {
             Policy::Strict => "strict",
             Policy::Quad => "quad",
             Policy::QuadMax => "quad_max",
             Policy::Energy => "energy",
+            Policy::Velocity => "velocity",
         }
+    }
+
+    /// Whether the policy measures a change from sweep to sweep (`energy`,
+    /// `velocity`) rather than a residual of the iterate: it is measured during the
+    /// sweeps, never by the check pass.
+    pub fn over_sweeps(self) -> bool {
+        matches!(self, Policy::Energy | Policy::Velocity)
     }
 }
 
@@ -199,6 +221,47 @@ impl SweepNorms {
     }
 }
 
+/// Sweeps per window of the contraction estimate of [`Policy::Velocity`].
+pub const VELOCITY_WINDOW: usize = 10;
+
+/// The geometric-tail factor `q/(1 − q)` of [`Policy::Velocity`], from the largest
+/// velocity correction of each window of [`VELOCITY_WINDOW`] sweeps.
+#[derive(Debug, Clone, Copy)]
+pub struct VelocityTail {
+    sweeps: usize,
+    window_max: f64,
+    last_max: f64,
+    factor: f64,
+}
+
+/// Largest contraction per sweep the estimate admits (a factor of 9999).
+const MAX_CONTRACTION: f64 = 0.9999;
+
+impl Default for VelocityTail {
+    /// No window yet: the largest factor.
+    fn default() -> Self {
+        Self { sweeps: 0, window_max: 0.0, last_max: f64::NAN, factor: MAX_CONTRACTION / (1.0 - MAX_CONTRACTION) }
+    }
+}
+
+impl VelocityTail {
+    /// Takes one sweep's `δ` (any positive multiple of it: only ratios matter) and
+    /// returns `δ q/(1 − q)` with the contraction of the last complete windows.
+    pub fn estimate(&mut self, delta: f64) -> f64 {
+        self.window_max = self.window_max.max(delta);
+        self.sweeps += 1;
+        if self.sweeps.is_multiple_of(VELOCITY_WINDOW) {
+            if self.last_max > 0.0 {
+                let q = (self.window_max / self.last_max).powf(1.0 / VELOCITY_WINDOW as f64);
+                let q = if q.is_finite() { q.min(MAX_CONTRACTION) } else { MAX_CONTRACTION };
+                self.factor = q / (1.0 - q);
+            }
+            (self.last_max, self.window_max) = (self.window_max, 0.0);
+        }
+        delta * self.factor
+    }
+}
+
 /// Evaluates the policy: returns `(value, converged)`, `value` being the largest of the
 /// norms the policy tests, each divided by its bound (so convergence is `value < tol`).
 /// `previous_wpp` is `Σ P·WP` after the previous sweep (energy criterion).
@@ -208,6 +271,8 @@ pub fn evaluate(policy: Policy, tol: f64, max_factor: f64, s: &SweepNorms, previ
         Policy::Quad => mean_dvor.abs().max(quad_dv).max(quad_dvr),
         Policy::Strict => mean_dvor.abs().max(maxm_dv).max(maxm_dvr),
         Policy::QuadMax => mean_dvor.abs().max(quad_dv).max(quad_dvr).max(maxm_dv.max(maxm_dvr) / max_factor),
+        // The raw correction; `iterate` multiplies it by the tail factor.
+        Policy::Velocity => maxm_dv,
         Policy::Energy => {
             if !s.changed {
                 0.0
@@ -219,4 +284,33 @@ pub fn evaluate(policy: Policy, tol: f64, max_factor: f64, s: &SweepNorms, previ
         }
     };
     (value, value < tol)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On a geometric sequence of corrections `δ_k = δ_0 q^k` the estimate is the
+    /// exact distance left to the limit, `δ_k q/(1 − q)`, once two windows are
+    /// complete; before, it is the largest factor; a growing sequence keeps it there.
+    #[test]
+    fn velocity_tail_is_exact_on_a_geometric_sequence() {
+        let q: f64 = 0.99;
+        let mut tail = VelocityTail::default();
+        for k in 0..5 * VELOCITY_WINDOW {
+            let delta = 3.0 * q.powi(k as i32);
+            let e = tail.estimate(delta);
+            if k < 2 * VELOCITY_WINDOW - 1 {
+                let largest = delta * MAX_CONTRACTION / (1.0 - MAX_CONTRACTION);
+                assert!((e - largest).abs() < 1e-12 * largest, "sweep {k}: {e} vs {largest}");
+            } else {
+                let exact: f64 = (k + 1..100_000).map(|j| 3.0 * q.powi(j as i32)).sum();
+                assert!((e - exact).abs() < 1e-9 * exact, "sweep {k}: {e} vs {exact}");
+            }
+        }
+        let mut tail = VelocityTail::default();
+        let last = (0..3 * VELOCITY_WINDOW).map(|k| tail.estimate(1.0 + k as f64)).last().unwrap();
+        let largest = 30.0 * MAX_CONTRACTION / (1.0 - MAX_CONTRACTION);
+        assert!((last - largest).abs() < 1e-12 * largest, "{last} vs {largest}");
+    }
 }

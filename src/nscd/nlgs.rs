@@ -17,7 +17,7 @@
 
 use super::contact::{dot3, ContactRow};
 use super::coulomb::solve;
-use super::criterion::{evaluate, Measure, Policy, SweepNorms};
+use super::criterion::{evaluate, Measure, Policy, SweepNorms, VelocityTail};
 use super::split::SplitWorkspace;
 use super::sublayer::SpringRow;
 
@@ -412,7 +412,8 @@ const FIRST_CHECK_RATIO: f64 = 0.5;
 
 fn iterate(settings: &NlgsSettings, mut pass: impl FnMut(Pass) -> SweepNorms) -> NlgsReport {
     let s = settings;
-    let checked = s.measure == Measure::Check && s.policy != Policy::Energy;
+    let checked = s.measure == Measure::Check && !s.policy.over_sweeps();
+    let mut tail = (s.policy == Policy::Velocity).then(VelocityTail::default);
     let mut ratio = FIRST_CHECK_RATIO;
     let mut previous_wpp = 0.0;
     let mut report = NlgsReport::default();
@@ -429,6 +430,10 @@ fn iterate(settings: &NlgsSettings, mut pass: impl FnMut(Pass) -> SweepNorms) ->
         let norms = pass(kind);
         let (mut value, mut ok) = evaluate(s.policy, s.tolerance, s.max_factor, &norms, previous_wpp);
         previous_wpp = norms.sum_wpp;
+        if let Some(tail) = &mut tail {
+            value = tail.estimate(value);
+            ok = value < s.tolerance;
+        }
         // The safeguard of over-relaxation: plain sweeps once the norm rises well above its lowest.
         lowest = lowest.min(value);
         if omega != 1.0 && value > 2.0 * lowest {

@@ -69,6 +69,9 @@ impl NscdParams {
         if n.min_iterations < 1 || n.max_iterations < n.min_iterations {
             return bad("nscd.max_iterations (must be >= min_iterations >= 1)", n.max_iterations as f64);
         }
+        if !(n.relaxation > 0.0 && n.relaxation < 2.0) {
+            return bad("nscd.relaxation (must be in (0, 2))", n.relaxation);
+        }
         if self.gravity.iter().any(|g| !g.is_finite()) {
             return bad("simulation.gravity", self.gravity[0] + self.gravity[1]);
         }
@@ -334,7 +337,7 @@ impl System {
     pub fn check_state(&self) -> crate::Result<()> {
         let bad = |msg: String| Err(crate::Error::Scene(msg));
         crate::plane::outputs::check_bodies(&self.bodies, self.materials, &self.springs)?;
-        if self.laws.len() != self.materials * self.materials {
+        if self.materials.checked_mul(self.materials) != Some(self.laws.len()) {
             return bad(format!("{} contact laws for {} materials", self.laws.len(), self.materials));
         }
         let n = self.bodies.len();

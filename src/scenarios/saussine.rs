@@ -518,7 +518,7 @@ impl LoadingSpec {
         positive("loaded_scene: dt (s)", self.dt)?;
         if Policy::from_name(&self.criterion).is_none() {
             return refuse(format!(
-                "loaded_scene: criterion '{}' is not one of 'strict', 'quad', 'quad_max', 'energy'",
+                "loaded_scene: criterion '{}' is not one of 'strict', 'quad', 'quad_max', 'energy', 'velocity'",
                 self.criterion
             ));
         }

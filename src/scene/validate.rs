@@ -279,7 +279,7 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
         ns.criterion.as_deref(),
         defaults.nlgs.policy,
         Policy::from_name,
-        "one of 'strict', 'quad', 'quad_max', 'energy'",
+        "one of 'strict', 'quad', 'quad_max', 'energy', 'velocity'",
     )?;
     let tolerance = ns.tolerance.unwrap_or(defaults.nlgs.tolerance);
     if !(tolerance > 0.0 && tolerance < 1.0) {
@@ -307,10 +307,12 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
         Measure::from_name,
         "'sweep' or 'check'",
     )?;
-    if ns.measure.is_some() && measure == Measure::Check && policy == Policy::Energy {
-        return err("nscd.measure: 'check' measures a residual (strict, quad, quad_max); the energy criterion \
-                    is a change from sweep to sweep, measured during the sweeps: remove the key or use 'sweep'"
-            .to_string());
+    if ns.measure.is_some() && measure == Measure::Check && policy.over_sweeps() {
+        return err(format!(
+            "nscd.measure: 'check' measures a residual (strict, quad, quad_max); the {} criterion is a change \
+             from sweep to sweep, measured during the sweeps: remove the key or use 'sweep'",
+            policy.name()
+        ));
     }
     let solver = named(
         "nscd.solver",
@@ -320,10 +322,11 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
         Solver::from_name,
         "'nlgs' or 'apgd'",
     )?;
-    if solver == Solver::Apgd && policy == Policy::Energy {
-        return err(
-            "nscd.solver: 'apgd' stops on a residual (strict, quad, quad_max), not on the energy criterion".to_string()
-        );
+    if solver == Solver::Apgd && policy.over_sweeps() {
+        return err(format!(
+            "nscd.solver: 'apgd' stops on a residual (strict, quad, quad_max), not on the {} criterion",
+            policy.name()
+        ));
     }
     let on_stall = named(
         "nscd.on_stall",
