@@ -185,7 +185,7 @@ pub struct LoadingArgs {
     /// Convergence policy: strict, quad, quad_max, energy, velocity (default: the cheapest measured to
     /// keep the max overlap below 1 % of the smallest grain over 1000 cycles; it under-predicts the
     /// settlement accrued after the seating by about half on a small sample: for accrual rates use
-    /// quad_max 1e-4 or tighter, BENCHMARKS.md).
+    /// quad 1e-6, where the settlement of a small sample stops changing, BENCHMARKS.md).
     #[arg(long, default_value_t = Loading::default().criterion)]
     pub criterion: String,
     /// Tolerance of the policy.
