@@ -36,23 +36,17 @@
 
 #![allow(clippy::needless_range_loop)] // per-component loops over [x, y, θ] read as the equations
 
-use ballast::nscd::contact::{dot3, ContactRow};
+#[path = "common/jacobian.rs"]
+mod jacobian;
+
+use ballast::nscd::contact::ContactRow;
 use ballast::nscd::criterion::{evaluate, Policy};
 use ballast::nscd::nlgs::{check, solve_nlgs, NlgsSettings};
 use ballast::nscd::sublayer::SpringRow;
 use ballast::nscd::Measure;
 use ballast::scene::Scene;
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
-};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Par, Side};
+use jacobian::{add_force, free_velocity, gather, rebuild, scatter, Jacobian, NONE};
 use std::time::Instant;
-
-const NONE: u32 = u32::MAX;
-/// Lower-triangle pairs `(p, q)`, `p ≤ q`, of a row's six local components.
-const PAIRS: usize = 21;
 
 /// Options of the prototype.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -98,11 +92,9 @@ struct Row {
 /// Buffers of the prototype.
 #[derive(Default)]
 struct NewtonWorkspace {
-    /// Per body and component, the index of the unknown, or `NONE`.
-    dof: Vec<[u32; 3]>,
-    /// Per unknown: its mass (kg or kg·m²), its diagonal slot, `F`, the step `d`.
-    mass: Vec<f64>,
-    diag: Vec<u32>,
+    /// The unknowns and the matrix `J`.
+    jac: Jacobian,
+    /// Per unknown: `F`, the step `d`.
     f: Vec<f64>,
     d: Vec<f64>,
     /// Body form: the Newton iterate, the free velocity, the step, `F`.
@@ -110,10 +102,7 @@ struct NewtonWorkspace {
     v_free: Vec<[f64; 3]>,
     dv: Vec<[f64; 3]>,
     fb: Vec<[f64; 3]>,
-    /// Per contact: unknowns of its six local components, slots of its 21 pairs,
-    /// multiplier, threshold `c`, bound `g`, penalties, `y` and `Gᵀd`, states.
-    cdof: Vec<[u32; 6]>,
-    cslot: Vec<[u32; PAIRS]>,
+    /// Per contact: multiplier, threshold `c`, bound `g`, penalties, `y` and `Gᵀd`, states.
     lam: Vec<[f64; 2]>,
     thr: Vec<f64>,
     bound: Vec<f64>,
@@ -122,26 +111,16 @@ struct NewtonWorkspace {
     dy: Vec<[f64; 2]>,
     state: Vec<u8>,
     fstate: Vec<u8>,
-    /// Per spring: unknowns, slots, `U_s`, `g_sᵀ d`, active, active in the factor.
-    sdof: Vec<[u32; 6]>,
-    sslot: Vec<[u32; PAIRS]>,
+    /// Per spring: `U_s`, `g_sᵀ d`, active, active in the factor.
     sy: Vec<f64>,
     sdy: Vec<f64>,
     sstate: Vec<u8>,
     sfstate: Vec<u8>,
-    /// Lower-triangle pattern (CSC) of `J`, its values and the pairs that built it.
-    col_ptr: Vec<u32>,
-    row_idx: Vec<u32>,
-    values: Vec<f64>,
-    pairs: Vec<(u32, u32)>,
-    symbolic: Option<SymbolicCholesky<u32>>,
-    l_values: Vec<f64>,
-    mem: Option<MemBuffer>,
 }
 
 impl std::fmt::Debug for NewtonWorkspace {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("NewtonWorkspace").field("unknowns", &self.mass.len()).finish_non_exhaustive()
+        f.debug_struct("NewtonWorkspace").field("unknowns", &self.jac.len()).finish_non_exhaustive()
     }
 }
 
@@ -150,12 +129,6 @@ impl Clone for NewtonWorkspace {
     fn clone(&self) -> Self {
         Self::default()
     }
-}
-
-/// The six local coefficients of a row's direction: `h_a` on body `a`, `−h_b` on `b`.
-#[inline(always)]
-fn local(ha: &[f64; 3], hb: &[f64; 3]) -> [f64; 6] {
-    [ha[0], ha[1], ha[2], -hb[0], -hb[1], -hb[2]]
 }
 
 /// State bits of a contact: normal active, tangential sticking (both enter `J`),
@@ -197,59 +170,17 @@ fn spring_impulse(s: &SpringRow, u: f64) -> (f64, u8) {
     }
 }
 
-#[inline(always)]
-fn gather(ws_v: &[[f64; 3]], a: u32, b: u32, ha: &[f64; 3], hb: &[f64; 3]) -> f64 {
-    let mut x = dot3(ha, &ws_v[a as usize]);
-    if b != NONE {
-        x -= dot3(hb, &ws_v[b as usize]);
-    }
-    x
-}
-
-#[inline(always)]
-fn scatter(out: &mut [[f64; 3]], scale: &[[f64; 3]], a: u32, b: u32, ha: &[f64; 3], hb: &[f64; 3], p: f64) {
-    for d in 0..3 {
-        out[a as usize][d] += scale[a as usize][d] * ha[d] * p;
-    }
-    if b != NONE {
-        for d in 0..3 {
-            out[b as usize][d] -= scale[b as usize][d] * hb[d] * p;
-        }
-    }
-}
-
 impl NewtonWorkspace {
     /// Numbers the unknowns, rebuilds `u_free` from `u` and the rows' impulses,
     /// builds the pattern of `J` and its symbolic Cholesky factorisation.
     fn prepare(&mut self, u: &[[f64; 3]], inv_m: &[[f64; 3]], rows: &[ContactRow], springs: &[SpringRow]) -> bool {
-        let nb = u.len();
-        self.dof.clear();
-        self.mass.clear();
-        for im in inv_m {
-            let mut ix = [NONE; 3];
-            for d in 0..3 {
-                if im[d] > 0.0 {
-                    ix[d] = self.mass.len() as u32;
-                    self.mass.push(1.0 / im[d]);
-                }
-            }
-            self.dof.push(ix);
-        }
-        let n = self.mass.len();
-        if n == 0 {
+        if !self.jac.prepare(inv_m, rows, springs) {
             return false;
         }
+        let (nb, n) = (u.len(), self.jac.len());
         self.v.clear();
         self.v.extend_from_slice(u);
-        self.v_free.clear();
-        self.v_free.extend_from_slice(u);
-        for s in springs {
-            scatter(&mut self.v_free, inv_m, s.a, s.b, &s.hn_a, &s.hn_b, -s.p);
-        }
-        for r in rows {
-            scatter(&mut self.v_free, inv_m, r.a, r.b, &r.hn_a, &r.hn_b, -r.p[0]);
-            scatter(&mut self.v_free, inv_m, r.a, r.b, &r.ht_a, &r.ht_b, -r.p[1]);
-        }
+        self.v_free = free_velocity(u, inv_m, rows, springs);
         self.dv.clear();
         self.dv.resize(nb, [0.0; 3]);
         self.fb.clear();
@@ -258,90 +189,6 @@ impl NewtonWorkspace {
         self.f.resize(n, 0.0);
         self.d.clear();
         self.d.resize(n, 0.0);
-
-        // The pattern: every diagonal entry, and the lower triangle of each row's block.
-        let dofs = |dof: &[[u32; 3]], a: u32, b: u32| {
-            let mut l = [NONE; 6];
-            l[..3].copy_from_slice(&dof[a as usize]);
-            if b != NONE {
-                l[3..].copy_from_slice(&dof[b as usize]);
-            }
-            l
-        };
-        self.pairs.clear();
-        self.pairs.extend((0..n as u32).map(|k| (k, k)));
-        self.cdof.clear();
-        for r in rows {
-            let l = dofs(&self.dof, r.a, r.b);
-            push_pairs(&mut self.pairs, &l);
-            self.cdof.push(l);
-        }
-        self.sdof.clear();
-        for s in springs {
-            let l = dofs(&self.dof, s.a, s.b);
-            push_pairs(&mut self.pairs, &l);
-            self.sdof.push(l);
-        }
-        // (column, row) with row ≥ column, sorted by column then row.
-        self.pairs.sort_unstable();
-        self.pairs.dedup();
-        self.col_ptr.clear();
-        self.col_ptr.resize(n + 1, 0);
-        self.row_idx.clear();
-        for &(c, r) in &self.pairs {
-            self.col_ptr[c as usize + 1] += 1;
-            self.row_idx.push(r);
-        }
-        for j in 0..n {
-            self.col_ptr[j + 1] += self.col_ptr[j];
-        }
-        self.values.clear();
-        self.values.resize(self.row_idx.len(), 0.0);
-        let slot = |col_ptr: &[u32], row_idx: &[u32], i: u32, j: u32| -> u32 {
-            let (c, r) = if i <= j { (i, j) } else { (j, i) };
-            let (lo, hi) = (col_ptr[c as usize] as usize, col_ptr[c as usize + 1] as usize);
-            lo as u32 + row_idx[lo..hi].binary_search(&r).expect("pattern holds every pair") as u32
-        };
-        self.diag.clear();
-        for k in 0..n as u32 {
-            self.diag.push(slot(&self.col_ptr, &self.row_idx, k, k));
-        }
-        let slots = |l: &[u32; 6], col_ptr: &[u32], row_idx: &[u32]| {
-            let mut out = [NONE; PAIRS];
-            let mut k = 0;
-            for p in 0..6 {
-                for q in p..6 {
-                    if l[p] != NONE && l[q] != NONE {
-                        out[k] = slot(col_ptr, row_idx, l[p], l[q]);
-                    }
-                    k += 1;
-                }
-            }
-            out
-        };
-        self.cslot.clear();
-        for l in &self.cdof {
-            self.cslot.push(slots(l, &self.col_ptr, &self.row_idx));
-        }
-        self.sslot.clear();
-        for l in &self.sdof {
-            self.sslot.push(slots(l, &self.col_ptr, &self.row_idx));
-        }
-        let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
-        let Ok(symbolic) =
-            factorize_symbolic_cholesky(sym, Side::Lower, SymmetricOrdering::Amd, CholeskySymbolicParams::default())
-        else {
-            return false;
-        };
-        self.l_values.clear();
-        self.l_values.resize(symbolic.len_val(), 0.0);
-        let req = StackReq::any_of(&[
-            symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
-            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
-        ]);
-        self.mem = Some(MemBuffer::new(req));
-        self.symbolic = Some(symbolic);
-
         let nc = rows.len();
         self.lam.clear();
         self.lam.extend(rows.iter().map(|r| r.p));
@@ -399,9 +246,9 @@ impl NewtonWorkspace {
     /// differ from the factor's.
     fn evaluate(&mut self, rows: &[ContactRow], springs: &[SpringRow]) -> bool {
         for (i, fb) in self.fb.iter_mut().enumerate() {
-            let (v, vf, ix) = (&self.v[i], &self.v_free[i], &self.dof[i]);
+            let (v, vf, ix) = (&self.v[i], &self.v_free[i], &self.jac.dof[i]);
             for d in 0..3 {
-                fb[d] = if ix[d] != NONE { self.mass[ix[d] as usize] * (v[d] - vf[d]) } else { 0.0 };
+                fb[d] = if ix[d] != NONE { self.jac.mass[ix[d] as usize] * (v[d] - vf[d]) } else { 0.0 };
             }
         }
         let mut changed = false;
@@ -424,77 +271,38 @@ impl NewtonWorkspace {
             add_force(&mut self.fb, r.a, r.b, &r.hn_a, &r.hn_b, -p[0]);
             add_force(&mut self.fb, r.a, r.b, &r.ht_a, &r.ht_b, -p[1]);
         }
-        for (i, ix) in self.dof.iter().enumerate() {
-            for d in 0..3 {
-                if ix[d] != NONE {
-                    self.f[ix[d] as usize] = self.fb[i][d];
-                }
-            }
-        }
+        self.jac.gather_dofs(&self.fb, &mut self.f);
         changed
     }
 
     /// Assembles `J` for the current states and factorises it; false on a failure.
     fn factorize(&mut self, rows: &[ContactRow], springs: &[SpringRow]) -> bool {
-        self.values.iter_mut().for_each(|x| *x = 0.0);
-        for (k, &m) in self.mass.iter().enumerate() {
-            self.values[self.diag[k] as usize] += m;
-        }
+        self.jac.reset();
         for (k, r) in rows.iter().enumerate() {
             let st = self.state[k];
             let cn = if st & NORMAL != 0 { self.rho[k][0] } else { 0.0 };
             let ct = if st & STICK != 0 { self.rho[k][1] } else { 0.0 };
-            if cn != 0.0 || ct != 0.0 {
-                add_block(&mut self.values, &self.cslot[k], &local(&r.hn_a, &r.hn_b), cn, &local(&r.ht_a, &r.ht_b), ct);
-            }
+            self.jac.add_contact(k, r, cn, ct);
         }
         for (k, s) in springs.iter().enumerate() {
             if self.sstate[k] != 0 && s.h_beta > 0.0 {
-                let g = local(&s.hn_a, &s.hn_b);
-                add_block(&mut self.values, &self.sslot[k], &g, s.h_beta, &[0.0; 6], 0.0);
+                self.jac.add_spring(k, s, s.h_beta);
             }
         }
         self.fstate.copy_from_slice(&self.state);
         self.sfstate.copy_from_slice(&self.sstate);
-        let (Some(symbolic), Some(mem)) = (&self.symbolic, &mut self.mem) else { return false };
-        let n = self.mass.len();
-        let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
-        let a = SparseColMatRef::new(sym, &self.values);
-        symbolic
-            .factorize_numeric_llt::<f64>(
-                &mut self.l_values,
-                a,
-                Side::Lower,
-                Default::default(),
-                Par::Seq,
-                MemStack::new(mem),
-                Default::default(),
-            )
-            .is_ok()
+        self.jac.factorize()
     }
 
     /// `d = −J⁻¹ F` with the current factor, scattered into `dv`, and `Gᵀd` per row.
     fn newton_step(&mut self, rows: &[ContactRow], springs: &[SpringRow]) -> bool {
-        let (Some(symbolic), Some(mem)) = (&self.symbolic, &mut self.mem) else { return false };
         for (d, f) in self.d.iter_mut().zip(&self.f) {
             *d = -f;
         }
-        let n = self.mass.len();
-        let llt = LltRef::new(symbolic, &self.l_values);
-        llt.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(&mut self.d, n, 1),
-            Par::Seq,
-            MemStack::new(mem),
-        );
-        if !self.d.iter().all(|x| x.is_finite()) {
+        if !self.jac.solve(&mut self.d) {
             return false;
         }
-        for (i, ix) in self.dof.iter().enumerate() {
-            for d in 0..3 {
-                self.dv[i][d] = if ix[d] != NONE { self.d[ix[d] as usize] } else { 0.0 };
-            }
-        }
+        self.jac.scatter_dofs(&self.d, &mut self.dv);
         for (k, r) in rows.iter().enumerate() {
             self.dy[k] = [gather(&self.dv, r.a, r.b, &r.hn_a, &r.hn_b), gather(&self.dv, r.a, r.b, &r.ht_a, &r.ht_b)];
         }
@@ -507,12 +315,12 @@ impl NewtonWorkspace {
     /// The potential's derivative along `d` at `v + t d`: `F(v + t d)·d`.
     fn slope(&self, t: f64, rows: &[ContactRow], springs: &[SpringRow]) -> f64 {
         let mut s = 0.0;
-        for (i, ix) in self.dof.iter().enumerate() {
+        for (i, ix) in self.jac.dof.iter().enumerate() {
             for d in 0..3 {
                 if ix[d] != NONE {
                     let k = ix[d] as usize;
                     let dd = self.d[k];
-                    s += self.mass[k] * (self.v[i][d] + t * dd - self.v_free[i][d]) * dd;
+                    s += self.jac.mass[k] * (self.v[i][d] + t * dd - self.v_free[i][d]) * dd;
                 }
             }
         }
@@ -578,56 +386,6 @@ impl NewtonWorkspace {
             scatter(u, inv_m, r.a, r.b, &r.ht_a, &r.ht_b, r.p[1]);
         }
     }
-
-    /// `u = u_free + M⁻¹ Σ H P` for the impulses stored in the rows.
-    fn rebuild(&self, u: &mut [[f64; 3]], inv_m: &[[f64; 3]], rows: &[ContactRow], springs: &[SpringRow]) {
-        u.copy_from_slice(&self.v_free);
-        for s in springs {
-            scatter(u, inv_m, s.a, s.b, &s.hn_a, &s.hn_b, s.p);
-        }
-        for r in rows {
-            scatter(u, inv_m, r.a, r.b, &r.hn_a, &r.hn_b, r.p[0]);
-            scatter(u, inv_m, r.a, r.b, &r.ht_a, &r.ht_b, r.p[1]);
-        }
-    }
-}
-
-/// Adds the generalised force of impulse `p` along a row (`h_a p` on `a`, `−h_b p` on `b`).
-#[inline(always)]
-fn add_force(out: &mut [[f64; 3]], a: u32, b: u32, ha: &[f64; 3], hb: &[f64; 3], p: f64) {
-    for d in 0..3 {
-        out[a as usize][d] += ha[d] * p;
-    }
-    if b != NONE {
-        for d in 0..3 {
-            out[b as usize][d] -= hb[d] * p;
-        }
-    }
-}
-
-fn push_pairs(pairs: &mut Vec<(u32, u32)>, l: &[u32; 6]) {
-    for p in 0..6 {
-        for q in p..6 {
-            let (i, j) = (l[p], l[q]);
-            if i != NONE && j != NONE && i != j {
-                pairs.push((i.min(j), i.max(j)));
-            }
-        }
-    }
-}
-
-/// Adds `cn gn gnᵀ + ct gt gtᵀ` to the lower-triangle slots of a row's block.
-#[inline(always)]
-fn add_block(values: &mut [f64], slots: &[u32; PAIRS], gn: &[f64; 6], cn: f64, gt: &[f64; 6], ct: f64) {
-    let mut k = 0;
-    for p in 0..6 {
-        for q in p..6 {
-            if slots[k] != NONE {
-                values[slots[k] as usize] += cn * gn[p] * gn[q] + ct * gt[p] * gt[q];
-            }
-            k += 1;
-        }
-    }
 }
 
 /// The finisher from an NLGS iterate (`u` consistent with the rows' impulses):
@@ -652,7 +410,7 @@ fn finish(
         evaluate(s.policy, s.tolerance, s.max_factor, &check(u, inv_m, rows, springs), 0.0)
     };
     // The entry made exactly consistent.
-    ws.rebuild(u, inv_m, rows, springs);
+    rebuild(u, &ws.v_free, inv_m, rows, springs);
     let mut kappa = opts.kappa;
     ws.relabel(kappa, u, rows);
     'outer: for _ in 0..opts.max_updates {
