@@ -345,6 +345,12 @@ pub(crate) struct AccelerateArgs {
     /// computed in addition to the window's, at most K of them (default: none).
     #[arg(long, value_name = "FACTOR", requires = "accelerate")]
     settle_rate: Option<f64>,
+    /// Roll a landing back (and retry the jump at half its length, or compute
+    /// its cycles) when the window after it settles at more than this factor
+    /// times the per-cycle rate the jump's fit predicted (default: none; a landing
+    /// is always rolled back when its relaxation fails or a cycle after it fails).
+    #[arg(long, value_name = "FACTOR", requires = "accelerate")]
+    rollback_rate: Option<f64>,
     /// A full run of the same sample and loading (its output folder, e.g. from
     /// `--accelerate K_I,N+1,1`, which never jumps, or a plain settle): errors.csv
     /// (settlement, accrued error after K_I, coordination) and its curve on the figure.
@@ -369,6 +375,7 @@ impl AccelerateArgs {
             smoothing_length: self.smoothing_length,
             settle_cycles: self.settle_cycles,
             settle_rate: self.settle_rate,
+            rollback_rate: self.rollback_rate,
             reference: self.reference.clone(),
         }))
     }

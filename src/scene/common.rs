@@ -298,6 +298,11 @@ pub struct SettlementSection {
     /// default: none, a fixed count.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub settle_rate: Option<f64>,
+    /// Roll a landing back when the window after it settles at more than this
+    /// factor (> 0) times the rate predicted at the landing, in absolute value;
+    /// default: none (landings judged by the engine's failures and the domain).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rollback_rate: Option<f64>,
 }
 
 /// `settlement.relax_tolerance`: a length (m) or a word (`"computed"`).
@@ -373,6 +378,7 @@ pub(crate) fn check_settlement(
         spec.settle_cycles = n;
     }
     spec.settle_rate = s.settle_rate;
+    spec.rollback_rate = s.rollback_rate;
     spec.relax.method = match s.relax_method.as_deref() {
         None | Some("lbfgs") => Method::Lbfgs,
         Some("gradient_descent") => Method::GradientDescent,
@@ -433,6 +439,7 @@ pub(crate) fn write_settlement(out: &mut String, s: Option<&SettlementSection>) 
     opt(out, "smoothing_length", s.smoothing_length, float);
     opt(out, "settle_cycles", s.settle_cycles, |n| n.to_string());
     opt(out, "settle_rate", s.settle_rate, float);
+    opt(out, "rollback_rate", s.rollback_rate, float);
 }
 
 /// A scene of either engine as a run records it (`scene.toml`): the text it was

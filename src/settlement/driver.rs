@@ -38,6 +38,8 @@
 //! cycles, relaxed where a jump lands), and `checkpoint.json` every `checkpoint_every_s` (at a cycle's end) for
 //! `--resume`; with `figures`, the figures of [`super::figures`].
 
+pub mod rollback;
+
 use super::estimate::{chernoff_cycles, extrapolate_within, fit, trend_moves, Training};
 use super::law::{Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
 use super::relax::{RelaxReport, RelaxSettings};
@@ -49,6 +51,7 @@ use crate::io::positions::{PositionsWriter, BODIES_FILE, DISPLACEMENTS_FILE};
 use crate::io::table::TableWriter;
 use crate::io::{self, RunInfo};
 use crate::run::{body_names, files, Boundary, Configuration, Engine, RunOptions};
+use rollback::Landing;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
@@ -187,6 +190,13 @@ pub struct Acceleration {
     /// (docs/settlement-driver.md, "A window starts one cycle after a landing").
     #[serde(default)]
     pub settle_rate: Option<f64>,
+    /// Roll a landing back when the settlement's mean increment per computed
+    /// cycle over the window after it exceeds this factor (> 0) times the
+    /// per-cycle rate its fit predicted at the landing, in absolute value
+    /// ([`rollback`]); `None`: landings are judged by the engine's
+    /// failures and the domain only.
+    #[serde(default)]
+    pub rollback_rate: Option<f64>,
 }
 
 fn default_settle_cycles() -> u64 {
@@ -221,6 +231,7 @@ impl Acceleration {
             smoothing_length: None,
             settle_cycles: 1,
             settle_rate: None,
+            rollback_rate: None,
         }
     }
 
@@ -256,6 +267,9 @@ impl Acceleration {
         }
         if let Some(f) = self.settle_rate.filter(|f| !(*f > 0.0 && f.is_finite())) {
             return bad(format!("settle_rate: must be a positive factor on the predicted rate, got {f}"));
+        }
+        if let Some(f) = self.rollback_rate.filter(|f| !(*f > 0.0 && f.is_finite())) {
+            return bad(format!("rollback_rate: must be a positive factor on the predicted rate, got {f}"));
         }
         if let Some(l) = self.smoothing_length.filter(|l| !(*l > 0.0 && l.is_finite())) {
             return bad(format!("smoothing_length: must be a positive length (m), got {l}"));
@@ -348,6 +362,13 @@ pub struct JumpRow {
     /// The settlement's per-cycle rate the fit predicts at this jump's landing (m per cycle).
     #[serde(default)]
     pub landing_rate_m: f64,
+    /// The jump was rolled back: the run went back to the state before it and
+    /// retried with half its length, or computed its cycles ([`rollback`]).
+    #[serde(default)]
+    pub rolled_back: bool,
+    /// Why it was rolled back (empty for a jump that stands).
+    #[serde(default)]
+    pub rollback_reason: String,
 }
 
 impl JumpRow {
@@ -374,6 +395,8 @@ impl JumpRow {
         "limited_bodies",
         "settling_cycles",
         "landing_rate_m",
+        "rolled_back",
+        "rollback_reason",
     ];
 }
 
@@ -392,8 +415,11 @@ pub struct AccelerationSummary {
     pub total_cycles: u64,
     /// `total_cycles / computed_cycles`.
     pub gained: f64,
-    /// Jumps made.
+    /// Jumps made (and kept).
     pub jumps: u64,
+    /// Landings rolled back ([`rollback`]).
+    #[serde(default)]
+    pub rollbacks: u64,
     /// `k_i`: the initial cycles (errors are measured on what accrues after them).
     pub initial_cycles: u64,
     /// Settlement at the last cycle (m).
@@ -431,7 +457,7 @@ pub struct AccelerationOutcome<E> {
 /// Where the procedure stands: all of it is the checkpoint.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct State<E> {
+pub(super) struct State<E> {
     version: String,
     engine: String,
     source_crc32: u32,
@@ -475,6 +501,28 @@ struct State<E> {
     /// CRC-32 of the cycle positions written (with `positions`).
     #[serde(default)]
     positions_crc32: u32,
+    /// Landings rolled back so far.
+    #[serde(default)]
+    pub(super) rollbacks: u64,
+    /// Rollbacks of the pending jump (since the state it starts from).
+    #[serde(default)]
+    pub(super) retries: u32,
+    /// No jump before this cycle: a jump rolled back down to the shortest
+    /// length has its cycles computed instead.
+    #[serde(default)]
+    pub(super) compute_until: u64,
+    /// The state before the last jump, kept while its landing is on probation
+    /// (from the jump to the next jump's attempt): a failure goes back to it.
+    #[serde(default = "no_state")]
+    pub(super) before_jump: Option<Box<State<E>>>,
+    /// The last jump's row, written again and marked if it is rolled back.
+    #[serde(default)]
+    pub(super) last_jump: Option<JumpRow>,
+}
+
+/// No state before a jump (a checkpoint of an older build, or off probation).
+fn no_state<E>() -> Option<Box<State<E>>> {
+    None
 }
 
 /// Where the system of a run comes from (for its record and `--resume`).
@@ -594,9 +642,16 @@ impl<E: Engine> Accelerated<E> {
                     break;
                 }
             }
-            if failure.is_some() {
-                end = "diverged";
-                break;
+            if let Some(e) = failure.take() {
+                // A failure while a landing is on probation rolls it back.
+                match self.recover(&mut st, law, &mut files, out, e, (wall0, &started)) {
+                    Ok(()) => continue,
+                    Err(e) => {
+                        failure = Some(e);
+                        end = "diverged";
+                        break;
+                    }
+                }
             }
             // The largest overlap at the cycle's end (a jump's relaxation target).
             if let Some(stats) = last {
@@ -606,9 +661,14 @@ impl<E: Engine> Accelerated<E> {
             st.computed += 1;
             let c = st.sys.configuration();
             if let Err(e) = check_domain(&st.sys, &st.origin, &c, || format!("computed cycle {}", st.cycle)) {
-                failure = Some(e);
-                end = "diverged";
-                break;
+                match self.recover(&mut st, law, &mut files, out, e, (wall0, &started)) {
+                    Ok(()) => continue,
+                    Err(e) => {
+                        failure = Some(e);
+                        end = "diverged";
+                        break;
+                    }
+                }
             }
             let bounds = st.sys.boundaries();
             let s = st.settlement(&c, &bounds, vertical, self.spec.settlement_boundary);
@@ -656,17 +716,10 @@ impl<E: Engine> Accelerated<E> {
                 st.last_increment = Some(increment);
             }
             // A jump when the window is long enough and cycles are left.
-            let left = self.target - st.cycle;
-            let k = st.since_jump;
-            if left > 0 && k >= self.spec.computed_cycles {
-                match self.jump(&mut st, law, k, left, &mut files, wall0, &started) {
-                    Ok(()) => {}
-                    Err(e) => {
-                        failure = Some(e);
-                        end = "diverged";
-                        break;
-                    }
-                }
+            if let Err(e) = self.attempt_jump(&mut st, law, &mut files, out, wall0, &started) {
+                failure = Some(e);
+                end = "diverged";
+                break;
             }
             progress(&AccelerationProgress {
                 cycle: st.cycle,
@@ -700,6 +753,7 @@ impl<E: Engine> Accelerated<E> {
             total_cycles: st.cycle,
             gained: if st.computed > 0 { st.cycle as f64 / st.computed as f64 } else { 0.0 },
             jumps: st.jumps,
+            rollbacks: st.rollbacks,
             initial_cycles: self.spec.initial_cycles,
             settlement_m: st.last_settlement,
             wall_time_s: st.wall_time_s,
@@ -739,7 +793,10 @@ impl<E: Engine> Accelerated<E> {
 
     /// Fits the window, extrapolates, writes back and relaxes; the rows of the
     /// extrapolated cycles and the jump's row. Leaves the window as it is when
-    /// the adaptive bound asks for more computed cycles.
+    /// the adaptive bound asks for more computed cycles. A landing that fails
+    /// (a body out of the domain, a relaxation that fails or does not converge)
+    /// is [`Landing::Failed`], with the state partly changed: the caller rolls
+    /// it back ([`rollback`]).
     #[allow(clippy::too_many_arguments)]
     fn jump(
         &self,
@@ -750,7 +807,7 @@ impl<E: Engine> Accelerated<E> {
         files: &mut Files,
         wall0: f64,
         started: &Instant,
-    ) -> Result<()> {
+    ) -> Result<Landing> {
         // The law's training data: the whole history, or the last window (the
         // points since the last jump).
         let first = if law.history() { 0 } else { st.window.window_start() };
@@ -762,7 +819,7 @@ impl<E: Engine> Accelerated<E> {
                 let need = chernoff_cycles(a.error, a.probability, f.xi_range)?;
                 let cap = 10 * self.spec.computed_cycles;
                 if k < need.min(cap) && left > need.min(cap) - k {
-                    return Ok(());
+                    return Ok(Landing::Waited);
                 }
                 Some(need)
             }
@@ -807,7 +864,36 @@ impl<E: Engine> Accelerated<E> {
             })?;
         }
         let (target, limited) = extrapolate_within(law, &window, &f, h as f64, &max_move, smoothing.as_ref());
-        check_domain(&st.sys, &st.origin, &target, || format!("the extrapolation of jump {}", st.jumps + 1))?;
+        let mut row = JumpRow {
+            jump: st.jumps + 1,
+            from_cycle: st.cycle,
+            to_cycle: st.cycle + h,
+            computed_cycles: k,
+            extrapolated_cycles: h,
+            chernoff_cycles: chernoff,
+            g_u_m: f.g_u,
+            f_xi_m: f.f_xi,
+            xi_range_m: f.xi_range,
+            relax_tolerance_m: self.spec.relax.tolerance,
+            relax_iterations: 0,
+            relax_evaluations: 0,
+            relax_converged: false,
+            max_overlap_before_relax_m: 0.0,
+            max_overlap_after_relax_m: 0.0,
+            relax_largest_move: 0.0,
+            relax_wall_time_s: 0.0,
+            held_bodies: held,
+            limited_bodies: limited as u64,
+            settling_cycles: st.settling,
+            landing_rate_m: landing_rate,
+            rolled_back: false,
+            rollback_reason: String::new(),
+        };
+        if let Err(e) =
+            check_domain(&st.sys, &st.origin, &target, || format!("the extrapolation of jump {}", st.jumps + 1))
+        {
+            return Ok(Landing::Failed(row, e.to_string()));
+        }
         // The boundaries (the MD plate) follow the same law.
         let mut series = vec![0.0; n.len()];
         let boundaries: Vec<f64> = (0..st.boundary_origin.len())
@@ -828,12 +914,32 @@ impl<E: Engine> Accelerated<E> {
             let floor = if smallest.is_finite() { 1e-6 * smallest } else { f64::MIN_POSITIVE };
             relax.tolerance = st.computed_overlap.max(floor);
         }
-        let report: RelaxReport = st.sys.relax(&relax)?;
-        let relax_wall = t0.elapsed().as_secs_f64();
-        check_domain(&st.sys, &st.origin, &st.sys.configuration(), || {
+        row.relax_tolerance_m = relax.tolerance;
+        let report: RelaxReport = match st.sys.relax(&relax) {
+            Ok(r) => r,
+            Err(e) => return Ok(Landing::Failed(row, format!("its relaxation failed: {e}"))),
+        };
+        row.relax_iterations = report.iterations;
+        row.relax_evaluations = report.evaluations;
+        row.relax_converged = report.converged;
+        row.max_overlap_before_relax_m = report.max_overlap_before;
+        row.max_overlap_after_relax_m = report.max_overlap_after;
+        row.relax_largest_move = report.largest_move;
+        row.relax_wall_time_s = t0.elapsed().as_secs_f64();
+        if !report.converged {
+            return Ok(Landing::Failed(
+                row,
+                format!(
+                    "its relaxation did not reach {:.3e} m ({:.3e} m left after {} iterations: {})",
+                    relax.tolerance, report.max_overlap_after, report.iterations, report.reason
+                ),
+            ));
+        }
+        if let Err(e) = check_domain(&st.sys, &st.origin, &st.sys.configuration(), || {
             format!("the relaxation of jump {}", st.jumps + 1)
-        })?;
-        let from = st.cycle;
+        }) {
+            return Ok(Landing::Failed(row, e.to_string()));
+        }
         st.cycle += h;
         st.jumps += 1;
         st.h *= self.spec.growth;
@@ -853,36 +959,14 @@ impl<E: Engine> Accelerated<E> {
             max_overlap_after_relax_m: Some(report.max_overlap_after),
             wall_time_s: wall0 + started.elapsed().as_secs_f64(),
         })?;
-        files.jumps.write(&JumpRow {
-            jump: st.jumps,
-            from_cycle: from,
-            to_cycle: st.cycle,
-            computed_cycles: k,
-            extrapolated_cycles: h,
-            chernoff_cycles: chernoff,
-            g_u_m: f.g_u,
-            f_xi_m: f.f_xi,
-            xi_range_m: f.xi_range,
-            relax_tolerance_m: relax.tolerance,
-            relax_iterations: report.iterations,
-            relax_evaluations: report.evaluations,
-            relax_converged: report.converged,
-            max_overlap_before_relax_m: report.max_overlap_before,
-            max_overlap_after_relax_m: report.max_overlap_after,
-            relax_largest_move: report.largest_move,
-            relax_wall_time_s: relax_wall,
-            held_bodies: held,
-            limited_bodies: limited as u64,
-            settling_cycles: st.settling,
-            landing_rate_m: landing_rate,
-        })?;
+        files.jumps.write(&row)?;
         st.landing_rate = landing_rate;
         st.settling = 0;
         st.last_increment = None;
         // The next window starts at the end of the first computed cycle after
         // the landing (the relaxed configuration re-seats in that cycle).
         st.since_jump = 0;
-        Ok(())
+        Ok(Landing::Landed(row))
     }
 
     /// A fresh run: the folder prepared, the records and table headers written.
@@ -947,6 +1031,11 @@ impl<E: Engine> Accelerated<E> {
             wall_time_s: 0.0,
             tables: [(0, 0, 0); 2],
             positions_crc32: 0,
+            rollbacks: 0,
+            retries: 0,
+            compute_until: 0,
+            before_jump: None,
+            last_jump: None,
         };
         let rows = TableWriter::create(&out.join(SETTLEMENT_FILE), SettlementRow::COLUMNS)?;
         let jumps = TableWriter::create(&out.join(JUMPS_FILE), JumpRow::COLUMNS)?;
@@ -975,6 +1064,21 @@ impl<E: Engine> Accelerated<E> {
         let bad = |msg: String| Error::Scene(format!("{}: not a valid checkpoint: {msg}", path.display()));
         st.sys.check_state().map_err(|e| bad(e.to_string()))?;
         st.sys.check_same_model(&self.system).map_err(|e| bad(e.to_string()))?;
+        if let Some(b) = &st.before_jump {
+            b.sys.check_state().map_err(|e| bad(format!("before_jump: {e}")))?;
+            b.sys.check_same_model(&self.system).map_err(|e| bad(format!("before_jump: {e}")))?;
+            if b.before_jump.is_some()
+                || b.cycle > st.cycle
+                || b.jumps > st.jumps
+                || st.last_jump.is_none()
+                || b.window.configurations.len() != b.window_settlement.len()
+                || b.window.segments.len() != b.window.cycles.len()
+                || b.tables[0].1 != b.cycle
+                || b.tables[1].1 != b.jumps + b.rollbacks
+            {
+                return Err(bad("before_jump: not the state before its last jump".into()));
+            }
+        }
         if st.origin != self.system.configuration() {
             return Err(bad("its start configuration is not the scene's".into()));
         }
@@ -986,10 +1090,10 @@ impl<E: Engine> Accelerated<E> {
             return Err(bad(format!("{} computed of {} cycles, target {}", st.computed, st.cycle, self.target)));
         }
         let [(rb, rr, rc), (jb, jr, jc)] = st.tables;
-        if rr != st.cycle || jr != st.jumps {
+        if rr != st.cycle || jr != st.jumps + st.rollbacks {
             return Err(bad(format!(
-                "{rr} rows of {SETTLEMENT_FILE} for {} cycles, {jr} of {JUMPS_FILE} for {} jumps",
-                st.cycle, st.jumps
+                "{rr} rows of {SETTLEMENT_FILE} for {} cycles, {jr} of {JUMPS_FILE} for {} jumps and {} rollbacks",
+                st.cycle, st.jumps, st.rollbacks
             )));
         }
         let rows = TableWriter::resume(&out.join(SETTLEMENT_FILE), rb, rr, rc)?;
@@ -1006,21 +1110,27 @@ impl<E: Engine> Accelerated<E> {
 }
 
 /// The files a run appends to.
-struct Files {
-    rows: TableWriter,
-    jumps: TableWriter,
-    positions: Option<PositionsWriter>,
+pub(super) struct Files {
+    pub(super) rows: TableWriter,
+    pub(super) jumps: TableWriter,
+    pub(super) positions: Option<PositionsWriter>,
 }
 
 /// Writes the checkpoint of the run in progress.
 fn checkpoint<E: Engine>(out: &Path, st: &mut State<E>, files: &mut Files) -> Result<()> {
+    sync_tables(st, files)?;
+    write_checked(out, st)?;
+    Ok(())
+}
+
+/// Flushes the tables and records their lengths and CRCs in `st`.
+pub(super) fn sync_tables<E>(st: &mut State<E>, files: &mut Files) -> Result<()> {
     let (rows, jumps) = (&mut files.rows, &mut files.jumps);
     st.tables = [(rows.sync()?, rows.rows(), rows.crc32()), (jumps.sync()?, jumps.rows(), jumps.crc32())];
     if let Some(p) = files.positions.as_mut() {
         p.sync()?;
         st.positions_crc32 = p.crc32();
     }
-    write_checked(out, st)?;
     Ok(())
 }
 

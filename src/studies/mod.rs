@@ -126,6 +126,8 @@ pub struct Accelerate {
     /// Keep re-seating while the settlement runs ahead of this factor times the
     /// landing's predicted rate; `None`: a fixed count.
     pub settle_rate: Option<f64>,
+    /// `rollback_rate` of the accelerated runs ([`crate::settlement::Acceleration::rollback_rate`]).
+    pub rollback_rate: Option<f64>,
     /// A full run of the same loaded sample (its folder) to measure the errors
     /// against: `errors.csv` and its curve on the settlement figure.
     pub reference: Option<PathBuf>,
@@ -156,6 +158,7 @@ impl Accelerate {
             smoothing_length: self.smoothing_length,
             settle_cycles: self.settle_cycles,
             settle_rate: self.settle_rate,
+            rollback_rate: self.rollback_rate,
             ..Default::default()
         }
     }
