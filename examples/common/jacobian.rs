@@ -100,6 +100,55 @@ pub fn free_velocity(u: &[[f64; 3]], inv_m: &[[f64; 3]], rows: &[ContactRow], sp
     v
 }
 
+/// Numbers the mobile velocity components: per body the unknown of each
+/// component (`NONE` where the inverse mass is zero), and each unknown's mass.
+fn number(inv_m: &[[f64; 3]]) -> (Vec<[u32; 3]>, Vec<f64>) {
+    let (mut dof, mut mass) = (Vec::with_capacity(inv_m.len()), Vec::new());
+    for im in inv_m {
+        let mut ix = [NONE; 3];
+        for d in 0..3 {
+            if im[d] > 0.0 {
+                ix[d] = mass.len() as u32;
+                mass.push(1.0 / im[d]);
+            }
+        }
+        dof.push(ix);
+    }
+    (dof, mass)
+}
+
+/// The unknowns of a row's six local components (bodies `a` and `b`).
+fn row_dofs(dof: &[[u32; 3]], a: u32, b: u32) -> [u32; 6] {
+    let mut l = [NONE; 6];
+    l[..3].copy_from_slice(&dof[a as usize]);
+    if b != NONE {
+        l[3..].copy_from_slice(&dof[b as usize]);
+    }
+    l
+}
+
+/// The CSC pattern of `n` columns from `(column, row)` pairs (sorted, deduplicated here).
+fn csc(n: usize, pairs: &mut Vec<(u32, u32)>) -> (Vec<u32>, Vec<u32>) {
+    pairs.sort_unstable();
+    pairs.dedup();
+    let mut col_ptr = vec![0u32; n + 1];
+    let mut row_idx = Vec::with_capacity(pairs.len());
+    for &(c, r) in pairs.iter() {
+        col_ptr[c as usize + 1] += 1;
+        row_idx.push(r);
+    }
+    for j in 0..n {
+        col_ptr[j + 1] += col_ptr[j];
+    }
+    (col_ptr, row_idx)
+}
+
+/// The slot of entry (row `r`, column `c`) in a CSC pattern.
+fn slot(col_ptr: &[u32], row_idx: &[u32], r: u32, c: u32) -> u32 {
+    let (lo, hi) = (col_ptr[c as usize] as usize, col_ptr[c as usize + 1] as usize);
+    lo as u32 + row_idx[lo..hi].binary_search(&r).expect("pattern holds every pair") as u32
+}
+
 fn push_pairs(pairs: &mut Vec<(u32, u32)>, l: &[u32; 6]) {
     for p in 0..6 {
         for q in p..6 {
@@ -152,64 +201,24 @@ impl Jacobian {
     /// Numbers the unknowns, builds the pattern of every row and its symbolic
     /// Cholesky factorisation; false if there is no unknown or the analysis fails.
     pub fn prepare(&mut self, inv_m: &[[f64; 3]], rows: &[ContactRow], springs: &[SpringRow]) -> bool {
-        self.dof.clear();
-        self.mass.clear();
-        for im in inv_m {
-            let mut ix = [NONE; 3];
-            for d in 0..3 {
-                if im[d] > 0.0 {
-                    ix[d] = self.mass.len() as u32;
-                    self.mass.push(1.0 / im[d]);
-                }
-            }
-            self.dof.push(ix);
-        }
+        (self.dof, self.mass) = number(inv_m);
         let n = self.mass.len();
         if n == 0 {
             return false;
         }
-        let dofs = |dof: &[[u32; 3]], a: u32, b: u32| {
-            let mut l = [NONE; 6];
-            l[..3].copy_from_slice(&dof[a as usize]);
-            if b != NONE {
-                l[3..].copy_from_slice(&dof[b as usize]);
-            }
-            l
-        };
         self.pairs.clear();
         self.pairs.extend((0..n as u32).map(|k| (k, k)));
-        self.cdof.clear();
-        for r in rows {
-            let l = dofs(&self.dof, r.a, r.b);
-            push_pairs(&mut self.pairs, &l);
-            self.cdof.push(l);
+        self.cdof = rows.iter().map(|r| row_dofs(&self.dof, r.a, r.b)).collect();
+        self.sdof = springs.iter().map(|s| row_dofs(&self.dof, s.a, s.b)).collect();
+        for l in self.cdof.iter().chain(&self.sdof) {
+            push_pairs(&mut self.pairs, l);
         }
-        self.sdof.clear();
-        for s in springs {
-            let l = dofs(&self.dof, s.a, s.b);
-            push_pairs(&mut self.pairs, &l);
-            self.sdof.push(l);
-        }
-        // (column, row) with row ≥ column, sorted by column then row.
-        self.pairs.sort_unstable();
-        self.pairs.dedup();
-        self.col_ptr.clear();
-        self.col_ptr.resize(n + 1, 0);
-        self.row_idx.clear();
-        for &(c, r) in &self.pairs {
-            self.col_ptr[c as usize + 1] += 1;
-            self.row_idx.push(r);
-        }
-        for j in 0..n {
-            self.col_ptr[j + 1] += self.col_ptr[j];
-        }
+        // (column, row) with row ≥ column.
+        (self.col_ptr, self.row_idx) = csc(n, &mut self.pairs);
         self.values.clear();
         self.values.resize(self.row_idx.len(), 0.0);
-        let slot = |col_ptr: &[u32], row_idx: &[u32], i: u32, j: u32| -> u32 {
-            let (c, r) = if i <= j { (i, j) } else { (j, i) };
-            let (lo, hi) = (col_ptr[c as usize] as usize, col_ptr[c as usize + 1] as usize);
-            lo as u32 + row_idx[lo..hi].binary_search(&r).expect("pattern holds every pair") as u32
-        };
+        // The lower triangle: (i, j) is stored as (max, min).
+        let slot = |col_ptr: &[u32], row_idx: &[u32], i: u32, j: u32| slot(col_ptr, row_idx, i.max(j), i.min(j));
         self.diag.clear();
         for k in 0..n as u32 {
             self.diag.push(slot(&self.col_ptr, &self.row_idx, k, k));
@@ -360,34 +369,15 @@ impl LuJacobian {
     /// Numbers the unknowns, builds the full pattern and its symbolic LU.
     pub fn prepare(&mut self, inv_m: &[[f64; 3]], rows: &[ContactRow], springs: &[SpringRow]) -> bool {
         use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams};
-        self.dof.clear();
-        self.mass.clear();
-        for im in inv_m {
-            let mut ix = [NONE; 3];
-            for d in 0..3 {
-                if im[d] > 0.0 {
-                    ix[d] = self.mass.len() as u32;
-                    self.mass.push(1.0 / im[d]);
-                }
-            }
-            self.dof.push(ix);
-        }
+        (self.dof, self.mass) = number(inv_m);
         let n = self.mass.len();
         if n == 0 {
             return false;
         }
-        let dofs = |dof: &[[u32; 3]], a: u32, b: u32| {
-            let mut l = [NONE; 6];
-            l[..3].copy_from_slice(&dof[a as usize]);
-            if b != NONE {
-                l[3..].copy_from_slice(&dof[b as usize]);
-            }
-            l
-        };
         let locals: Vec<[u32; 6]> = rows
             .iter()
-            .map(|r| dofs(&self.dof, r.a, r.b))
-            .chain(springs.iter().map(|s| dofs(&self.dof, s.a, s.b)))
+            .map(|r| row_dofs(&self.dof, r.a, r.b))
+            .chain(springs.iter().map(|s| row_dofs(&self.dof, s.a, s.b)))
             .collect();
         // (column, row) pairs of the full pattern.
         let mut pairs: Vec<(u32, u32)> = (0..n as u32).map(|k| (k, k)).collect();
@@ -398,22 +388,8 @@ impl LuJacobian {
                 }
             }
         }
-        pairs.sort_unstable();
-        pairs.dedup();
-        self.col_ptr = vec![0; n + 1];
-        self.row_idx.clear();
-        for &(c, r) in &pairs {
-            self.col_ptr[c as usize + 1] += 1;
-            self.row_idx.push(r);
-        }
-        for j in 0..n {
-            self.col_ptr[j + 1] += self.col_ptr[j];
-        }
+        (self.col_ptr, self.row_idx) = csc(n, &mut pairs);
         self.values = vec![0.0; self.row_idx.len()];
-        let slot = |col_ptr: &[u32], row_idx: &[u32], r: u32, c: u32| -> u32 {
-            let (lo, hi) = (col_ptr[c as usize] as usize, col_ptr[c as usize + 1] as usize);
-            lo as u32 + row_idx[lo..hi].binary_search(&r).expect("pattern holds every pair") as u32
-        };
         self.diag = (0..n as u32).map(|k| slot(&self.col_ptr, &self.row_idx, k, k)).collect();
         let slots = |l: &[u32; 6]| {
             let mut out = [NONE; 36];

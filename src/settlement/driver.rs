@@ -469,8 +469,23 @@ impl<E: Engine> Accelerated<E> {
                     break;
                 }
             }
-            if let Some(e) = failure.take() {
+            let mut c = None;
+            if failure.is_none() {
+                // The largest overlap at the cycle's end (a jump's relaxation target).
+                if let Some(stats) = last {
+                    st.computed_overlap = E::summary(&stats).max_overlap;
+                }
+                st.cycle += 1;
+                st.computed += 1;
+                let conf = st.sys.configuration();
+                match check_domain(&st.sys, &st.origin, &conf, || format!("computed cycle {}", st.cycle)) {
+                    Ok(()) => c = Some(conf),
+                    Err(e) => failure = Some(e),
+                }
+            }
+            let Some(c) = c else {
                 // A failure while a landing is on probation rolls it back.
+                let e = failure.take().expect("a cycle without its configuration failed");
                 match self.recover(&mut st, law, &mut files, out, e, (wall0, &started)) {
                     Ok(()) => continue,
                     Err(e) => {
@@ -479,24 +494,7 @@ impl<E: Engine> Accelerated<E> {
                         break;
                     }
                 }
-            }
-            // The largest overlap at the cycle's end (a jump's relaxation target).
-            if let Some(stats) = last {
-                st.computed_overlap = E::summary(&stats).max_overlap;
-            }
-            st.cycle += 1;
-            st.computed += 1;
-            let c = st.sys.configuration();
-            if let Err(e) = check_domain(&st.sys, &st.origin, &c, || format!("computed cycle {}", st.cycle)) {
-                match self.recover(&mut st, law, &mut files, out, e, (wall0, &started)) {
-                    Ok(()) => continue,
-                    Err(e) => {
-                        failure = Some(e);
-                        end = "diverged";
-                        break;
-                    }
-                }
-            }
+            };
             let bounds = st.sys.boundaries();
             let s = st.settlement(&c, &bounds, vertical, self.spec.settlement_boundary);
             let b = coordinates(&bounds);
