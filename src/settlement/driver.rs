@@ -439,7 +439,8 @@ impl<E: Engine> Accelerated<E> {
         let law = self.spec.law.estimator();
         let started = Instant::now();
         let wall0 = st.wall_time_s;
-        let steps0 = st.sys.steps_done();
+        // Steps made by this call, rolled-back ones included (`stop_after`).
+        let mut stepped = 0u64;
         let mut checkpointed = Instant::now();
         let mut end = "finished";
         let mut failure = None;
@@ -451,6 +452,7 @@ impl<E: Engine> Accelerated<E> {
             let mut made = 0;
             let mut last = None;
             while cycles_at(st.sys.time(), self.frequency, st.sys.dt()) == before {
+                stepped += 1;
                 match st.sys.step() {
                     Ok(stats) => last = Some(stats),
                     Err(e) => {
@@ -552,7 +554,7 @@ impl<E: Engine> Accelerated<E> {
                 computed: st.computed,
                 settlement: st.last_settlement,
             });
-            let stop = opts.stop_after.is_some_and(|n| st.sys.steps_done() - steps0 >= n);
+            let stop = opts.stop_after.is_some_and(|n| stepped >= n);
             if st.cycle < self.target
                 && (stop
                     || (opts.checkpoint_every_s > 0.0

@@ -154,7 +154,7 @@ pub struct AccelerationSummary {
     pub settlement_m: f64,
     /// Wall time (s).
     pub wall_time_s: f64,
-    /// Steps the engine made.
+    /// Steps of the run's kept trajectory (the steps of rolled-back cycles are not counted).
     pub steps: u64,
 }
 
