@@ -916,13 +916,22 @@ impl<E: Engine> Accelerated<E> {
         {
             return Err(bad(format!("{} computed of {} cycles, target {}", st.computed, st.cycle, self.target)));
         }
-        let [(rb, rr, rc), (jb, jr, jc)] = st.tables;
+        let [(_, rr, _), (_, jr, _)] = st.tables;
         if rr != st.cycle || jr != st.jumps + st.rollbacks {
             return Err(bad(format!(
                 "{rr} rows of {SETTLEMENT_FILE} for {} cycles, {jr} of {JUMPS_FILE} for {} jumps and {} rollbacks",
                 st.cycle, st.jumps, st.rollbacks
             )));
         }
+        let files = self.reopen(out, &st)?;
+        io::remove_stale(out, files::SUMMARY)?;
+        Ok((st, files))
+    }
+
+    /// The run's files reopened at the lengths `st` recorded (`st.tables`, its
+    /// cycles of positions): cut back to them, checked against their CRCs.
+    fn reopen(&self, out: &Path, st: &State<E>) -> Result<Files> {
+        let [(rb, rr, rc), (jb, jr, jc)] = st.tables;
         let rows = TableWriter::resume(&out.join(SETTLEMENT_FILE), rb, rr, rc)?;
         let jumps = TableWriter::resume(&out.join(JUMPS_FILE), jb, jr, jc)?;
         let positions = if self.spec.positions {
@@ -931,8 +940,7 @@ impl<E: Engine> Accelerated<E> {
         } else {
             None
         };
-        io::remove_stale(out, files::SUMMARY)?;
-        Ok((st, Files { rows, jumps, positions }))
+        Ok(Files { rows, jumps, positions })
     }
 }
 

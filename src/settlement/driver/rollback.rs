@@ -25,11 +25,9 @@
 //! when a computed cycle fails with no landing on probation. Everything is a
 //! function of the state, so a rolled-back run is as deterministic as any.
 
-use super::{sync_tables, Accelerated, Files, JumpRow, State, JUMPS_FILE, SETTLEMENT_FILE};
+use super::{sync_tables, Accelerated, Files, JumpRow, State};
 use crate::error::{Error, Result};
-use crate::io::positions::PositionsWriter;
-use crate::io::table::TableWriter;
-use crate::run::{body_names, Engine};
+use crate::run::Engine;
 use crate::settlement::law::ResidualLaw;
 use std::path::Path;
 use std::time::Instant;
@@ -145,14 +143,10 @@ impl<E: Engine> Accelerated<E> {
         // Flush what is buffered before the files are cut back.
         files.rows.sync()?;
         files.jumps.sync()?;
-        let [(rb, rr, rc), (jb, jr, jc)] = st.tables;
-        files.rows = TableWriter::resume(&out.join(SETTLEMENT_FILE), rb, rr, rc)?;
-        files.jumps = TableWriter::resume(&out.join(JUMPS_FILE), jb, jr, jc)?;
         if let Some(p) = files.positions.as_mut() {
             p.sync()?;
-            let names = body_names(&self.system, &st.origin.bodies);
-            *p = PositionsWriter::resume(out, st.origin.clone(), &names, st.cycle, st.positions_crc32)?;
         }
+        *files = self.reopen(out, st)?;
         row.rolled_back = true;
         row.rollback_reason = reason;
         files.jumps.write(&row)?;
