@@ -44,6 +44,8 @@ pub mod contact;
 pub mod coulomb;
 pub mod criterion;
 pub mod engine;
+#[cfg(feature = "faer")]
+pub mod interior;
 pub mod measure;
 pub mod nlgs;
 pub mod split;

@@ -79,20 +79,32 @@ pub enum Solver {
     /// projected gradient of [`super::apgd`] with its default options; the same
     /// stopping rule, `max_iterations` counted in sweep-equivalents; one thread.
     Apgd,
+    /// Up to 50 NLGS sweeps, then, if the step has not converged, the interior point
+    /// of `super::interior` on the problem's complementarity form (at most 100
+    /// iterations, a sparse LU each), then NLGS again up to `max_iterations` if it has
+    /// not met the tolerance; the same stopping rule (residual policies only); one
+    /// thread. Needs the crate's `faer` feature (on by default).
+    InteriorPoint,
 }
 
 impl Solver {
-    /// The name in scenes (`nlgs`, `apgd`).
+    /// The name in scenes (`nlgs`, `apgd`, `interior_point`).
     pub fn name(self) -> &'static str {
         match self {
             Solver::Nlgs => "nlgs",
             Solver::Apgd => "apgd",
+            Solver::InteriorPoint => "interior_point",
         }
     }
 
     /// The solver named `name` (as [`Solver::name`] writes it).
     pub fn from_name(name: &str) -> Option<Self> {
-        [Solver::Nlgs, Solver::Apgd].into_iter().find(|s| s.name() == name)
+        [Solver::Nlgs, Solver::Apgd, Solver::InteriorPoint].into_iter().find(|s| s.name() == name)
+    }
+
+    /// Whether this build has the solver (`interior_point` needs the `faer` feature).
+    pub fn available(self) -> bool {
+        self != Solver::InteriorPoint || cfg!(feature = "faer")
     }
 }
 

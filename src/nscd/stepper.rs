@@ -134,6 +134,25 @@ impl System {
                     &mut ws.spring_rows,
                 )
             }
+            #[cfg(feature = "faer")]
+            Solver::InteriorPoint => {
+                let s = NlgsSettings { max_iterations: settings.sweep_cap(), ..*settings };
+                super::interior::solve_interior(
+                    &s,
+                    &Default::default(),
+                    &mut ws.interior,
+                    &mut self.bodies.u,
+                    &self.bodies.inv_m,
+                    &mut ws.rows,
+                    &mut ws.spring_rows,
+                )
+            }
+            // `params.check` (the first thing a step does) refuses a solver this build
+            // does not have, so this arm is never taken.
+            #[cfg(not(feature = "faer"))]
+            Solver::InteriorPoint => {
+                super::nlgs::NlgsReport { iterations: 0, criterion: f64::INFINITY, converged: false }
+            }
         };
 
         if !report.converged && self.params.nlgs.on_stall == OnStall::Stop {

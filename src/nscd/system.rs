@@ -75,6 +75,19 @@ impl NscdParams {
         if self.gravity.iter().any(|g| !g.is_finite()) {
             return bad("simulation.gravity", self.gravity[0] + self.gravity[1]);
         }
+        if !n.solver.available() {
+            return Err(crate::Error::Scene(format!(
+                "nscd.solver: '{}' needs the crate's `faer` feature, which this build was made without",
+                n.solver.name()
+            )));
+        }
+        if n.solver != super::nlgs::Solver::Nlgs && n.policy.over_sweeps() {
+            return Err(crate::Error::Scene(format!(
+                "nscd.solver: '{}' stops on a residual (strict, quad, quad_max), not on the {} criterion",
+                n.solver.name(),
+                n.policy.name()
+            )));
+        }
         Ok(())
     }
 }
@@ -122,6 +135,9 @@ pub(crate) struct Workspace {
     pub split: super::split::SplitWorkspace,
     /// Buffers of the accelerated solver ([`super::apgd`]).
     pub apgd: super::apgd::ApgdWorkspace,
+    /// Buffers of the interior-point solver (`super::interior`).
+    #[cfg(feature = "faer")]
+    pub interior: super::interior::InteriorWorkspace,
     /// Threads of the NLGS sweeps (0 or 1: one); not part of the state.
     pub threads: usize,
 }

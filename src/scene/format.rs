@@ -81,8 +81,10 @@ pub struct NscdSection {
     /// sweep) or `"check"` (a separate pass after it that updates nothing, as LMGC90).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub measure: Option<String>,
-    /// The solver of each step: `"nlgs"` (default) or `"apgd"` (NLGS first, then
-    /// the accelerated projected gradient; `docs/accelerated-solver.md`).
+    /// The solver of each step: `"nlgs"` (default), `"apgd"` (NLGS first, then
+    /// the accelerated projected gradient; `docs/accelerated-solver.md`) or
+    /// `"interior_point"` (NLGS first, then an interior point on the law's
+    /// complementarity form, then NLGS; `nscd::interior`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub solver: Option<String>,
     /// What a step does when `max_iterations` sweeps stop short of the tolerance:

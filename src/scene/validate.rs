@@ -320,12 +320,19 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
         ns.solver.as_deref(),
         defaults.nlgs.solver,
         Solver::from_name,
-        "'nlgs' or 'apgd'",
+        "'nlgs', 'apgd' or 'interior_point'",
     )?;
-    if solver == Solver::Apgd && policy.over_sweeps() {
+    if solver != Solver::Nlgs && policy.over_sweeps() {
         return err(format!(
-            "nscd.solver: 'apgd' stops on a residual (strict, quad, quad_max), not on the {} criterion",
+            "nscd.solver: '{}' stops on a residual (strict, quad, quad_max), not on the {} criterion",
+            solver.name(),
             policy.name()
+        ));
+    }
+    if !solver.available() {
+        return err(format!(
+            "nscd.solver: '{}' needs the crate's `faer` feature, which this build was made without",
+            solver.name()
         ));
     }
     let on_stall = named(
