@@ -769,7 +769,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let options = Options::from_env();
     let entry: usize = std::env::var("ENTRY").map_or(Ok(0), |v| v.parse())?;
     let mut ipm = Ipm { gmres: std::env::var("GMRES").is_ok(), ..Ipm::default() };
-    ipm.lu.supernodal = true;
     let mut out = csv::Writer::from_writer(std::io::stdout());
     let (mut t_def, mut t_tol, mut t_ipm, mut n_conv, mut n) = (0.0, 0.0, 0.0, 0, 0);
     for k in 1..=steps {

@@ -153,6 +153,11 @@ impl NewtonMatrix {
         self.mass.len()
     }
 
+    /// True when there is no unknown (nothing to factorise).
+    pub fn is_empty(&self) -> bool {
+        self.mass.is_empty()
+    }
+
     /// Starts a new assembly: `K = M`.
     pub fn reset(&mut self) {
         self.values.iter_mut().for_each(|x| *x = 0.0);

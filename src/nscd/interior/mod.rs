@@ -48,7 +48,7 @@
 
 #![allow(clippy::needless_range_loop)] // per-component loops over [x, y, θ] and the pairs read as the equations
 
-mod lu;
+pub mod lu;
 
 use super::contact::{dot3, ContactRow};
 use super::criterion::evaluate;
