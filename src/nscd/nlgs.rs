@@ -106,6 +106,24 @@ impl Solver {
     pub fn available(self) -> bool {
         self != Solver::InteriorPoint || cfg!(feature = "faer")
     }
+
+    /// Why this solver cannot stop on `policy` in this build, naming the scene key:
+    /// the solvers other than NLGS stop on a residual, and `interior_point` needs `faer`.
+    pub fn refusal(self, policy: Policy) -> Option<String> {
+        if self != Solver::Nlgs && policy.over_sweeps() {
+            return Some(format!(
+                "nscd.solver: '{}' stops on a residual (strict, quad, quad_max), not on the {} criterion",
+                self.name(),
+                policy.name()
+            ));
+        }
+        (!self.available()).then(|| {
+            format!(
+                "nscd.solver: '{}' needs the crate's `faer` feature, which this build was made without",
+                self.name()
+            )
+        })
+    }
 }
 
 /// What a step does when its sweeps reach `max_iterations` without meeting the

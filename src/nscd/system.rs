@@ -75,18 +75,8 @@ impl NscdParams {
         if self.gravity.iter().any(|g| !g.is_finite()) {
             return bad("simulation.gravity", self.gravity[0] + self.gravity[1]);
         }
-        if !n.solver.available() {
-            return Err(crate::Error::Scene(format!(
-                "nscd.solver: '{}' needs the crate's `faer` feature, which this build was made without",
-                n.solver.name()
-            )));
-        }
-        if n.solver != super::nlgs::Solver::Nlgs && n.policy.over_sweeps() {
-            return Err(crate::Error::Scene(format!(
-                "nscd.solver: '{}' stops on a residual (strict, quad, quad_max), not on the {} criterion",
-                n.solver.name(),
-                n.policy.name()
-            )));
+        if let Some(why) = n.solver.refusal(n.policy) {
+            return Err(crate::Error::Scene(why));
         }
         Ok(())
     }

@@ -322,18 +322,8 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
         Solver::from_name,
         "'nlgs', 'apgd' or 'interior_point'",
     )?;
-    if solver != Solver::Nlgs && policy.over_sweeps() {
-        return err(format!(
-            "nscd.solver: '{}' stops on a residual (strict, quad, quad_max), not on the {} criterion",
-            solver.name(),
-            policy.name()
-        ));
-    }
-    if !solver.available() {
-        return err(format!(
-            "nscd.solver: '{}' needs the crate's `faer` feature, which this build was made without",
-            solver.name()
-        ));
+    if let Some(why) = solver.refusal(policy) {
+        return err(why);
     }
     let on_stall = named(
         "nscd.on_stall",
