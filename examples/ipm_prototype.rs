@@ -5,6 +5,10 @@
 //!
 //! `cargo run --release --features faer --example ipm_prototype -- SCENE STEPS EVERY [TOL]`
 //!
+//! The library's solver `[nscd] solver = "interior_point"` (`src/nscd/interior/`) is
+//! this method's default variant (Mehrotra, the neighbourhood, the re-centring) with NLGS
+//! sweeps before and after it; this prototype keeps the variants measured beside it.
+//!
 //! The scene runs with its own settings (one thread); every `EVERY` steps up to `STEPS`
 //! a copy makes the step with the scene's solver (warm-started: the time to beat) and
 //! another with NLGS `quad` TOL (default 1e-6, cap 20 000, warm; the reference of the
