@@ -244,15 +244,25 @@ fn apply(u: &mut [f64; 3], im: &[f64; 3], hn: &[f64; 3], dn: f64, ht: &[f64; 3],
 
 /// Adds `M⁻¹ H P` of every row to `u` (the warm start).
 pub fn apply_impulses(u: &mut [[f64; 3]], inv_m: &[[f64; 3]], rows: &[ContactRow], springs: &[SpringRow]) {
+    add_impulses(u, inv_m, rows, springs, 1.0);
+}
+
+/// Subtracts `M⁻¹ H P` of every row from `u`: the free velocity of a consistent pair.
+pub fn remove_impulses(u: &mut [[f64; 3]], inv_m: &[[f64; 3]], rows: &[ContactRow], springs: &[SpringRow]) {
+    add_impulses(u, inv_m, rows, springs, -1.0);
+}
+
+/// Adds `sign · M⁻¹ H P` of every row to `u`.
+fn add_impulses(u: &mut [[f64; 3]], inv_m: &[[f64; 3]], rows: &[ContactRow], springs: &[SpringRow], sign: f64) {
     for s in springs {
-        apply(&mut u[s.a as usize], &inv_m[s.a as usize], &s.hn_a, s.p, &[0.0; 3], 0.0, 1.0);
+        apply(&mut u[s.a as usize], &inv_m[s.a as usize], &s.hn_a, s.p, &[0.0; 3], 0.0, sign);
         if s.b != u32::MAX {
-            apply(&mut u[s.b as usize], &inv_m[s.b as usize], &s.hn_b, s.p, &[0.0; 3], 0.0, -1.0);
+            apply(&mut u[s.b as usize], &inv_m[s.b as usize], &s.hn_b, s.p, &[0.0; 3], 0.0, -sign);
         }
     }
     for r in rows {
-        apply(&mut u[r.a as usize], &inv_m[r.a as usize], &r.hn_a, r.p[0], &r.ht_a, r.p[1], 1.0);
-        apply(&mut u[r.b as usize], &inv_m[r.b as usize], &r.hn_b, r.p[0], &r.ht_b, r.p[1], -1.0);
+        apply(&mut u[r.a as usize], &inv_m[r.a as usize], &r.hn_a, r.p[0], &r.ht_a, r.p[1], sign);
+        apply(&mut u[r.b as usize], &inv_m[r.b as usize], &r.hn_b, r.p[0], &r.ht_b, r.p[1], -sign);
     }
 }
 

@@ -268,13 +268,7 @@ impl System {
         let mut springs = self.ws.spring_rows.clone();
         // u_free = u_f − M⁻¹ Σ H P.
         let mut u = self.bodies.u.clone();
-        for r in rows.iter_mut() {
-            r.p = [-r.p[0], -r.p[1]];
-        }
-        for s in springs.iter_mut() {
-            s.p = -s.p;
-        }
-        super::nlgs::apply_impulses(&mut u, &self.bodies.inv_m, &rows, &springs);
+        super::nlgs::remove_impulses(&mut u, &self.bodies.inv_m, &rows, &springs);
         rows.iter_mut().for_each(|r| r.p = [0.0; 2]);
         springs.iter_mut().for_each(|s| s.p = 0.0);
         super::nlgs::NlgsProblem { u, inv_m: self.bodies.inv_m.clone(), rows, springs }

@@ -52,7 +52,7 @@ pub mod lu;
 
 use super::contact::{dot3, ContactRow};
 use super::criterion::evaluate;
-use super::nlgs::{check, solve_nlgs, NlgsReport, NlgsSettings};
+use super::nlgs::{apply_impulses, check, remove_impulses, solve_nlgs, NlgsReport, NlgsSettings};
 use super::sublayer::SpringRow;
 use lu::{local, NewtonMatrix};
 
@@ -142,16 +142,15 @@ fn gather(v: &[[f64; 3]], a: u32, b: u32, ha: &[f64; 3], hb: &[f64; 3]) -> f64 {
     x
 }
 
-/// Adds the generalised force of `p` along a row (`h_a p` on `a`, `−h_b p` on `b`),
-/// scaled per component by `scale` if given (`M⁻¹`: a velocity change).
+/// Adds the generalised force of `p` along a row (`h_a p` on `a`, `−h_b p` on `b`).
 #[inline(always)]
-fn add(out: &mut [[f64; 3]], scale: Option<&[[f64; 3]]>, a: u32, b: u32, ha: &[f64; 3], hb: &[f64; 3], p: f64) {
+fn add(out: &mut [[f64; 3]], a: u32, b: u32, ha: &[f64; 3], hb: &[f64; 3], p: f64) {
     for d in 0..3 {
-        out[a as usize][d] += scale.map_or(1.0, |s| s[a as usize][d]) * ha[d] * p;
+        out[a as usize][d] += ha[d] * p;
     }
     if b != u32::MAX {
         for d in 0..3 {
-            out[b as usize][d] -= scale.map_or(1.0, |s| s[b as usize][d]) * hb[d] * p;
+            out[b as usize][d] -= hb[d] * p;
         }
     }
 }
@@ -195,13 +194,7 @@ impl InteriorWorkspace {
         let nb = u.len();
         self.u_free.clear();
         self.u_free.extend_from_slice(u);
-        for s in springs {
-            add(&mut self.u_free, Some(inv_m), s.a, s.b, &s.hn_a, &s.hn_b, -s.p);
-        }
-        for r in rows {
-            add(&mut self.u_free, Some(inv_m), r.a, r.b, &r.hn_a, &r.hn_b, -r.p[0]);
-            add(&mut self.u_free, Some(inv_m), r.a, r.b, &r.ht_a, &r.ht_b, -r.p[1]);
-        }
+        remove_impulses(&mut self.u_free, inv_m, rows, springs);
         self.v.clear();
         self.v.extend_from_slice(u);
         for buf in [&mut self.fd, &mut self.fb, &mut self.dv] {
@@ -300,13 +293,13 @@ impl InteriorWorkspace {
         }
         for s in springs {
             let p = spring_impulse(s, &self.v).0;
-            add(&mut self.fd, None, s.a, s.b, &s.hn_a, &s.hn_b, -p);
+            add(&mut self.fd, s.a, s.b, &s.hn_a, &s.hn_b, -p);
         }
         for (j, &k) in self.active.iter().enumerate() {
             let r = &rows[k as usize];
             let z = &self.z[j];
-            add(&mut self.fd, None, r.a, r.b, &r.hn_a, &r.hn_b, -z[0]);
-            add(&mut self.fd, None, r.a, r.b, &r.ht_a, &r.ht_b, -(z[1] - z[2]));
+            add(&mut self.fd, r.a, r.b, &r.hn_a, &r.hn_b, -z[0]);
+            add(&mut self.fd, r.a, r.b, &r.ht_a, &r.ht_b, -(z[1] - z[2]));
         }
     }
 
@@ -354,8 +347,8 @@ impl InteriorWorkspace {
             let q: Quad =
                 std::array::from_fn(|i| if i < nu { self.rc[j][i] / self.w[j][i] - d[i] * self.rp[j][i] } else { 0.0 });
             let x = solve_c(&d, r.mu, &q);
-            add(&mut self.fb, None, r.a, r.b, &r.hn_a, &r.hn_b, x[0]);
-            add(&mut self.fb, None, r.a, r.b, &r.ht_a, &r.ht_b, x[1] - x[2]);
+            add(&mut self.fb, r.a, r.b, &r.hn_a, &r.hn_b, x[0]);
+            add(&mut self.fb, r.a, r.b, &r.ht_a, &r.ht_b, x[1] - x[2]);
         }
         self.k.gather(&self.fb, &mut self.x);
         if !self.k.solve(&mut self.x) {
@@ -445,13 +438,7 @@ impl InteriorWorkspace {
             s.p = spring_impulse(s, &self.v).0;
         }
         u.copy_from_slice(&self.u_free);
-        for s in springs.iter() {
-            add(u, Some(inv_m), s.a, s.b, &s.hn_a, &s.hn_b, s.p);
-        }
-        for r in rows.iter() {
-            add(u, Some(inv_m), r.a, r.b, &r.hn_a, &r.hn_b, r.p[0]);
-            add(u, Some(inv_m), r.a, r.b, &r.ht_a, &r.ht_b, r.p[1]);
-        }
+        apply_impulses(u, inv_m, rows, springs);
     }
 
     /// One Mehrotra iteration from the current residuals and barrier `mu`: the step
