@@ -155,6 +155,16 @@ fn bad_settlement_tables_name_the_key() {
         ),
         (
             "law = \"shenton\"",
+            "law = \"shenton\"\nrelax_stage = 0.0",
+            "settlement.relax_stage: must be a positive fraction of the smallest body's size",
+        ),
+        (
+            "law = \"shenton\"",
+            "law = \"shenton\"\nrelax_stage = nan",
+            "settlement.relax_stage: must be a positive fraction of the smallest body's size",
+        ),
+        (
+            "law = \"shenton\"",
             "law = \"shenton\"\nextrapolation_limit = 0.0",
             "settlement.extrapolation_limit: must be a positive fraction",
         ),
@@ -343,4 +353,24 @@ fn a_body_that_leaves_the_domain_stops_the_run_naming_it() {
         serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap()).unwrap();
     assert_eq!(summary["end"], "diverged");
     let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn relax_stage_sets_the_stages_of_each_landing() {
+    let text = std::fs::read_to_string(SCENE).unwrap();
+    let with = |stage: &str| text.replace("law = \"shenton\"", &format!("law = \"shenton\"\nrelax_stage = {stage}"));
+    let (_, (_, one)) = run_text("single", &with("inf"));
+    // The example's landings move a grain by about 1e-10 m: one stage
+    // at the default, several at a stage of 1e-9 of the smallest grain's size (0.02 nm).
+    let (_, (_, default)) = run_text("default", &text);
+    let (_, (_, fine)) = run_text("fine", &with("1e-9"));
+    assert!(one.iter().chain(&default).all(|j| j.relax_stages == 1), "{one:?} {default:?}");
+    assert_eq!(one, default);
+    assert!(fine.iter().all(|j| j.relax_stages > 1 && j.relax_converged), "{fine:?}");
+    for (f, o) in fine.iter().zip(&one) {
+        // No stage starts deeper than the single relaxation's overlap (these
+        // are below the tolerance, left as they are: the stages only add the
+        // moves up in parts, and the runs part at round-off, 1e-15 m).
+        assert!(f.max_overlap_before_relax_m <= o.max_overlap_before_relax_m + 1e-12, "{f:?} {o:?}");
+    }
 }

@@ -128,7 +128,7 @@ pub enum KarrechCommand {
         #[command(flatten)]
         run: RunArgs,
         #[command(flatten)]
-        accelerate: super::saussine::AccelerateArgs,
+        accelerate: Box<super::saussine::AccelerateArgs>,
     },
 }
 

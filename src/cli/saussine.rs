@@ -351,6 +351,12 @@ pub(crate) struct AccelerateArgs {
     /// is always rolled back when its relaxation fails or a cycle after it fails).
     #[arg(long, value_name = "FACTOR", requires = "accelerate")]
     rollback_rate: Option<f64>,
+    /// Land each jump in stages, each moving a point of a body by at most this
+    /// fraction of the smallest grain's size and relaxed before the next (a
+    /// relaxation from deep overlaps can push a grain through a sublayer pad);
+    /// default 0.25; inf: one relaxation of the extrapolated configuration (the paper's).
+    #[arg(long, value_name = "FRACTION", requires = "accelerate")]
+    relax_stage: Option<f64>,
     /// A full run of the same sample and loading (its output folder, e.g. from
     /// `--accelerate K_I,N+1,1`, which never jumps, or a plain settle): errors.csv
     /// (settlement, accrued error after K_I, coordination) and its curve on the figure.
@@ -376,6 +382,7 @@ impl AccelerateArgs {
             settle_cycles: self.settle_cycles,
             settle_rate: self.settle_rate,
             rollback_rate: self.rollback_rate,
+            relax_stage: self.relax_stage,
             reference: self.reference.clone(),
         }))
     }

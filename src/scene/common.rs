@@ -303,6 +303,12 @@ pub struct SettlementSection {
     /// default: none (landings judged by the engine's failures and the domain).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rollback_rate: Option<f64>,
+    /// The largest move of a point of a body in one stage of a landing, as a
+    /// fraction of the smallest body's size (> 0; `inf`: one relaxation of the
+    /// extrapolated configuration, the paper's); default 0.25
+    /// ([`crate::settlement::sweep`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relax_stage: Option<f64>,
 }
 
 /// `settlement.relax_tolerance`: a length (m) or a word (`"computed"`).
@@ -379,6 +385,9 @@ pub(crate) fn check_settlement(
     }
     spec.settle_rate = s.settle_rate;
     spec.rollback_rate = s.rollback_rate;
+    if let Some(f) = s.relax_stage {
+        spec.relax_stage = f;
+    }
     spec.relax.method = match s.relax_method.as_deref() {
         None | Some("lbfgs") => Method::Lbfgs,
         Some("gradient_descent") => Method::GradientDescent,
@@ -440,6 +449,7 @@ pub(crate) fn write_settlement(out: &mut String, s: Option<&SettlementSection>) 
     opt(out, "settle_cycles", s.settle_cycles, |n| n.to_string());
     opt(out, "settle_rate", s.settle_rate, float);
     opt(out, "rollback_rate", s.rollback_rate, float);
+    opt(out, "relax_stage", s.relax_stage, float);
 }
 
 /// A scene of either engine as a run records it (`scene.toml`): the text it was

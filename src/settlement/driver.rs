@@ -47,6 +47,7 @@ use super::estimate::{chernoff_cycles, extrapolate_within, fit, trend_moves, Tra
 use super::law::{Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
 use super::relax::{RelaxReport, RelaxSettings};
 use super::smooth::Smoothing;
+use super::sweep;
 use crate::clock::cycles_at;
 use crate::error::{Error, Result};
 use crate::io::checkpoint::{check_origin, crc32, read_checked, write_checked, CHECKPOINT_FILE};
@@ -200,6 +201,16 @@ pub struct Acceleration {
     /// failures and the domain only.
     #[serde(default)]
     pub rollback_rate: Option<f64>,
+    /// The largest move of a point of a body in one stage of a landing, as a
+    /// fraction of the smallest body's size ([`sweep`]), > 0; default
+    /// [`sweep::RELAX_STAGE`]; infinite: one relaxation of the extrapolated
+    /// configuration (the paper's).
+    #[serde(default = "default_relax_stage")]
+    pub relax_stage: f64,
+}
+
+fn default_relax_stage() -> f64 {
+    sweep::RELAX_STAGE
 }
 
 fn default_settle_cycles() -> u64 {
@@ -235,6 +246,7 @@ impl Acceleration {
             settle_cycles: 1,
             settle_rate: None,
             rollback_rate: None,
+            relax_stage: sweep::RELAX_STAGE,
         }
     }
 
@@ -273,6 +285,12 @@ impl Acceleration {
         }
         if let Some(f) = self.rollback_rate.filter(|f| !(*f > 0.0 && f.is_finite())) {
             return bad(format!("rollback_rate: must be a positive factor on the predicted rate, got {f}"));
+        }
+        if self.relax_stage.is_nan() || self.relax_stage <= 0.0 {
+            return bad(format!(
+                "relax_stage: must be a positive fraction of the smallest body's size (inf: one stage), got {}",
+                self.relax_stage
+            ));
         }
         if let Some(l) = self.smoothing_length.filter(|l| !(*l > 0.0 && l.is_finite())) {
             return bad(format!("smoothing_length: must be a positive length (m), got {l}"));
@@ -715,6 +733,7 @@ impl<E: Engine> Accelerated<E> {
             landing_rate_m: landing_rate,
             rolled_back: false,
             rollback_reason: String::new(),
+            relax_stages: 1,
         };
         if let Err(e) =
             check_domain(&st.sys, &st.origin, &target, || format!("the extrapolation of jump {}", st.jumps + 1))
@@ -730,8 +749,12 @@ impl<E: Engine> Accelerated<E> {
                 st.boundary_origin[j] + law.extrapolate(&c, n_last, series[series.len() - 1], h as f64)
             })
             .collect();
-        st.sys.set_boundaries(&boundaries)?;
-        st.sys.set_configuration(&target)?;
+        // The landing, in stages (`sweep`): from the computed configuration the
+        // window ends on (the system's) to the extrapolated one.
+        let from = window.configurations.last().expect("a fitted window has points").clone();
+        let stages = sweep::stages(&from, &target, &st.sys.body_sizes(bodies), E::DIM, self.spec.relax_stage);
+        row.relax_stages = stages;
+        let boundaries_from = coordinates(&st.sys.boundaries());
         let t0 = Instant::now();
         let mut relax = self.spec.relax.clone();
         if self.spec.relax_to_computed {
@@ -742,10 +765,11 @@ impl<E: Engine> Accelerated<E> {
             relax.tolerance = st.computed_overlap.max(floor);
         }
         row.relax_tolerance_m = relax.tolerance;
-        let report: RelaxReport = match st.sys.relax(&relax) {
-            Ok(r) => r,
-            Err(e) => return Ok(Landing::Failed(row, format!("its relaxation failed: {e}"))),
-        };
+        let report: RelaxReport =
+            match sweep::relax_along(&mut st.sys, &from, &target, (&boundaries_from, &boundaries), &relax, stages) {
+                Ok(r) => r,
+                Err(e) => return Ok(Landing::Failed(row, format!("its relaxation failed: {e}"))),
+            };
         row.relax_iterations = report.iterations;
         row.relax_evaluations = report.evaluations;
         row.relax_converged = report.converged;

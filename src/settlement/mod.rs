@@ -26,6 +26,7 @@ pub mod file;
 pub mod law;
 pub mod relax;
 pub mod smooth;
+pub mod sweep;
 
 pub use driver::{
     Accelerated, Acceleration, AccelerationOutcome, AccelerationProgress, AccelerationSummary, Adaptive, JumpRow, Law,

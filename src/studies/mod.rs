@@ -128,6 +128,9 @@ pub struct Accelerate {
     pub settle_rate: Option<f64>,
     /// `rollback_rate` of the accelerated runs ([`crate::settlement::Acceleration::rollback_rate`]).
     pub rollback_rate: Option<f64>,
+    /// `relax_stage` of the accelerated runs ([`crate::settlement::Acceleration::relax_stage`]);
+    /// `None`: [`crate::settlement::sweep::RELAX_STAGE`].
+    pub relax_stage: Option<f64>,
     /// A full run of the same loaded sample (its folder) to measure the errors
     /// against: `errors.csv` and its curve on the settlement figure.
     pub reference: Option<PathBuf>,
@@ -159,6 +162,7 @@ impl Accelerate {
             settle_cycles: self.settle_cycles,
             settle_rate: self.settle_rate,
             rollback_rate: self.rollback_rate,
+            relax_stage: self.relax_stage,
             ..Default::default()
         }
     }

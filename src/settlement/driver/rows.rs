@@ -67,11 +67,13 @@ pub struct JumpRow {
     pub relax_evaluations: u64,
     /// Whether it reached the tolerance.
     pub relax_converged: bool,
-    /// Largest overlap before (m).
+    /// Largest overlap a stage of the relaxation started from (m; with one
+    /// stage, the extrapolated configuration's).
     pub max_overlap_before_relax_m: f64,
     /// Largest overlap after (m).
     pub max_overlap_after_relax_m: f64,
-    /// Largest move of a coordinate in the relaxation (m or rad).
+    /// Largest distance of a coordinate from the extrapolated configuration
+    /// after the relaxation (m or rad).
     pub relax_largest_move: f64,
     /// Wall time of the relaxation (s).
     pub relax_wall_time_s: f64,
@@ -97,6 +99,14 @@ pub struct JumpRow {
     /// Why it was rolled back (empty for a jump that stands).
     #[serde(default)]
     pub rollback_reason: String,
+    /// Stages of the landing ([`crate::settlement::sweep`]): 1 for the paper's
+    /// single relaxation (and in files written before the stages).
+    #[serde(default = "one")]
+    pub relax_stages: u64,
+}
+
+fn one() -> u64 {
+    1
 }
 
 impl JumpRow {
@@ -125,6 +135,7 @@ impl JumpRow {
         "landing_rate_m",
         "rolled_back",
         "rollback_reason",
+        "relax_stages",
     ];
 }
 
