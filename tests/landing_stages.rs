@@ -129,3 +129,28 @@ fn one_stage_is_the_single_relaxation_and_the_count_follows_the_moves() {
     assert_eq!(a.bodies.q, b.bodies.q);
     assert_eq!((ra.iterations, ra.max_overlap_after), (rb.iterations, rb.max_overlap_after));
 }
+
+#[test]
+fn a_step_with_a_pad_at_its_anchor_fails_naming_the_pad() {
+    // The single relaxation of the whole sample left pad20 0.4 mm past its
+    // spring's anchor; its spring, a distance, would then push it on to its
+    // mirror position. A step now refuses a spring shorter than a tenth of its
+    // rest length, naming the body (a landing that does this is rolled back).
+    let (mut sys, _) = landing();
+    let pad = index(&sys, "pad20");
+    let anchor = sys.springs.iter().find(|s| s.a == pad).unwrap().point_b[1];
+    let mut c = sys.configuration();
+    let k = c.bodies.iter().position(|&b| b == pad).unwrap();
+    c.body_mut(k)[1] = anchor - 0.0004;
+    sys.set_configuration(&c).unwrap();
+    match sys.step() {
+        Err(ballast::Error::Diverged { body, name, what, .. }) => {
+            assert_eq!((body, name.as_str()), (pad, "pad20"));
+            assert!(what.contains("crushed"), "{what}");
+        }
+        other => panic!("expected a crushed spring, got {other:?}"),
+    }
+    // Upright, the same pads step on (the computed configuration).
+    let (mut sys, _) = landing();
+    sys.step().unwrap();
+}

@@ -212,6 +212,9 @@ impl System {
         if let Some(i) = (0..n).find(|&i| self.bodies.q[i].iter().chain(&self.bodies.u[i]).any(|x| !x.is_finite())) {
             failure = Some((i, "non-finite position or velocity".to_string()));
         }
+        if failure.is_none() {
+            failure = crate::plane::springs::crushed(&self.springs, &self.bodies.q);
+        }
         // Scenes place bodies within ±MAX_LENGTH (the detection grid and the
         // restart scene, `final_scene.toml`, rely on it): a body carried beyond
         // has run away.

@@ -57,6 +57,30 @@ pub struct Spring {
     pub impulse: f64,
 }
 
+/// The shortest length a spring may take, as a fraction of its rest length: a
+/// spring's length is a distance, so law (17) turns over where it passes
+/// through zero (a pad pushed past its anchor is then pushed on, to its mirror
+/// position beyond it: docs/settlement-driver.md, "Landings in stages"). A
+/// spring shorter than this is crushed, and the step fails.
+pub const CRUSHED: f64 = 0.1;
+
+/// The first spring of `springs` shorter than [`CRUSHED`] times its rest length
+/// in configuration `q`: the body at its first end and what happened.
+pub fn crushed(springs: &[Spring], q: &[[f64; 3]]) -> Option<(usize, String)> {
+    springs.iter().enumerate().find_map(|(k, s)| {
+        let l = s.length(q);
+        (l < CRUSHED * s.rest_length).then(|| {
+            (
+                s.a,
+                format!(
+                    "spring {k} crushed to {l:.3e} m of its {:.3e} m rest length (below {CRUSHED} of it law (17) turns over)",
+                    s.rest_length
+                ),
+            )
+        })
+    })
+}
+
 /// Placement of an attachment point: world point and lever arm.
 #[inline]
 fn attach(q: &[f64; 3], p: [f64; 2]) -> (Vec2, Vec2) {

@@ -394,12 +394,16 @@ impl PlanarSystem {
         }
     }
 
-    /// A non-finite coordinate or velocity stops the step, naming the body.
+    /// A non-finite coordinate or velocity, or a crushed spring
+    /// ([`crate::plane::springs::crushed`]), stops the step, naming the body.
     fn check(&self) -> Result<()> {
         for (i, (q, u)) in self.bodies.q.iter().zip(&self.bodies.u).enumerate() {
             if q.iter().chain(u).any(|v| !v.is_finite()) {
                 return Err(self.diverged(i, "non-finite position or velocity".into()));
             }
+        }
+        if let Some((body, what)) = crate::plane::springs::crushed(&self.springs, &self.bodies.q) {
+            return Err(self.diverged(body, what));
         }
         Ok(())
     }
