@@ -73,7 +73,8 @@ pub fn crushed(springs: &[Spring], q: &[[f64; 3]]) -> Option<(usize, String)> {
             (
                 s.a,
                 format!(
-                    "spring {k} crushed to {l:.3e} m of its {:.3e} m rest length (below {CRUSHED} of it law (17) turns over)",
+                    "spring {k} crushed to {l:.3e} m, below {CRUSHED} of its {:.3e} m rest length (law (17) turns over \
+                     at zero length)",
                     s.rest_length
                 ),
             )
