@@ -16,6 +16,7 @@
 //! leaves the grain on the pads and both springs upright. The full sample's
 //! run shows the same two outcomes (BENCHMARKS.md, "Landings in stages").
 
+use ballast::nscd::measure::world_polygon;
 use ballast::nscd::System;
 use ballast::run::{Configuration, Engine};
 use ballast::scene::Scene;
@@ -23,8 +24,6 @@ use ballast::settlement::{sweep, RelaxSettings};
 
 /// The relaxation tolerance of the full run: 1 % of the smallest grain's inradius (m).
 const TOLERANCE: f64 = 4.045084971874737e-5;
-/// Half the pads' thickness (m).
-const PAD_HALF_HEIGHT: f64 = 0.005;
 
 fn system(file: &str) -> System {
     Scene::load(format!("{}/tests/data/{file}", env!("CARGO_MANIFEST_DIR"))).unwrap().build().unwrap()
@@ -49,15 +48,12 @@ fn heights_above_anchors(sys: &System) -> Vec<(String, f64)> {
 
 /// The lowest point of the grain g102 and the pads' lowest top and lowest bottom (m).
 fn grain_and_pads(sys: &System) -> (f64, f64, f64) {
-    let g = index(sys, "g102");
-    let (y, theta) = (sys.bodies.q[g][1], sys.bodies.q[g][2]);
-    // g102 is a regular pentagon of circumradius 5 mm, first vertex at `theta`.
-    let lowest = (0..5)
-        .map(|k| y + 0.005 * (theta + std::f64::consts::TAU * k as f64 / 5.0).sin())
-        .fold(f64::INFINITY, f64::min);
-    let pads = ["pad19", "pad20"].map(|p| sys.bodies.q[index(sys, p)][1]);
-    let top = pads.iter().fold(f64::INFINITY, |a, &b| a.min(b)) + PAD_HALF_HEIGHT;
-    let bottom = top - 2.0 * PAD_HALF_HEIGHT;
+    let ys = |name: &str| world_polygon(sys, index(sys, name)).into_iter().map(|v| v[1]);
+    let lowest = ys("g102").fold(f64::INFINITY, f64::min);
+    let pads =
+        ["pad19", "pad20"].map(|p| (ys(p).fold(f64::NEG_INFINITY, f64::max), ys(p).fold(f64::INFINITY, f64::min)));
+    let top = pads.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
+    let bottom = pads.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
     (lowest, top, bottom)
 }
 
