@@ -92,7 +92,7 @@ pub fn relax_along<E: Engine>(
     let mut at = from.clone();
     let mut total: Option<RelaxReport> = None;
     for k in 1..=m {
-        if k == m && m == 1 {
+        if m == 1 {
             at.q.copy_from_slice(&to.q);
         } else {
             at.q.iter_mut().zip(from.q.iter().zip(&to.q)).for_each(|(q, (a, b))| *q += (b - a) / m as f64);
