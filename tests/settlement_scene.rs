@@ -194,6 +194,11 @@ fn bad_settlement_tables_name_the_key() {
             "settlement.settle_rate: must be a positive factor on the predicted rate, got 0",
         ),
         ("law = \"shenton\"", "law = \"shenton\"\nspeed = 2", "unknown field `speed`"),
+        (
+            "law = \"shenton\"",
+            "law = \"shenton\"\nhold_anchored = \"pads\"",
+            "expected a boolean (at `hold_anchored = \"pads\"`)",
+        ),
         ("initial_cycles = 2", "initial_cycles = 0", "settlement.initial_cycles: Shenton's law needs at least 1"),
         (
             "cycles = { frequency = 20.0, body = \"sleeper\" }",
@@ -373,4 +378,51 @@ fn relax_stage_sets_the_stages_of_each_landing() {
         // moves up in parts, and the runs part at round-off, 1e-15 m).
         assert!(f.max_overlap_before_relax_m <= o.max_overlap_before_relax_m + 1e-12, "{f:?} {o:?}");
     }
+}
+
+#[test]
+fn hold_anchored_keeps_the_sprung_bodies_where_the_computed_cycle_left_them() {
+    // The example with two bottom grains on springs to anchors under the floor
+    // (at rest length: no force at the start), every cycle's positions written.
+    let text = std::fs::read_to_string(SCENE)
+        .unwrap()
+        .replace("body = \"sleeper\" }", "body = \"sleeper\", positions = true }")
+        + "\n[[spring]]\nbody = \"grain1\"\nanchor = [-0.05906, 0.00477]\nk_n = 1000.0\nnu = 1.0\nrest_length = 0.02\n\
+           \n[[spring]]\nbody = \"grain3\"\nanchor = [0.05906, 0.00477]\nk_n = 1000.0\nnu = 1.0\nrest_length = 0.02\n";
+    let with = |hold: &str| text.replace("law = \"shenton\"", &format!("law = \"shenton\"\nhold_anchored = {hold}"));
+    let positions = |name: &str, t: &str| {
+        let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
+        let dir = out_dir(name);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("scene.toml"), t).unwrap();
+        run_file(&dir.join("scene.toml"), &dir.join("out"), &opts, &mut |_| {}).unwrap().unwrap();
+        let p = ballast::io::positions::read(&dir.join("out")).unwrap();
+        let jumps = tables(&dir.join("out")).1;
+        let _ = std::fs::remove_dir_all(dir);
+        (p, jumps)
+    };
+    // The sprung grains' coordinates at the end of cycle `c` (cycles[0] ends cycle 1).
+    let sprung = |p: &ballast::io::positions::CyclePositions, c: u64| -> Vec<f64> {
+        ["grain1", "grain3"]
+            .iter()
+            .flat_map(|n| {
+                let k = p.names.iter().position(|m| m == n).unwrap();
+                p.cycles[c as usize - 1].body(k).to_vec()
+            })
+            .collect()
+    };
+    let (held, held_jumps) = positions("hold-held", &with("true"));
+    let (free, free_jumps) = positions("hold-free", &with("false"));
+    assert_eq!((held_jumps.len(), free_jumps.len()), (3, 3));
+    for j in &held_jumps {
+        // Both counted as held, and landed exactly where the window ended.
+        assert!(j.held_bodies >= 2, "{j:?}");
+        assert_eq!(sprung(&held, j.to_cycle), sprung(&held, j.from_cycle), "jump {}", j.jump);
+    }
+    // Free, their fits move them (by about 1e-10 m in this example): the hold
+    // is what keeps them.
+    assert!(free_jumps.iter().any(|j| sprung(&free, j.to_cycle) != sprung(&free, j.from_cycle)));
+    // `false` is the default.
+    let (_, default_jumps) = positions("hold-default", &text);
+    assert_eq!(default_jumps, free_jumps);
 }

@@ -357,6 +357,11 @@ pub(crate) struct AccelerateArgs {
     /// default 0.25; inf: one relaxation of the extrapolated configuration (the paper's).
     #[arg(long, value_name = "FRACTION", requires = "accelerate")]
     relax_stage: Option<f64>,
+    /// Hold the sublayer pads (the bodies tied to an anchor by a spring) at their
+    /// computed positions through each landing: neither extrapolated nor moved by
+    /// the relaxation (default: every body on its own fit, the paper's).
+    #[arg(long, requires = "accelerate")]
+    hold_anchored: bool,
     /// A full run of the same sample and loading (its output folder, e.g. from
     /// `--accelerate K_I,N+1,1`, which never jumps, or a plain settle): errors.csv
     /// (settlement, accrued error after K_I, coordination) and its curve on the figure.
@@ -383,6 +388,7 @@ impl AccelerateArgs {
             settle_rate: self.settle_rate,
             rollback_rate: self.rollback_rate,
             relax_stage: self.relax_stage,
+            hold_anchored: self.hold_anchored,
             reference: self.reference.clone(),
         }))
     }

@@ -183,6 +183,10 @@ impl Engine for System {
         bodies.iter().map(|&i| count[i]).collect()
     }
 
+    fn anchored_bodies(&self) -> Vec<usize> {
+        crate::plane::springs::anchored(&self.springs)
+    }
+
     fn set_configuration(&mut self, c: &Configuration) -> Result<()> {
         System::set_configuration(self, c)
     }

@@ -82,6 +82,16 @@ pub fn crushed(springs: &[Spring], q: &[[f64; 3]]) -> Option<(usize, String)> {
     })
 }
 
+/// The bodies tied to a fixed anchor by a spring (the sublayer pads), sorted,
+/// each once: their positions follow the springs' load, not a trend of their
+/// own ([`crate::run::Engine::anchored_bodies`]).
+pub fn anchored(springs: &[Spring]) -> Vec<usize> {
+    let mut bodies: Vec<usize> = springs.iter().filter(|s| s.b.is_none()).map(|s| s.a).collect();
+    bodies.sort_unstable();
+    bodies.dedup();
+    bodies
+}
+
 /// Placement of an attachment point: world point and lever arm.
 #[inline]
 fn attach(q: &[f64; 3], p: [f64; 2]) -> (Vec2, Vec2) {

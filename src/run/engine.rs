@@ -245,6 +245,15 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// over the pair's contact points; MD a touching pair, image or wall).
     fn contact_counts(&self, bodies: &[usize]) -> Vec<usize>;
 
+    /// The bodies tied to a fixed anchor by a spring (NSCD and planar MD:
+    /// the sublayer pads of law (17) of Saussine et al. 2006), engine indices,
+    /// sorted; none by default (3D MD). A settlement driver may hold them at
+    /// their computed positions through a landing
+    /// ([`crate::settlement::Acceleration::hold_anchored`]).
+    fn anchored_bodies(&self) -> Vec<usize> {
+        Vec::new()
+    }
+
     /// The generalised positions of every mobile body.
     fn configuration(&self) -> Configuration {
         self.configuration_of(&self.mobile_bodies())

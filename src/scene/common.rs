@@ -309,6 +309,10 @@ pub struct SettlementSection {
     /// ([`crate::settlement::sweep`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub relax_stage: Option<f64>,
+    /// Hold the bodies tied to a fixed anchor by a spring (the sublayer pads) at
+    /// their computed positions through each landing; default `false`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hold_anchored: Option<bool>,
 }
 
 /// `settlement.relax_tolerance`: a length (m) or a word (`"computed"`).
@@ -388,6 +392,7 @@ pub(crate) fn check_settlement(
     if let Some(f) = s.relax_stage {
         spec.relax_stage = f;
     }
+    spec.hold_anchored = s.hold_anchored.unwrap_or(false);
     spec.relax.method = match s.relax_method.as_deref() {
         None | Some("lbfgs") => Method::Lbfgs,
         Some("gradient_descent") => Method::GradientDescent,
@@ -450,6 +455,7 @@ pub(crate) fn write_settlement(out: &mut String, s: Option<&SettlementSection>) 
     opt(out, "settle_rate", s.settle_rate, float);
     opt(out, "rollback_rate", s.rollback_rate, float);
     opt(out, "relax_stage", s.relax_stage, float);
+    opt(out, "hold_anchored", s.hold_anchored, |b| b.to_string());
 }
 
 /// A scene of either engine as a run records it (`scene.toml`): the text it was

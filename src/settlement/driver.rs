@@ -207,6 +207,16 @@ pub struct Acceleration {
     /// configuration (the paper's).
     #[serde(default = "default_relax_stage")]
     pub relax_stage: f64,
+    /// Hold the bodies tied to a fixed anchor by a spring
+    /// ([`Engine::anchored_bodies`]: the sublayer pads) at their computed
+    /// positions through each landing: not extrapolated, not moved by the
+    /// relaxation. Default `false` (every body on its own fit, the paper's). A
+    /// pad carries a share of a load whose mean does not change from cycle to
+    /// cycle, so its residual trend is noise; the relaxation leaves the springs
+    /// out, and a pad it pushes down loads its spring (docs/settlement-driver.md,
+    /// "Held pads").
+    #[serde(default)]
+    pub hold_anchored: bool,
 }
 
 fn default_relax_stage() -> f64 {
@@ -247,6 +257,7 @@ impl Acceleration {
             settle_rate: None,
             rollback_rate: None,
             relax_stage: sweep::RELAX_STAGE,
+            hold_anchored: false,
         }
     }
 
@@ -684,14 +695,19 @@ impl<E: Engine> Accelerated<E> {
         let contacts = st.sys.contact_counts(bodies);
         let mut moves = trend_moves(law, &window, &f, h as f64);
         let coherent = MEDIAN_MOVES * median(&mut moves);
-        let max_move: Vec<f64> = (st.sys.body_sizes(bodies).iter().zip(&contacts))
-            .map(|(size, &n)| if n == 0 { 0.0 } else { (self.spec.extrapolation_limit * size).max(coherent) })
+        // With `hold_anchored`, the sprung pads stay where the computed cycle
+        // left them, through the extrapolation and the relaxation alike.
+        let anchored = if self.spec.hold_anchored { st.sys.anchored_bodies() } else { Vec::new() };
+        let pinned: Vec<bool> =
+            (bodies.iter().zip(&contacts)).map(|(b, &n)| n == 0 || anchored.binary_search(b).is_ok()).collect();
+        let max_move: Vec<f64> = (st.sys.body_sizes(bodies).iter().zip(&pinned))
+            .map(|(size, &pin)| if pin { 0.0 } else { (self.spec.extrapolation_limit * size).max(coherent) })
             .collect();
-        let held = contacts.iter().filter(|&&n| n == 0).count() as u64;
+        let held = pinned.iter().filter(|&&pin| pin).count() as u64;
         let smoothing = self.spec.smoothing_length.map(|length| {
             let last = window.configurations.last().expect("a fitted window has points");
             let excluded: Vec<bool> =
-                (bodies.iter().zip(&contacts)).map(|(&b, &n)| n == 0 || Some(b) == self.spec.settlement_body).collect();
+                (bodies.iter().zip(&pinned)).map(|(&b, &pin)| pin || Some(b) == self.spec.settlement_body).collect();
             Smoothing::new(last, E::DIM, length, &excluded)
         });
         for j in 1..h {
@@ -757,6 +773,11 @@ impl<E: Engine> Accelerated<E> {
         let boundaries_from = coordinates(&st.sys.boundaries());
         let t0 = Instant::now();
         let mut relax = self.spec.relax.clone();
+        for &b in &anchored {
+            if !relax.held.contains(&b) {
+                relax.held.push(b);
+            }
+        }
         if self.spec.relax_to_computed {
             // A floor for a configuration without contacts: a millionth of the
             // smallest body (any overlap a jump makes there is spurious).

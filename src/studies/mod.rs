@@ -131,6 +131,8 @@ pub struct Accelerate {
     /// `relax_stage` of the accelerated runs ([`crate::settlement::Acceleration::relax_stage`]);
     /// `None`: [`crate::settlement::sweep::RELAX_STAGE`].
     pub relax_stage: Option<f64>,
+    /// `hold_anchored` of the accelerated runs ([`crate::settlement::Acceleration::hold_anchored`]).
+    pub hold_anchored: bool,
     /// A full run of the same loaded sample (its folder) to measure the errors
     /// against: `errors.csv` and its curve on the settlement figure.
     pub reference: Option<PathBuf>,
@@ -163,6 +165,7 @@ impl Accelerate {
             settle_rate: self.settle_rate,
             rollback_rate: self.rollback_rate,
             relax_stage: self.relax_stage,
+            hold_anchored: self.hold_anchored.then_some(true),
             ..Default::default()
         }
     }

@@ -182,6 +182,10 @@ impl Engine for PlanarSystem {
         bodies.iter().map(|&i| count[i]).collect()
     }
 
+    fn anchored_bodies(&self) -> Vec<usize> {
+        crate::plane::springs::anchored(&self.springs)
+    }
+
     fn set_configuration(&mut self, c: &Configuration) -> Result<()> {
         PlanarSystem::set_configuration(self, c)
     }

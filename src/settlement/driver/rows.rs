@@ -78,7 +78,8 @@ pub struct JumpRow {
     /// Wall time of the relaxation (s).
     pub relax_wall_time_s: f64,
     /// Bodies held where they were (no force-carrying contact at the window's
-    /// end: in flight, or loose in their cage).
+    /// end: in flight, or loose in their cage; with `hold_anchored`, the
+    /// bodies on springs to an anchor too).
     #[serde(default)]
     pub held_bodies: u64,
     /// Bodies moved less than their trend by `extrapolation_limit` (held ones
