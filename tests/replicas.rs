@@ -206,6 +206,28 @@ fn settle_replicas_ensemble_is_that_of_the_replicas() {
     for stem in ["settlement_ensemble.png", "settlement_ensemble.svg"] {
         assert!(std::fs::metadata(out.join(stem)).unwrap().len() > 1000);
     }
+    // One replica alone (`--replica R`, the same perturbation): the same start
+    // and the same run as replica R of the ensemble, bit for bit; accelerated,
+    // the same start.
+    let alone = dir.join("alone");
+    let alone_s = alone.to_str().unwrap();
+    let one = [&["saussine", "settle", "--sample", &sample, "--out", alone_s, "--replica", "2"][..], &SHORT].concat();
+    run(&[&one[..], &["--perturb-seed", "5", "--snapshot-every", "0"]].concat());
+    assert_eq!(csv(&alone.join("cycles.csv")), cycles[2]);
+    assert_eq!(positions(&Scene::load(alone.join("loaded.toml")).unwrap()), positions(&loaded(2)));
+    assert!(alone.join("replica.json").is_file());
+    let fast = dir.join("alone-accelerated");
+    let fast_s = fast.to_str().unwrap();
+    let args_fast =
+        [&["saussine", "settle", "--sample", &sample, "--out", fast_s, "--replica", "1"][..], &SHORT].concat();
+    run(&[&args_fast[..], &["--perturb-seed", "5", "--snapshot-every", "0", "--accelerate", "1,2,1"]].concat());
+    assert_eq!(positions(&Scene::load(fast.join("loaded.toml")).unwrap()), positions(&loaded(1)));
+    let both =
+        Command::new(env!("CARGO_BIN_EXE_ballast")).args([&one[..], &["--replicas", "3"]].concat()).output().unwrap();
+    assert!(!both.status.success());
+    let e = String::from_utf8_lossy(&both.stderr);
+    assert!(e.contains("--replica") && e.contains("--replicas"), "{e}");
+
     // Resumed, the finished replicas are not rerun.
     let summary = replica(2).join("summary.json");
     let before = std::fs::read(&summary).unwrap();

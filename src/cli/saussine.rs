@@ -23,7 +23,7 @@ use ballast::run::default_threads;
 use ballast::scenarios::saussine::{Guide, SampleSpec};
 use ballast::studies::campaigns::{self, ConvergenceSpec, EnsembleSpec, StepsSpec, StudyOptions};
 use ballast::studies::replicas::{
-    Perturbation, Replicas, DEFAULT_PERTURBATION_M, DEFAULT_PERTURB_SEED, DEFAULT_SEATING_CYCLES,
+    Perturbation, Replicas, Start, DEFAULT_PERTURBATION_M, DEFAULT_PERTURB_SEED, DEFAULT_SEATING_CYCLES,
 };
 use ballast::studies::saussine::{self, Loading, SettleOptions, SettleReplicas};
 use clap::Subcommand;
@@ -92,6 +92,11 @@ pub enum SaussineCommand {
         resume: bool,
         #[command(flatten)]
         replicas: ReplicaArgs,
+        /// Run replica R alone (one run, or one accelerated run): 0 from the sample as
+        /// it is, R ≥ 1 from the start replica R of --replicas has (every mobile body
+        /// moved by at most --perturb, stream R of --perturb-seed; `replica.json`).
+        #[arg(long, value_name = "R", default_value_t = 0, conflicts_with = "replicas")]
+        replica: u64,
         /// Replicas run at once, each on one core (default: the number of cores).
         #[arg(long)]
         jobs: Option<usize>,
@@ -466,22 +471,26 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
             checkpoint_every,
             resume,
             replicas,
+            replica,
             jobs,
             accelerate,
             quiet,
         } => {
             let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume };
             let replicas = replicas.replicas();
+            let start = Start { replica, perturbation: replicas.perturbation };
             if let Some(acc) = accelerate.accelerate()? {
                 if replicas.count > 1 {
                     return Err(input(
-                        "--accelerate with --replicas: not built yet (run the replicas one by one with --perturb-seed)"
+                        "--accelerate with --replicas: not built yet (run the replicas one by one with --replica R, \
+                         the same --perturb and --perturb-seed)"
                             .into(),
                     ));
                 }
                 let bar = super::cycle_bar(quiet);
                 let mut show = |p: &ballast::settlement::AccelerationProgress| super::show_cycles(&bar, p);
-                let s = saussine::settle_accelerated(&sample, &loading.loading()?, &acc, &out, &opts, &mut show)?;
+                let s =
+                    saussine::settle_accelerated(&sample, &loading.loading()?, &start, &acc, &out, &opts, &mut show)?;
                 bar.finish_and_clear();
                 super::print_acceleration(&s, &out);
                 if accelerate.reference.is_some() {
@@ -489,7 +498,7 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                 }
             } else if replicas.count == 1 {
                 replicas.check()?;
-                saussine::settle(&sample, &loading.loading()?, &out, &opts, &Bars::single(quiet))?;
+                saussine::settle(&sample, &loading.loading()?, &start, &out, &opts, &Bars::single(quiet))?;
             } else {
                 let bars = Bars::group(quiet);
                 let r = saussine::settle_replicas(&sample, &loading.loading()?, &out, &opts, &replicas, jobs, &bars)?;

@@ -13,7 +13,7 @@
 //!   a settlement comparison.
 
 use super::md_stage::{chart, columns, curve, final_state, spheres_of, Stage, StageOutcome, TestSpec};
-use super::replicas::{perturb_md_scene, Perturbation, REPLICA_FILE};
+use super::replicas::{perturb_md_scene, REPLICA_FILE};
 use super::RunDisplay;
 use crate::error::{Error, Result};
 use crate::scenarios::karrech::{self, KarrechSpec, Loading};
@@ -69,16 +69,9 @@ pub fn deposit(spec: &Deposit, stage: &Stage, display: &dyn RunDisplay) -> Resul
     Ok(StageOutcome { run, written: deposit_figures(&stage.out)? })
 }
 
-/// The start of a loading run: replica 0 is the deposit as it is, replica
-/// `r ≥ 1` the deposit with every sphere moved by [`perturb_md_scene`]
-/// (recorded as [`REPLICA_FILE`] in the run's folder).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Start {
-    /// The replica: 0 for the deposit as it is.
-    pub replica: u64,
-    /// How replicas `r ≥ 1` are perturbed (default: ≤ 1e-9 m, seed 1).
-    pub perturbation: Perturbation,
-}
+/// The start of a loading run ([`super::replicas::Start`]): here replica
+/// `r ≥ 1` is the deposit with every sphere moved by [`perturb_md_scene`].
+pub use super::replicas::Start;
 
 /// The loading scene of the sample deposited in `from`, from `start`, written
 /// as `load.toml` in `stage.out` (with `[settlement]` from `settlement` if

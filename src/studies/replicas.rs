@@ -80,6 +80,19 @@ pub struct Perturbation {
     pub seed: u64,
 }
 
+/// The start of one run of a sample: replica 0 is the sample as it is,
+/// replica `r ≥ 1` the sample with every mobile body moved by `perturbation`
+/// (stream `r` of its seed: [`perturb_scene`], [`perturb_md_scene`]), recorded
+/// as [`REPLICA_FILE`] in the run's folder. The same `r` and perturbation give
+/// the start of replica `r` of an ensemble, so one replica can be run alone.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Start {
+    /// The replica: 0 for the sample as it is.
+    pub replica: u64,
+    /// How replicas `r ≥ 1` are perturbed (default: ≤ 1e-9 m, seed 1).
+    pub perturbation: Perturbation,
+}
+
 impl Default for Perturbation {
     /// [`DEFAULT_PERTURBATION_M`], [`DEFAULT_PERTURB_SEED`].
     fn default() -> Self {

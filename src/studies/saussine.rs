@@ -19,7 +19,7 @@
 //! sleeper's width and the load scaled alike (same pressure,
 //! [`Loading::for_sample`]), unless the sleeper's width is given.
 
-use super::replicas::{perturb_scene, settlement_ensemble, Replicas, SettlementEnsembleRow, REPLICA_FILE};
+use super::replicas::{perturb_scene, settlement_ensemble, Replicas, SettlementEnsembleRow, Start, REPLICA_FILE};
 use super::{output_error, run_scene, write_file, RunDisplay};
 use crate::error::{Error, Result};
 use crate::io;
@@ -257,41 +257,72 @@ pub struct SettleOptions {
 /// §4: loads the sample at `sample` and runs its cycles in `out` (the loaded
 /// scene written there as `loaded.toml`, kept on `resume`): per-cycle
 /// settlement, mean grain speed, contacts and iterations (`cycles.csv`), VTK
-/// snapshots, figures. The run is labelled `settle`. This is replica 0 of
-/// [`settle_replicas`], the unperturbed start.
+/// snapshots, figures. The run is labelled `settle`. It starts as replica
+/// `start.replica` of [`settle_replicas`] with the same perturbation does (0:
+/// the sample as it is; `r ≥ 1`: perturbed, recorded as [`REPLICA_FILE`]).
 ///
 /// # Errors
-/// [`Error::Scene`] for an unreadable sample, an invalid loading or
-/// checkpoint; else as [`crate::run::Runner::run`].
+/// [`Error::Scene`] for an unreadable sample, an invalid loading, perturbation
+/// or checkpoint; else as [`crate::run::Runner::run`].
 pub fn settle(
     sample: &Path,
     loading: &Loading,
+    start: &Start,
     out: &Path,
     opts: &SettleOptions,
     display: &dyn RunDisplay,
 ) -> Result<RunOutcome> {
     let (scene, spec) = loaded(sample, loading)?;
+    let path = write_start(sample, scene, start, out, opts.resume, "")?;
+    run_settle(&path, out, &spec, opts, default_threads(), opts.resume, display, "settle")
+}
+
+/// Writes the loaded `scene` of `sample` as `out/loaded.toml` from `start`
+/// (and [`REPLICA_FILE`] for a perturbed start), unless `resume` keeps the one
+/// there; `what` is added to the file's note. Its path.
+fn write_start(
+    sample: &Path,
+    mut scene: Scene,
+    start: &Start,
+    out: &Path,
+    resume: bool,
+    what: &str,
+) -> Result<PathBuf> {
+    let record = perturb_scene(&mut scene, &start.perturbation, start.replica)?;
     io::create_output_dir(out)?;
     let path = out.join("loaded.toml");
-    if !opts.resume {
-        write_scene(&path, &scene, &format!("loaded from {}", sample.display()))?;
+    if !resume {
+        let replica = match start.replica {
+            0 => String::new(),
+            r => format!(
+                ", replica {r} (start perturbed by at most {} m, seed {})",
+                start.perturbation.distance_m, start.perturbation.seed
+            ),
+        };
+        write_scene(&path, &scene, &format!("loaded from {}{replica}{what}", sample.display()))?;
+        if start.replica > 0 {
+            io::write_json(&out.join(REPLICA_FILE), &record)?;
+        }
     }
-    run_settle(&path, out, &spec, opts, default_threads(), opts.resume, display, "settle")
+    Ok(path)
 }
 
 pub use super::Accelerate;
 
-/// §4 accelerated: [`settle`]'s loaded scene (written as `OUT/loaded.toml`, with
-/// its `[settlement]` table, the sleeper as the settlement body) run through
+/// §4 accelerated: [`settle`]'s loaded scene from `start` (written as
+/// `OUT/loaded.toml`, with its `[settlement]` table, the sleeper as the
+/// settlement body) run through
 /// [`crate::settlement::run_file`]: `settlement.csv`, `jumps.csv`, `summary.json`,
 /// the figures; with a reference, `errors.csv` ([`crate::settlement::figures`]).
 ///
 /// # Errors
 /// [`Error::Scene`] for an unreadable sample, an invalid loading or settings;
 /// else as [`crate::settlement::Accelerated::run`].
+#[allow(clippy::too_many_arguments)]
 pub fn settle_accelerated(
     sample: &Path,
     loading: &Loading,
+    start: &Start,
     accelerate: &Accelerate,
     out: &Path,
     opts: &SettleOptions,
@@ -306,11 +337,7 @@ pub fn settle_accelerated(
     let sleeper = scene.output.as_ref().and_then(|o| o.cycles.as_ref()).and_then(|c| c.body.clone());
     scene.settlement = Some(accelerate.section(sleeper, Some(0.01 * smallest)));
     scene.validate()?;
-    io::create_output_dir(out)?;
-    let path = out.join("loaded.toml");
-    if !opts.resume {
-        write_scene(&path, &scene, &format!("loaded from {}, accelerated", sample.display()))?;
-    }
+    let path = write_start(sample, scene, start, out, opts.resume, ", accelerated")?;
     let run = RunOptions {
         checkpoint_every_s: opts.checkpoint_every_s,
         resume: opts.resume,
