@@ -216,12 +216,39 @@ fn settle_replicas_ensemble_is_that_of_the_replicas() {
     assert_eq!(csv(&alone.join("cycles.csv")), cycles[2]);
     assert_eq!(positions(&Scene::load(alone.join("loaded.toml")).unwrap()), positions(&loaded(2)));
     assert!(alone.join("replica.json").is_file());
+    // Accelerated (1 initial cycle, windows of 2 computed cycles and a jump of
+    // 1, over 4 cycles): replica 1 alone, then the ensemble of two.
+    let accelerated = ["--cycles", "4", "--dt", "1e-3", "--bars", "0", "--perturb-seed", "5", "--snapshot-every", "0"];
+    let accelerated = [&accelerated[..], &["--accelerate", "1,2,1", "--seating-cycles", "1"]].concat();
     let fast = dir.join("alone-accelerated");
     let fast_s = fast.to_str().unwrap();
-    let args_fast =
-        [&["saussine", "settle", "--sample", &sample, "--out", fast_s, "--replica", "1"][..], &SHORT].concat();
-    run(&[&args_fast[..], &["--perturb-seed", "5", "--snapshot-every", "0", "--accelerate", "1,2,1"]].concat());
+    run(&[&["saussine", "settle", "--sample", &sample, "--out", fast_s, "--replica", "1"][..], &accelerated].concat());
     assert_eq!(positions(&Scene::load(fast.join("loaded.toml")).unwrap()), positions(&loaded(1)));
+    let ens = dir.join("accelerated-ensemble");
+    let ens_s = ens.to_str().unwrap();
+    let stdout =
+        run(&[&["saussine", "settle", "--sample", &sample, "--out", ens_s, "--replicas", "2"][..], &accelerated]
+            .concat());
+    assert!(stdout.contains("2 replicas, cycle 4"), "{stdout}");
+    // Wall times aside, replica 1 of the ensemble is the run of `--replica 1`.
+    let table = |d: &Path| -> Vec<HashMap<String, String>> {
+        let mut t = csv(&d.join("settlement.csv"));
+        t.iter_mut().for_each(|r| drop(r.remove("wall_time_s")));
+        t
+    };
+    let (r0, r1) = (table(&ens.join("runs/replica-0")), table(&ens.join("runs/replica-1")));
+    assert_eq!(r1, table(&fast));
+    assert_eq!(r1.len(), 4);
+    assert!(r1.iter().any(|r| r["computed"] == "0"), "a jump: {r1:?}");
+    // The ensemble is theirs: the mean of the two settlements, per cycle.
+    let rows = csv(&ens.join("settlement_ensemble.csv"));
+    assert_eq!(rows.len(), 4);
+    for (c, row) in rows.iter().enumerate() {
+        let mean = (num(&r0[c], "settlement_m") + num(&r1[c], "settlement_m")) / 2.0;
+        close(num(row, "settlement_mean_m"), mean, "accelerated mean");
+        assert_eq!(num(row, "replicas"), 2.0);
+    }
+    assert_ne!(r0, r1, "the perturbed start is another draw");
     let both =
         Command::new(env!("CARGO_BIN_EXE_ballast")).args([&one[..], &["--replicas", "3"]].concat()).output().unwrap();
     assert!(!both.status.success());

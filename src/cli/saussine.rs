@@ -69,8 +69,9 @@ pub enum SaussineCommand {
     },
     /// Loads a deposited sample and runs the cycles (§4): per-cycle settlement, mean
     /// grain speed, contacts and iterations (`cycles.csv`), VTK snapshots, figures.
-    /// With --replicas R > 1: R runs from perturbed starts side by side in
-    /// DIR/runs/replica-<r>/, and DIR/settlement_ensemble.csv (mean, sd, 95 % CI per cycle).
+    /// With --replicas R > 1: R runs (accelerated ones with --accelerate) from perturbed
+    /// starts side by side in DIR/runs/replica-<r>/, and DIR/settlement_ensemble.csv
+    /// (mean, sd, 95 % CI per cycle); --replica R runs one of them alone.
     Settle {
         /// A deposited sample (`sample.toml` of `ballast saussine sample`).
         #[arg(long, value_name = "FILE")]
@@ -481,11 +482,17 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
             let start = Start { replica, perturbation: replicas.perturbation };
             if let Some(acc) = accelerate.accelerate()? {
                 if replicas.count > 1 {
-                    return Err(input(
-                        "--accelerate with --replicas: not built yet (run the replicas one by one with --replica R, \
-                         the same --perturb and --perturb-seed)"
-                            .into(),
-                    ));
+                    let r = ballast::studies::accelerated::settle_accelerated_replicas(
+                        &sample,
+                        &loading.loading()?,
+                        &acc,
+                        &out,
+                        &opts,
+                        &replicas,
+                        jobs,
+                    )?;
+                    print_replicas(&r);
+                    return Ok(());
                 }
                 let bar = super::cycle_bar(quiet);
                 let mut show = |p: &ballast::settlement::AccelerationProgress| super::show_cycles(&bar, p);

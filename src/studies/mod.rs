@@ -7,7 +7,7 @@
 //!
 //! - [`saussine`]: the Saussine et al. (2006) sample deposited in stages
 //!   ([`saussine::sample`]), loaded ([`saussine::load`]) and settled over cycles
-//!   (§4, [`saussine::settle`]);
+//!   (§4, [`saussine::settle`]); [`accelerated`]: replicas of its accelerated run;
 //! - [`campaigns`]: the studies of Saussine et al. (2006) §3.2 (convergence
 //!   policies), §3.3 (time steps) and §4.2 (ensembles of samples), many runs side
 //!   by side on a thread pool;
@@ -38,6 +38,7 @@
 //! # Ok::<(), ballast::Error>(())
 //! ```
 
+pub mod accelerated;
 pub mod campaigns;
 pub mod compare;
 mod display;

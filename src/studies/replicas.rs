@@ -49,6 +49,7 @@
 use crate::error::{Error, Result};
 use crate::io::cycles::NscdCycleRow;
 use crate::scene::{MdScene, Scene};
+use crate::settlement::SettlementRow;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, UnitBall};
@@ -370,17 +371,46 @@ pub struct SettlementEnsembleRow {
     pub accrued_ci95_high_m: Option<f64>,
 }
 
-/// The cycles every run reached (the shortest `cycles.csv`).
-fn common_cycles(runs: &[&[NscdCycleRow]]) -> usize {
+/// A row of a run's per-cycle table with the settlement at the cycle's end, the
+/// load minimum: `cycles.csv` of a plain run ([`NscdCycleRow`]), `settlement.csv`
+/// of an accelerated one ([`SettlementRow`]: computed cycles measured there, the
+/// extrapolated ones on the fitted law).
+pub trait CycleSettlement {
+    /// The loading cycle (1 for the first).
+    fn cycle(&self) -> u64;
+    /// The settlement at the cycle's load minimum (m, positive downwards).
+    fn settlement_at_min_load(&self) -> f64;
+}
+
+impl CycleSettlement for NscdCycleRow {
+    fn cycle(&self) -> u64 {
+        self.cycle
+    }
+    fn settlement_at_min_load(&self) -> f64 {
+        self.settlement_at_min_load_m
+    }
+}
+
+impl CycleSettlement for SettlementRow {
+    fn cycle(&self) -> u64 {
+        self.cycle
+    }
+    fn settlement_at_min_load(&self) -> f64 {
+        self.settlement_m
+    }
+}
+
+/// The cycles every run reached (the shortest table).
+fn common_cycles<T>(runs: &[&[T]]) -> usize {
     runs.iter().map(|r| r.len()).min().unwrap_or(0)
 }
 
 /// The settlement of `run` at the load minimum of cycle `s` (0: the start, 0 m);
 /// its rows are cycles 1, 2, … in order.
-fn settlement_at(run: &[NscdCycleRow], s: u64) -> f64 {
+fn settlement_at<T: CycleSettlement>(run: &[T], s: u64) -> f64 {
     match s {
         0 => 0.0,
-        s => run[s as usize - 1].settlement_at_min_load_m,
+        s => run[s as usize - 1].settlement_at_min_load(),
     }
 }
 
@@ -388,17 +418,17 @@ fn settlement_at(run: &[NscdCycleRow], s: u64) -> f64 {
 /// cycle order from cycle 1), with the seating cycle `seating_cycles` (clipped
 /// to the cycles every replica reached): one row per cycle that every replica
 /// reached.
-pub fn settlement_ensemble(runs: &[&[NscdCycleRow]], seating_cycles: u64) -> Vec<SettlementEnsembleRow> {
+pub fn settlement_ensemble<T: CycleSettlement>(runs: &[&[T]], seating_cycles: u64) -> Vec<SettlementEnsembleRow> {
     let n = common_cycles(runs);
     let s = seating_cycles.min(n as u64);
     (0..n)
         .filter_map(|c| {
-            let total: Vec<f64> = runs.iter().map(|r| r[c].settlement_at_min_load_m).collect();
+            let total: Vec<f64> = runs.iter().map(|r| r[c].settlement_at_min_load()).collect();
             let t = Estimate::of(&total)?;
-            let cycle = runs[0][c].cycle;
+            let cycle = runs[0][c].cycle();
             let a = if (c as u64) + 1 >= s {
                 let accrued: Vec<f64> =
-                    runs.iter().map(|r| r[c].settlement_at_min_load_m - settlement_at(r, s)).collect();
+                    runs.iter().map(|r| r[c].settlement_at_min_load() - settlement_at(r, s)).collect();
                 Estimate::of(&accrued)
             } else {
                 None
@@ -441,16 +471,16 @@ impl SettlementSummary {
     /// The summary of the replicas' cycles `runs` with `seating_cycles` (see
     /// [`settlement_ensemble`]); `None` if there is no replica or some replica
     /// completed no cycle.
-    pub fn of(runs: &[&[NscdCycleRow]], seating_cycles: u64) -> Option<Self> {
+    pub fn of<T: CycleSettlement>(runs: &[&[T]], seating_cycles: u64) -> Option<Self> {
         let n = common_cycles(runs);
         if runs.is_empty() || n == 0 {
             return None;
         }
         let s = seating_cycles.min(n as u64);
-        let settlement: Vec<f64> = runs.iter().map(|r| r[n - 1].settlement_at_min_load_m).collect();
+        let settlement: Vec<f64> = runs.iter().map(|r| r[n - 1].settlement_at_min_load()).collect();
         let seating: Vec<f64> = runs.iter().map(|r| settlement_at(r, s)).collect();
         let accrued = settlement.iter().zip(&seating).map(|(t, s)| t - s).collect();
-        Some(Self { cycle: runs[0][n - 1].cycle, seating_cycle: s, settlement, seating, accrued })
+        Some(Self { cycle: runs[0][n - 1].cycle(), seating_cycle: s, settlement, seating, accrued })
     }
 
     /// The columns of a study's summary CSV.

@@ -19,7 +19,9 @@
 //! sleeper's width and the load scaled alike (same pressure,
 //! [`Loading::for_sample`]), unless the sleeper's width is given.
 
-use super::replicas::{perturb_scene, settlement_ensemble, Replicas, SettlementEnsembleRow, Start, REPLICA_FILE};
+use super::replicas::{
+    perturb_scene, settlement_ensemble, CycleSettlement, Replicas, SettlementEnsembleRow, Start, REPLICA_FILE,
+};
 use super::{output_error, run_scene, write_file, RunDisplay};
 use crate::error::{Error, Result};
 use crate::io;
@@ -328,6 +330,21 @@ pub fn settle_accelerated(
     opts: &SettleOptions,
     progress: &mut dyn FnMut(&crate::settlement::AccelerationProgress),
 ) -> Result<crate::settlement::AccelerationSummary> {
+    settle_accelerated_on(sample, loading, start, accelerate, out, opts, default_threads(), progress)
+}
+
+/// [`settle_accelerated`] on `threads` sweep threads.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn settle_accelerated_on(
+    sample: &Path,
+    loading: &Loading,
+    start: &Start,
+    accelerate: &Accelerate,
+    out: &Path,
+    opts: &SettleOptions,
+    threads: usize,
+    progress: &mut dyn FnMut(&crate::settlement::AccelerationProgress),
+) -> Result<crate::settlement::AccelerationSummary> {
     let (mut scene, _) = loaded(sample, loading)?;
     let sys = scene.build()?;
     let smallest = (0..sys.bodies.len())
@@ -342,6 +359,7 @@ pub fn settle_accelerated(
         checkpoint_every_s: opts.checkpoint_every_s,
         resume: opts.resume,
         figures: true,
+        threads,
         ..RunOptions::default()
     };
     accelerate.run_scene(&path, out, &run, progress)
@@ -491,7 +509,7 @@ pub fn settle_replicas(
 pub(crate) fn ensemble_figure(
     stem: &Path,
     title: &str,
-    runs: &[&[NscdCycleRow]],
+    runs: &[&[impl CycleSettlement]],
     rows: &[SettlementEnsembleRow],
 ) -> Result<()> {
     let mm = |x: f64| 1e3 * x;
@@ -499,7 +517,7 @@ pub(crate) fn ensemble_figure(
         .iter()
         .map(|r| Series {
             label: String::new(),
-            points: r.iter().map(|c| (c.cycle as f64, mm(c.settlement_at_min_load_m))).collect(),
+            points: r.iter().map(|c| (c.cycle() as f64, mm(c.settlement_at_min_load()))).collect(),
             band: vec![],
             thin: true,
             points_only: false,
