@@ -6,10 +6,10 @@
 //! chaotic process (a start moved by 1e-9 m changes its error by tens of per
 //! cent: BENCHMARKS.md, "Settlement acceleration"), so its error is an ensemble's.
 
-use super::replicas::{settlement_ensemble, Replicas, Start};
-use super::saussine::SettleReplicas;
-use super::saussine::{ensemble_figure, replica_dir, settle_accelerated_on, Accelerate, Loading, SettleOptions};
-use crate::error::{Error, Result};
+use super::replicas::{Replicas, Start};
+use super::saussine::{finish_replicas, replica_dir, replica_jobs, settle_accelerated_on};
+use super::saussine::{Accelerate, Loading, SettleOptions, SettleReplicas};
+use crate::error::Result;
 use crate::io;
 use crate::run::{files, Prior};
 use crate::settlement::SettlementRow;
@@ -40,10 +40,7 @@ pub fn settle_accelerated_replicas(
 ) -> Result<SettleReplicas> {
     crate::io::figures::require()?; // the runs end with their figures
     replicas.check()?;
-    let threads = match jobs.unwrap_or_else(crate::run::cores) {
-        0 => return Err(Error::Scene("--jobs: must be at least 1".into())),
-        n => n.min(replicas.count as usize),
-    };
+    let threads = replica_jobs(jobs, replicas.count)?;
     io::create_output_dir(&out.join("runs"))?;
     let priors: Vec<Prior> =
         (0..replicas.count).map(|r| Prior::of(&replica_dir(out, r), files::SUMMARY, opts.resume)).collect();
@@ -65,21 +62,7 @@ pub fn settle_accelerated_replicas(
             })
             .collect()
     });
-    let mut failed = Vec::new();
-    let mut tables = Vec::new();
-    for (r, result) in results.into_iter().enumerate() {
-        match result {
-            Ok(()) => {}
-            Err(e @ Error::Scene(_)) => return Err(e),
-            Err(e) => failed.push((format!("replica-{r}"), e.one_line())),
-        }
-        let path = replica_dir(out, r as u64).join("settlement.csv");
-        tables.push(if path.exists() { io::read_csv::<SettlementRow>(&path)? } else { vec![] });
-    }
-    let runs: Vec<&[SettlementRow]> = tables.iter().map(Vec::as_slice).collect();
-    let rows = settlement_ensemble(&runs, replicas.seating_cycles.min(loading.cycles));
-    let table = out.join("settlement_ensemble.csv");
-    io::table::write_all(&table, &rows)?;
-    ensemble_figure(&out.join("settlement_ensemble"), "Settlement of the sleeper, accelerated", &runs, &rows)?;
-    Ok(SettleReplicas { runs: out.join("runs"), table, rows, failed })
+    let seating = replicas.seating_cycles.min(loading.cycles);
+    let read = |path: &Path| io::read_csv::<SettlementRow>(path);
+    finish_replicas(out, results, "settlement.csv", read, seating, "Settlement of the sleeper, accelerated")
 }

@@ -25,7 +25,6 @@ use super::replicas::{
 use super::{output_error, run_scene, write_file, RunDisplay};
 use crate::error::{Error, Result};
 use crate::io;
-use crate::io::cycles::NscdCycleRow;
 use crate::io::figures::Series;
 use crate::run::{default_threads, files, Prior, RunOptions, RunOutcome};
 use crate::scenarios::saussine::{
@@ -438,10 +437,7 @@ pub fn settle_replicas(
 ) -> Result<SettleReplicas> {
     crate::io::figures::require()?; // the runs end with their figures
     replicas.check()?;
-    let threads = match jobs.unwrap_or_else(crate::run::cores) {
-        0 => return Err(Error::Scene("--jobs: must be at least 1".into())),
-        n => n.min(replicas.count as usize),
-    };
+    let threads = replica_jobs(jobs, replicas.count)?;
     let (scene, spec) = loaded(sample, loading)?;
     io::create_output_dir(&out.join("runs"))?;
     // Every replica's scene first, so that an invalid one stops before any run.
@@ -484,22 +480,54 @@ pub fn settle_replicas(
             })
             .collect()
     });
+    let seating = replicas.seating_cycles.min(loading.cycles);
+    let read = |path: &Path| io::cycles::read_nscd(path).map_err(output_error);
+    finish_replicas(out, results, files::CYCLES, read, seating, "Settlement of the sleeper")
+}
+
+/// The runs of a replica study at once: `jobs` (`None`: one per core), at most
+/// `count`.
+///
+/// # Errors
+/// [`Error::Scene`] for `jobs` = 0.
+pub(crate) fn replica_jobs(jobs: Option<usize>, count: u64) -> Result<usize> {
+    match jobs.unwrap_or_else(crate::run::cores) {
+        0 => Err(Error::Scene("--jobs: must be at least 1".into())),
+        n => Ok(n.min(count as usize)),
+    }
+}
+
+/// The end of a replica study in `out`: the failed replicas of `results` (one
+/// per replica; a [`Error::Scene`] is returned as it is), each replica's table
+/// `file` read by `read` (empty when absent), `OUT/settlement_ensemble.csv`
+/// with the seating cycle `seating` and its figure titled `title`.
+///
+/// # Errors
+/// A replica's [`Error::Scene`]; a table that cannot be read or written.
+pub(crate) fn finish_replicas<T: CycleSettlement>(
+    out: &Path,
+    results: Vec<Result<()>>,
+    file: &str,
+    read: impl Fn(&Path) -> Result<Vec<T>>,
+    seating: u64,
+    title: &str,
+) -> Result<SettleReplicas> {
     let mut failed = Vec::new();
-    let mut cycles = Vec::new();
+    let mut tables = Vec::new();
     for (r, result) in results.into_iter().enumerate() {
         match result {
             Ok(()) => {}
             Err(e @ Error::Scene(_)) => return Err(e),
             Err(e) => failed.push((format!("replica-{r}"), e.one_line())),
         }
-        let path = replica_dir(out, r as u64).join(files::CYCLES);
-        cycles.push(if path.exists() { io::cycles::read_nscd(&path).map_err(output_error)? } else { vec![] });
+        let path = replica_dir(out, r as u64).join(file);
+        tables.push(if path.exists() { read(&path)? } else { vec![] });
     }
-    let runs: Vec<&[NscdCycleRow]> = cycles.iter().map(Vec::as_slice).collect();
-    let rows = settlement_ensemble(&runs, replicas.seating_cycles.min(loading.cycles));
+    let runs: Vec<&[T]> = tables.iter().map(Vec::as_slice).collect();
+    let rows = settlement_ensemble(&runs, seating);
     let table = out.join("settlement_ensemble.csv");
     io::table::write_all(&table, &rows)?;
-    ensemble_figure(&out.join("settlement_ensemble"), "Settlement of the sleeper", &runs, &rows)?;
+    ensemble_figure(&out.join("settlement_ensemble"), title, &runs, &rows)?;
     Ok(SettleReplicas { runs: out.join("runs"), table, rows, failed })
 }
 
