@@ -496,8 +496,16 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                 }
                 let bar = super::cycle_bar(quiet);
                 let mut show = |p: &ballast::settlement::AccelerationProgress| super::show_cycles(&bar, p);
-                let s =
-                    saussine::settle_accelerated(&sample, &loading.loading()?, &start, &acc, &out, &opts, &mut show)?;
+                let s = saussine::settle_accelerated(
+                    &sample,
+                    &loading.loading()?,
+                    &start,
+                    &acc,
+                    &out,
+                    &opts,
+                    default_threads(),
+                    &mut show,
+                )?;
                 bar.finish_and_clear();
                 super::print_acceleration(&s, &out);
                 if accelerate.reference.is_some() {

@@ -7,7 +7,7 @@
 //! cent: BENCHMARKS.md, "Settlement acceleration"), so its error is an ensemble's.
 
 use super::replicas::{Replicas, Start};
-use super::saussine::{finish_replicas, replica_dir, replica_jobs, settle_accelerated_on};
+use super::saussine::{finish_replicas, replica_dir, replica_jobs, settle_accelerated};
 use super::saussine::{Accelerate, Loading, SettleOptions, SettleReplicas};
 use crate::error::Result;
 use crate::io;
@@ -56,7 +56,7 @@ pub fn settle_accelerated_replicas(
                     let opts = SettleOptions { resume: prior == Prior::Checkpointed, ..opts.clone() };
                     let dir = replica_dir(out, r);
                     let threads = super::campaigns::run_threads(threads);
-                    settle_accelerated_on(sample, loading, &start, accelerate, &dir, &opts, threads, &mut |_| {})
+                    settle_accelerated(sample, loading, &start, accelerate, &dir, &opts, threads, &mut |_| {})
                         .map(|_| ())
                 }
             })

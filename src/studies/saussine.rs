@@ -316,25 +316,13 @@ pub use super::Accelerate;
 /// [`crate::settlement::run_file`]: `settlement.csv`, `jumps.csv`, `summary.json`,
 /// the figures; with a reference, `errors.csv` ([`crate::settlement::figures`]).
 ///
+/// The run sweeps on `threads` threads (the numbers do not depend on them).
+///
 /// # Errors
 /// [`Error::Scene`] for an unreadable sample, an invalid loading or settings;
 /// else as [`crate::settlement::Accelerated::run`].
 #[allow(clippy::too_many_arguments)]
 pub fn settle_accelerated(
-    sample: &Path,
-    loading: &Loading,
-    start: &Start,
-    accelerate: &Accelerate,
-    out: &Path,
-    opts: &SettleOptions,
-    progress: &mut dyn FnMut(&crate::settlement::AccelerationProgress),
-) -> Result<crate::settlement::AccelerationSummary> {
-    settle_accelerated_on(sample, loading, start, accelerate, out, opts, default_threads(), progress)
-}
-
-/// [`settle_accelerated`] on `threads` sweep threads.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn settle_accelerated_on(
     sample: &Path,
     loading: &Loading,
     start: &Start,
