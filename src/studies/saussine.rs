@@ -258,8 +258,8 @@ pub struct SettleOptions {
 /// §4: loads the sample at `sample` and runs its cycles in `out` (the loaded
 /// scene written there as `loaded.toml`, kept on `resume`): per-cycle
 /// settlement, mean grain speed, contacts and iterations (`cycles.csv`), VTK
-/// snapshots, figures. The run is labelled `settle`. It starts as replica
-/// `start.replica` of [`settle_replicas`] with the same perturbation does (0:
+/// snapshots, figures. The run is labelled `settle`. It starts where replica
+/// `start.replica` of [`settle_replicas`] with the same perturbation starts (0:
 /// the sample as it is; `r ≥ 1`: perturbed, recorded as [`REPLICA_FILE`]).
 ///
 /// # Errors
