@@ -274,34 +274,38 @@ pub fn settle(
     display: &dyn RunDisplay,
 ) -> Result<RunOutcome> {
     let (scene, spec) = loaded(sample, loading)?;
-    let path = write_start(sample, scene, start, out, opts.resume, "")?;
+    let path = write_start(sample, scene, start, out, opts.resume, false, "")?;
     run_settle(&path, out, &spec, opts, default_threads(), opts.resume, display, "settle")
 }
 
-/// Writes the loaded `scene` of `sample` as `out/loaded.toml` from `start`
-/// (and [`REPLICA_FILE`] for a perturbed start), unless `resume` keeps the one
-/// there; `what` is added to the file's note. Its path.
+/// Writes the loaded `scene` of `sample` as `out/loaded.toml` from `start`,
+/// unless `resume` keeps the one there; `what` is added to the file's note. A
+/// perturbed start, or any start of an ensemble (`in_ensemble`, replica 0
+/// too), is named in the note and recorded as [`REPLICA_FILE`]. Its path.
 fn write_start(
     sample: &Path,
     mut scene: Scene,
     start: &Start,
     out: &Path,
     resume: bool,
+    in_ensemble: bool,
     what: &str,
 ) -> Result<PathBuf> {
     let record = perturb_scene(&mut scene, &start.perturbation, start.replica)?;
     io::create_output_dir(out)?;
     let path = out.join("loaded.toml");
     if !resume {
+        let labelled = in_ensemble || start.replica > 0;
         let replica = match start.replica {
-            0 => String::new(),
+            _ if !labelled => String::new(),
             r => format!(
                 ", replica {r} (start perturbed by at most {} m, seed {})",
-                start.perturbation.distance_m, start.perturbation.seed
+                if r == 0 { 0.0 } else { start.perturbation.distance_m },
+                start.perturbation.seed
             ),
         };
         write_scene(&path, &scene, &format!("loaded from {}{replica}{what}", sample.display()))?;
-        if start.replica > 0 {
+        if labelled {
             io::write_json(&out.join(REPLICA_FILE), &record)?;
         }
     }
@@ -341,7 +345,7 @@ pub fn settle_accelerated(
     let sleeper = scene.output.as_ref().and_then(|o| o.cycles.as_ref()).and_then(|c| c.body.clone());
     scene.settlement = Some(accelerate.section(sleeper, Some(0.01 * smallest)));
     scene.validate()?;
-    let path = write_start(sample, scene, start, out, opts.resume, ", accelerated")?;
+    let path = write_start(sample, scene, start, out, opts.resume, false, ", accelerated")?;
     let run = RunOptions {
         checkpoint_every_s: opts.checkpoint_every_s,
         resume: opts.resume,
@@ -433,19 +437,8 @@ pub fn settle_replicas(
     for r in 0..replicas.count {
         let dir = replica_dir(out, r);
         let prior = Prior::of(&dir, files::SUMMARY, opts.resume);
-        if prior == Prior::Nothing {
-            io::create_output_dir(&dir)?;
-            let mut perturbed = scene.clone();
-            let record = perturb_scene(&mut perturbed, &replicas.perturbation, r)?;
-            let what = format!(
-                "loaded from {}, replica {r} (start perturbed by at most {} m, seed {})",
-                sample.display(),
-                if r == 0 { 0.0 } else { replicas.perturbation.distance_m },
-                replicas.perturbation.seed
-            );
-            write_scene(&dir.join("loaded.toml"), &perturbed, &what)?;
-            io::write_json(&dir.join(REPLICA_FILE), &record)?;
-        }
+        let start = Start { replica: r, perturbation: replicas.perturbation };
+        write_start(sample, scene.clone(), &start, &dir, prior != Prior::Nothing, true, "")?;
         priors.push(prior);
     }
     let pool = super::campaigns::pool(threads)?;
