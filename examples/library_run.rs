@@ -7,9 +7,10 @@
 //!
 //! `cargo run --release --example library_run -- [OUT]` (default `out/library_run`).
 
+use ballast::engine::Engine;
 use ballast::md::{Ghosts, LawTable, Material, MdSettings, MdSystem, Motion, PairLaw, Particles, Wall, V3};
 use ballast::nscd::{BodyInfo, ContactLaw, NscdParams, System};
-use ballast::run::{run_file, Engine, RunOptions, RunPlan, Runner};
+use ballast::run::{run_file, RunOptions, RunPlan, Runner};
 use std::path::PathBuf;
 
 fn main() -> Result<(), ballast::Error> {

@@ -196,7 +196,7 @@ fn loaded_sample(grains: usize, cycles: u64, out: &Path) -> Result<Scene, ballas
     if deposit.status != Status::Ended(ballast::io::RunEnd::Equilibrium) {
         eprintln!("warning: the deposit ended without reaching equilibrium ({:?})", deposit.status);
     }
-    let fin = ballast::io::FinalState::read(&dir.join("final.json"))?;
+    let fin = ballast::engine::FinalState::read(&dir.join("final.json"))?;
     let mut sys = scene.build()?;
     for (i, b) in fin.bodies.iter().enumerate() {
         sys.bodies.q[i] = [b.position[0], b.position[1], b.angle.unwrap_or(0.0)];

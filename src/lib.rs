@@ -1,6 +1,6 @@
 //! `ballast`: granular mechanics under cyclic loading, for railway ballast settlement.
 //!
-//! Two engines behind one interface ([`run::Engine`]):
+//! Two engines behind one interface ([`engine::Engine`]):
 //! - [`nscd`]: non-smooth contact dynamics of rigid 2D polygons and discs
 //!   (Moreau–Jean θ-method, nonlinear Gauss–Seidel with exact Coulomb friction,
 //!   shadow-overlap detection, viscoelastic sublayer; Saussine et al. 2006);
@@ -58,6 +58,7 @@
 #![deny(missing_docs)]
 
 pub mod clock;
+pub mod engine;
 pub mod error;
 pub mod geometry;
 pub mod io;

@@ -6,9 +6,9 @@
 //! `ballast::io::run_figures::draw_run_figures`, by `ballast run --figures`'s
 //! path (`RunOptions::figures`) and by the `ballast figures DIR` command.
 
-use ballast::io::contacts::{self, ContactKind};
+use ballast::engine::contacts::{self, ContactKind};
+use ballast::engine::FinalState;
 use ballast::io::run_figures::draw_run_figures;
-use ballast::io::FinalState;
 use ballast::run::{run_file, RunOptions};
 use std::path::{Path, PathBuf};
 use std::process::Command;

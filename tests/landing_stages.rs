@@ -16,11 +16,12 @@
 //! leaves the grain on the pads and both springs upright. The full sample's
 //! run shows the same two outcomes (BENCHMARKS.md, "Landings in stages").
 
+use ballast::engine::RelaxSettings;
+use ballast::engine::{Configuration, Engine};
 use ballast::nscd::measure::world_polygon;
 use ballast::nscd::System;
-use ballast::run::{Configuration, Engine};
 use ballast::scene::Scene;
-use ballast::settlement::{sweep, RelaxSettings};
+use ballast::settlement::sweep;
 
 /// The relaxation tolerance of the full run: 1 % of the smallest grain's inradius (m).
 const TOLERANCE: f64 = 4.045084971874737e-5;

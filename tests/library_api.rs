@@ -448,7 +448,7 @@ fn md_sphere_on_plane_rests_at_the_hertz_overlap() {
 
 #[test]
 fn engines_count_the_force_carrying_contacts_and_size_the_bodies() {
-    use ballast::run::Engine;
+    use ballast::engine::Engine;
     // NSCD: two 10 cm blocks stacked on a floor, at rest after 100 steps: the
     // lower one touches the floor and the upper one (2), the upper one the
     // lower one (1). Size: the radius of the disc of the same area, √(0.01/π).

@@ -345,7 +345,7 @@ fn diverging_run_exits_with_code_1() {
     assert!(vector(&fin["bodies"][1]["position"]).iter().all(|x| x.is_finite()));
     assert!(out.join("summary.json").is_file() && !out.join("final_scene.toml").exists());
     // The contact list of the last good step.
-    let contacts = ballast::io::contacts::read(&out.join("contacts.csv")).unwrap();
+    let contacts = ballast::engine::contacts::read(&out.join("contacts.csv")).unwrap();
     assert!(contacts.iter().all(|c| c.f_n.is_finite() && c.gap_m < 0.0), "{contacts:?}");
     // The header, and the row of the last good step if one was made.
     let rows = std::fs::read_to_string(out.join("series.csv")).unwrap().lines().count();

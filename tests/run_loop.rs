@@ -5,8 +5,10 @@
 //! leaves the last good state and its row; every CSV it writes reads back
 //! through the library's row types.
 
-use ballast::io::{FinalState, RunEnd};
-use ballast::run::{Engine, RunOptions, RunPlan, Runner, Status};
+use ballast::engine::Engine;
+use ballast::engine::FinalState;
+use ballast::io::RunEnd;
+use ballast::run::{RunOptions, RunPlan, Runner, Status};
 use ballast::scene::{MdScene, Scene};
 use ballast::Error;
 use std::path::{Path, PathBuf};

@@ -36,13 +36,13 @@ fn deposit(seed: u64) -> (Scene, f64) {
         "the deposit did not reach equilibrium within {} s",
         scene.simulation.duration
     );
-    let fin = ballast::io::FinalState::read(&dir.join("final.json")).unwrap();
+    let fin = ballast::engine::FinalState::read(&dir.join("final.json")).unwrap();
     let mut sys = sys;
     for (i, b) in fin.bodies.iter().enumerate() {
         sys.bodies.q[i] = [b.position[0], b.position[1], b.angle.unwrap()];
         let spin = match b.spin {
-            ballast::io::Spin::Planar(w) => w,
-            ballast::io::Spin::Spatial(_) => unreachable!(),
+            ballast::engine::Spin::Planar(w) => w,
+            ballast::engine::Spin::Spatial(_) => unreachable!(),
         };
         sys.bodies.u[i] = [b.velocity[0], b.velocity[1], spin];
     }

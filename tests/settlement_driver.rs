@@ -36,7 +36,7 @@ fn loaded() -> &'static Scene {
         let run = Runner::from_system(sys, scene.plan().unwrap()).unwrap();
         let out = run.run(&dir, &opts, &mut |_| {}).unwrap();
         assert_eq!(out.status, Status::Ended(ballast::io::RunEnd::Equilibrium));
-        let fin = ballast::io::FinalState::read(&dir.join("final.json")).unwrap();
+        let fin = ballast::engine::FinalState::read(&dir.join("final.json")).unwrap();
         let mut sys = scene.build().unwrap();
         for (i, b) in fin.bodies.iter().enumerate() {
             sys.bodies.q[i] = [b.position[0], b.position[1], b.angle.unwrap()];

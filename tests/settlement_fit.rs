@@ -4,7 +4,7 @@
 //! accuracy measures (eqs. 13–14) and the configuration error (eq. 22) match
 //! their hand-computed values, and the Chernoff bound (eq. 15) its closed form.
 
-use ballast::run::Configuration;
+use ballast::engine::Configuration;
 use ballast::settlement::{
     chernoff_cycles, chernoff_probability, configuration_error, extrapolate, extrapolate_within, fit, law_named,
     trend_moves, Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin, Training,

@@ -7,7 +7,8 @@
 //! The load is a tenth of the paper's amplitude (at the full one the soft
 //! contacts are pressed by 5 % of a radius and the sample flows).
 
-use ballast::run::{Engine, RunOptions, Runner};
+use ballast::engine::Engine;
+use ballast::run::{RunOptions, Runner};
 use ballast::scenarios::karrech::{deposit_scene, loading_scene, KarrechSpec, Loading};
 use ballast::settlement::{Accelerated, Acceleration, SettlementRow};
 use std::path::PathBuf;
@@ -36,7 +37,7 @@ fn deposit(spec: &KarrechSpec, name: &str) -> Vec<(f64, ballast::md::V3)> {
     let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
     let run = Runner::from_system(scene.build().unwrap(), scene.plan().unwrap()).unwrap();
     run.run(&dir, &opts, &mut |_| {}).unwrap();
-    let fin = ballast::io::FinalState::read(&dir.join("final.json")).unwrap();
+    let fin = ballast::engine::FinalState::read(&dir.join("final.json")).unwrap();
     let _ = std::fs::remove_dir_all(&dir);
     fin.bodies
         .iter()

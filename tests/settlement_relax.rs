@@ -9,10 +9,10 @@
 #[path = "md_common/mod.rs"]
 mod md_common;
 
+use ballast::engine::Engine;
+use ballast::engine::{Functional, Method, RelaxReport, RelaxSettings};
 use ballast::md::relax::Potential;
 use ballast::md::{Ghosts, Integrator, LawTable, Material, MdSystem, PairLaw, Particles, SymmetryPlane, V3};
-use ballast::run::Engine;
-use ballast::settlement::{Functional, Method, RelaxReport, RelaxSettings};
 use md_common::{plane, settings};
 
 /// Karrech et al. Table 1: diorite.
@@ -165,7 +165,7 @@ fn a_deliberately_overlapped_nscd_pile_is_projected_below_the_tolerance() {
     // close to the pushed one, in the metric of the masses, as the settled pile
     // it came from (which has overlaps of its own up to the tolerance's order).
     let c1 = relaxed.configuration();
-    let dist = |a: &ballast::run::Configuration| {
+    let dist = |a: &ballast::engine::Configuration| {
         let mut s = 0.0;
         for (k, &i) in a.bodies.iter().enumerate() {
             let info = &sys.bodies.info[i];

@@ -6,8 +6,8 @@
 //! takes the same steps, bit for bit, as a system built fresh at the written
 //! positions with zero velocities. Nothing of its past may leak into them.
 
+use ballast::engine::{Configuration, Engine};
 use ballast::md::{Ghosts, MdSystem};
-use ballast::run::{Configuration, Engine};
 use ballast::scene::{MdScene, Scene};
 
 /// Pentagons and a disc on a pad held by two sublayer springs above a fixed

@@ -71,7 +71,7 @@ pub struct Checkpoint<S, C> {
     pub cycles_done: u64,
     /// The followed bodies and their coordinates at the start (with
     /// `output.cycles.positions`).
-    pub positions: Option<crate::run::Configuration>,
+    pub positions: Option<crate::engine::Configuration>,
     /// CRC-32 of the records of `cycle_displacements.npy` (0 without positions).
     pub positions_crc32: u32,
 }

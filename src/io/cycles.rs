@@ -28,6 +28,7 @@
 //! The per-cycle state is plain data, kept in checkpoints so that a resumed run
 //! writes the same rows.
 
+use crate::engine::CycleCheck;
 use crate::error::Result;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -97,16 +98,6 @@ impl NscdCycleState {
         let first = self.first_cycle_q.take();
         *self = Self { first_cycle_q: first, ..Self::new(self.body, self.y0) };
     }
-}
-
-/// The check of a per-cycle state read from a checkpoint.
-pub trait CycleCheck {
-    /// Checks `self`, read from a checkpoint written after `cycles` completed
-    /// cycles of a system of `bodies` bodies, against `start`, the state the
-    /// run started with ([`crate::run::Engine::cycle_start`]): what the
-    /// per-cycle output follows and starts from, and the shape of what it
-    /// keeps. The message says what differs.
-    fn check(&self, start: &Self, bodies: usize, cycles: u64) -> std::result::Result<(), String>;
 }
 
 impl CycleCheck for NscdCycleState {

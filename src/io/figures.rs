@@ -26,7 +26,7 @@
 //! `figures` feature (on by default); without it every function here returns an
 //! error saying so, and [`ENABLED`] is false.
 
-use super::contacts::{ContactKind, ContactRow};
+use crate::engine::{ContactKind, ContactRow};
 use crate::error::Result;
 use crate::nscd::System;
 use std::collections::BTreeMap;
@@ -215,12 +215,12 @@ pub fn polygons_of(sys: &System) -> (Vec<Vec<[f64; 2]>>, Vec<bool>) {
 /// contact list): between the centres of two moving bodies, from a body's
 /// centre to its contact points with a fixed one.
 pub fn force_lines_of(sys: &System) -> Vec<ForceLine> {
-    let rows = crate::run::Engine::contact_rows(sys);
+    let rows = crate::engine::Engine::contact_rows(sys);
     let q = &sys.bodies.q;
     force_lines(&rows, |i| q.get(i).map(|q| [q[0], q[1], 0.0]), |p| [p[0], p[1]])
 }
 
-/// Force chain segments of a contact list ([`super::contacts`]), in the plane
+/// Force chain segments of a contact list ([`crate::engine::contacts`]), in the plane
 /// `project` maps a point (m) to: one per pair of moving bodies, between their
 /// centres (`centre` of a body index, m), with the sum of the normal forces (N)
 /// of the pair's contact points; one per contact with a wall, a fixed body or a

@@ -143,7 +143,7 @@ fn plate_cycles(dir: &Path, servos: &[(usize, String)], out: &mut RunFigures) ->
 }
 
 /// `side_view`: the spheres on the x–z plane with the contact forces.
-fn side_view(dir: &Path, fin: &super::FinalState, out: &mut RunFigures) -> Result<()> {
+fn side_view(dir: &Path, fin: &crate::engine::FinalState, out: &mut RunFigures) -> Result<()> {
     let Some(rows) = read_contacts(dir)? else {
         out.skip("side_view", "no contacts.csv (a run of an older version)");
         return Ok(());
@@ -196,7 +196,7 @@ fn walls_of(dir: &Path) -> Result<Option<Vec<Wall>>> {
 /// The walls seen edge-on in the x–z plane as strips (m, in x–z) on their outer
 /// side, as long as the spheres' extent (`circles`) and 2 % of it thick, at their
 /// displacement in `fin`.
-fn wall_strips(dir: &Path, fin: &super::FinalState, circles: &[Vec<[f64; 2]>]) -> Result<Vec<Vec<[f64; 2]>>> {
+fn wall_strips(dir: &Path, fin: &crate::engine::FinalState, circles: &[Vec<[f64; 2]>]) -> Result<Vec<Vec<[f64; 2]>>> {
     let Some(walls) = walls_of(dir)? else { return Ok(Vec::new()) };
     let points = circles.iter().flatten();
     let (lo, hi) = points.fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), p| {

@@ -6,9 +6,10 @@
 //! - `cycles.csv`: per-cycle statistics with `output.cycles` ([`cycles`]), and
 //!   with `output.cycles.positions` the positions of every mobile body at each
 //!   cycle end ([`positions`]);
-//! - `final.json`: the state of every body (and wall) at the end ([`FinalState`]);
+//! - `final.json`: the state of every body (and wall) at the end
+//!   ([`crate::engine::FinalState`]);
 //! - `contacts.csv`: every contact at the end with its point, normal and forces
-//!   ([`contacts`]);
+//!   ([`crate::engine::contacts`]);
 //! - `summary.json`: wall time and speed, mean contacts, overlaps, NLGS
 //!   iterations ([`summary::RunReport`]);
 //! - `scene.toml`: a copy of the input scene (the text the run read), or
@@ -27,10 +28,8 @@
 //! I/O error names the file it happened on.
 
 pub mod checkpoint;
-pub mod contacts;
 pub mod cycles;
 pub mod figures;
-pub mod final_state;
 pub mod md_figures;
 pub mod positions;
 pub mod run_figures;
@@ -44,8 +43,7 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 pub use checkpoint::{Checkpoint, CHECKPOINT_FILE};
-pub use final_state::{BodyState, FinalState, Spin, WallState};
-pub use summary::{RunEnd, RunReport, RunSummary, StepSummary};
+pub use summary::{RunEnd, RunReport, RunSummary};
 pub use table::TableWriter;
 
 /// An I/O error with the path it happened on in its message.

@@ -18,8 +18,8 @@
 //! [`read`] gives the positions back as [`Configuration`]s.
 
 use super::io_error;
+use crate::engine::Configuration;
 use crate::error::{Error, Result};
-use crate::run::Configuration;
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom, Write};

@@ -23,9 +23,9 @@
 //! A figure whose data the folder does not hold (no cycles, an older run
 //! without `contacts.csv`) is skipped and said so in [`RunFigures::skipped`].
 
-use super::contacts;
 use super::figures::{self, Arrow, Axes, Series};
-use super::final_state::FinalState;
+use crate::engine::contacts;
+use crate::engine::FinalState;
 use crate::error::{Error, Result};
 use crate::nscd::System;
 use crate::run::files;

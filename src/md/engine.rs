@@ -12,14 +12,14 @@
 use super::contacts::MdContactKind;
 use super::system::{MdStepStats, MdSystem};
 use super::walls::Motion;
+use crate::engine::contacts::{ContactKind, ContactRow};
+use crate::engine::final_state::{BodyState, FinalState, Spin, WallState};
+use crate::engine::StepSummary;
+use crate::engine::{Configuration, Energies, Engine};
 use crate::error::{Error, Result};
-use crate::io::contacts::{ContactKind, ContactRow};
 use crate::io::cycles::{MdCycleRow, MdCycleState, MD_CYCLE_COLUMNS};
-use crate::io::final_state::{BodyState, FinalState, Spin, WallState};
 use crate::io::series::{MdSeriesRow, MD_SERIES_COLUMNS};
-use crate::io::summary::StepSummary;
 use crate::io::vtk::PvdCollection;
-use crate::run::{Configuration, Energies, Engine};
 use std::path::Path;
 
 impl MdSystem {
@@ -263,12 +263,12 @@ impl Engine for MdSystem {
         MdSystem::set_configuration(self, c)
     }
 
-    fn boundaries(&self) -> Vec<crate::run::Boundary> {
+    fn boundaries(&self) -> Vec<crate::engine::Boundary> {
         let up = self.up();
         self.walls
             .iter()
             .filter(|w| matches!(w.motion, super::Motion::Servo { .. }))
-            .map(|w| crate::run::Boundary {
+            .map(|w| crate::engine::Boundary {
                 name: w.name.clone(),
                 s: w.s,
                 down: w.normal().map_or(0.0, |n| -n.dot(&up)),
@@ -280,7 +280,7 @@ impl Engine for MdSystem {
         MdSystem::set_servo_positions(self, s)
     }
 
-    fn relax(&mut self, settings: &crate::settlement::RelaxSettings) -> Result<crate::settlement::RelaxReport> {
+    fn relax(&mut self, settings: &crate::engine::RelaxSettings) -> Result<crate::engine::RelaxReport> {
         MdSystem::relax(self, settings)
     }
 }

@@ -16,8 +16,8 @@
 
 use super::contact::History;
 use super::system::MdSystem;
+use crate::engine::relax::{minimise, Functional, RelaxReport, RelaxSettings};
 use crate::error::{Error, Result};
-use crate::settlement::relax::{minimise, Functional, RelaxReport, RelaxSettings};
 use nalgebra::Vector3;
 
 type V3 = Vector3<f64>;
@@ -132,7 +132,7 @@ impl MdSystem {
         if let Some(&i) = settings.held.iter().find(|&&i| i >= n) {
             return Err(Error::Scene(format!("relaxation: held sphere {i} does not exist ({n} spheres)")));
         }
-        let before = crate::run::Engine::configuration(self);
+        let before = crate::engine::Engine::configuration(self);
         let outcome = {
             let mut potential = Potential::new(self, &settings.held);
             let mut x = potential.start();

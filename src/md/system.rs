@@ -611,7 +611,7 @@ impl MdSystem {
     /// # Errors
     /// [`Error::Scene`] if `c` has not 6 coordinates per sphere, names an unknown
     /// sphere or holds a non-finite value; the system is then unchanged.
-    pub fn set_configuration(&mut self, c: &crate::run::Configuration) -> Result<()> {
+    pub fn set_configuration(&mut self, c: &crate::engine::Configuration) -> Result<()> {
         c.check(6, self.particles.len())?;
         let p = &mut self.particles;
         for (k, &i) in c.bodies.iter().enumerate() {

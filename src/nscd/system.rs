@@ -320,7 +320,7 @@ impl System {
     /// # Errors
     /// [`crate::Error::Scene`] if `c` has not 3 coordinates per body, names an unknown
     /// or fixed body or holds a non-finite value; the system is then unchanged.
-    pub fn set_configuration(&mut self, c: &crate::run::Configuration) -> crate::Result<()> {
+    pub fn set_configuration(&mut self, c: &crate::engine::Configuration) -> crate::Result<()> {
         self.bodies.place(c, self.time)?;
         self.contacts.clear();
         self.impulses.clear();
@@ -399,12 +399,9 @@ impl System {
     ///
     /// # Errors
     /// [`crate::Error::Scene`] for settings out of range or a held body that does not exist.
-    pub fn relax(
-        &mut self,
-        settings: &crate::settlement::RelaxSettings,
-    ) -> crate::Result<crate::settlement::RelaxReport> {
+    pub fn relax(&mut self, settings: &crate::engine::RelaxSettings) -> crate::Result<crate::engine::RelaxReport> {
         let (report, q) = crate::plane::relax::project(&self.bodies, settings)?;
-        let mut c = crate::run::Engine::configuration(self);
+        let mut c = crate::engine::Engine::configuration(self);
         for (k, &i) in c.bodies.clone().iter().enumerate() {
             c.body_mut(k).copy_from_slice(&q[i]);
         }

@@ -331,7 +331,7 @@ impl Bodies {
     /// # Errors
     /// [`Error::Scene`] if `c` has not 3 coordinates per body, names an unknown
     /// or fixed body or holds a non-finite value; the bodies are then unchanged.
-    pub fn place(&mut self, c: &crate::run::Configuration, time: f64) -> Result<()> {
+    pub fn place(&mut self, c: &crate::engine::Configuration, time: f64) -> Result<()> {
         c.check(3, self.len())?;
         if let Some(&i) = c.bodies.iter().find(|&&i| self.info[i].fixed) {
             return Err(Error::Scene(format!(

@@ -3,14 +3,14 @@
 //! per-cycle output that follows a body (the sleeper: Saussine et al. 2006 §4),
 //! the coordination number and the generalised positions `(x, y, θ)` a driver
 //! reads. The NSCD engine ([`crate::nscd::engine`]) and the planar MD engine
-//! (`md::planar::engine`) implement [`crate::run::Engine`] through these.
+//! (`md::planar::engine`) implement [`crate::engine::Engine`] through these.
 
 use super::{Bodies, ContactInfo};
+use crate::engine::contacts::{ContactKind, ContactRow};
+use crate::engine::final_state::{BodyState, FinalState, Spin};
+use crate::engine::Configuration;
 use crate::error::{Error, Result};
-use crate::io::contacts::{ContactKind, ContactRow};
 use crate::io::cycles::{NscdCycleRow, NscdCycleState};
-use crate::io::final_state::{BodyState, FinalState, Spin};
-use crate::run::Configuration;
 
 /// A 2D system as the shared outputs see it.
 pub trait PlaneSystem {

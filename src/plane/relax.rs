@@ -30,9 +30,9 @@
 use super::detection::Detector;
 use super::springs::gen_dir;
 use super::Bodies;
+use crate::engine::relax::{minimise, Functional, RelaxReport, RelaxSettings};
 use crate::error::{Error, Result};
 use crate::geometry::Vec2;
-use crate::settlement::relax::{minimise, Functional, RelaxReport, RelaxSettings};
 
 /// The penalised projection of a configuration (module doc).
 pub struct Projection<'a> {

@@ -84,7 +84,7 @@ pub fn crushed(springs: &[Spring], q: &[[f64; 3]]) -> Option<(usize, String)> {
 
 /// The bodies tied to a fixed anchor by a spring (the sublayer pads), sorted,
 /// each once: their positions follow the springs' load, not a trend of their
-/// own ([`crate::run::Engine::anchored_bodies`]).
+/// own ([`crate::engine::Engine::anchored_bodies`]).
 pub fn anchored(springs: &[Spring]) -> Vec<usize> {
     let mut bodies: Vec<usize> = springs.iter().filter(|s| s.b.is_none()).map(|s| s.a).collect();
     bodies.sort_unstable();

@@ -1,4 +1,4 @@
-//! Running a simulation: the [`Engine`] trait both engines implement, the run
+//! Running a simulation: the [`Engine`](crate::engine::Engine) trait both engines implement, the run
 //! loop over it ([`Runner`]: equilibrium stop, outputs, checkpoints and
 //! `--resume`, divergence handling, progress callback) and [`run_file`], which
 //! runs a scene file of either engine.
@@ -13,15 +13,13 @@
 //! A system built in code goes through [`Runner::from_system`] with a
 //! [`RunPlan`] (see the crate documentation and `examples/library_run.rs`).
 
-mod engine;
 mod equilibrium;
 mod runner;
 
-pub use engine::{Boundary, Configuration, Energies, Engine};
 pub use equilibrium::{Equilibrium, EquilibriumWatch, DEFAULT_EQUILIBRIUM_STEPS};
 pub(crate) use runner::body_names;
 pub use runner::{
-    check_options, cores, default_threads, files, CyclePlan, Prior, Progress, Restart, RunLength, RunOptions,
+    check_options, cores, default_threads, files, CyclePlan, Figures, Prior, Progress, Restart, RunLength, RunOptions,
     RunOutcome, RunPlan, Runner, Status,
 };
 
@@ -52,7 +50,11 @@ pub fn run_file(
             let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts.clone() };
             let (system, plan) = (scene.build()?, scene.plan()?);
             let restart: Restart<crate::md::MdSystem> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
-            Runner::from_scene(system, plan, scene_path, text, Some(restart)).run(out, &opts, progress)
+            let figures: Figures<crate::md::MdSystem> =
+                Box::new(|dir, _| crate::io::run_figures::draw_run_figures(dir).map(drop));
+            Runner::from_scene(system, plan, scene_path, text, Some(restart))
+                .with_figures(figures)
+                .run(out, &opts, progress)
         }
         SceneKind::PlanarMd => {
             let (mut scene, text) = scene_on(&text, &name, SceneKind::PlanarMd, opts.engine.is_some())?;
@@ -62,14 +64,28 @@ pub fn run_file(
             let model = serde_json::to_value(info).map_err(|e| crate::Error::Io(std::io::Error::other(e)))?;
             let restart: Restart<crate::md::planar::PlanarSystem> =
                 Box::new(move |sys| scene.with_bodies(&sys.bodies).to_toml_string());
-            Runner::from_scene(system, plan, scene_path, text, Some(restart)).with_model(model).run(out, opts, progress)
+            Runner::from_scene(system, plan, scene_path, text, Some(restart))
+                .with_model(model)
+                .with_figures(plane_figures::<crate::md::planar::PlanarSystem>())
+                .run(out, opts, progress)
         }
         SceneKind::Nscd => {
             let (mut scene, text) = scene_on(&text, &name, SceneKind::Nscd, opts.engine.is_some())?;
             let text = scene.text_with_length(text, opts.length)?;
             let (system, plan) = (scene.build()?, scene.plan()?);
             let restart: Restart<crate::nscd::System> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
-            Runner::from_scene(system, plan, scene_path, text, Some(restart)).run(out, opts, progress)
+            Runner::from_scene(system, plan, scene_path, text, Some(restart))
+                .with_figures(plane_figures::<crate::nscd::System>())
+                .run(out, opts, progress)
         }
     }
+}
+
+/// The figures of a run of either 2D engine: from its folder, with the positions at the end of the first
+/// cycle kept by its per-cycle state (the reference of the displacement field).
+fn plane_figures<E: crate::engine::Engine<CycleState = crate::io::cycles::NscdCycleState>>() -> Figures<E> {
+    Box::new(|dir, cycles| {
+        let first = cycles.and_then(|c| c.first_cycle_q.as_deref());
+        crate::io::run_figures::nscd_figures(dir, first).map(drop)
+    })
 }

@@ -14,12 +14,12 @@
 //! `contacts.csv`, `summary.json` (and figures, if asked) are written before the
 //! error is returned.
 
-use super::engine::Engine;
 use super::equilibrium::Equilibrium;
 use crate::clock::cycles_at;
+use crate::engine::CycleCheck;
+use crate::engine::Engine;
 use crate::error::{Error, Result};
 use crate::io::checkpoint::{crc32, Checkpoint, CHECKPOINT_FILE};
-use crate::io::cycles::CycleCheck;
 use crate::io::positions::{PositionsWriter, BODIES_FILE, DISPLACEMENTS_FILE};
 use crate::io::summary::{RunEnd, RunReport, RunSummary};
 use crate::io::table::TableWriter;
@@ -102,7 +102,8 @@ pub struct RunOptions {
     pub vtk_every: u64,
     /// Threads of a step (1 or 2).
     pub threads: usize,
-    /// Draw the run's figures at the end.
+    /// Draw the run's figures at the end (a run of a scene file, [`super::run_file`], or one given
+    /// [`Runner::with_figures`]; else the run refuses it).
     pub figures: bool,
     /// A scene file's `[simulation] duration` replaced for this run (for quick
     /// tries); the scene copy in the output folder records it. `None`: the
@@ -163,7 +164,7 @@ pub struct Progress {
     pub time: f64,
     /// Kinetic energy of the step (J).
     pub kinetic_energy: f64,
-    /// Contacts of the step (as [`crate::io::StepSummary::contacts`] counts them).
+    /// Contacts of the step (as [`crate::engine::StepSummary::contacts`] counts them).
     pub contacts: f64,
     /// Loading cycles completed, and in the whole run.
     pub cycles: Option<(u64, u64)>,
@@ -205,6 +206,12 @@ pub struct RunOutcome {
 /// Writes the final state of a system as a scene text.
 pub type Restart<E> = Box<dyn Fn(&E) -> Result<String> + Send + Sync>;
 
+/// Draws the figures of a finished run from its folder (`ballast figures`); the per-cycle state the run
+/// ended with, if it had one, gives what the files do not hold (NSCD: the positions at the end of the first
+/// cycle). Given by whoever opens the scene ([`super::run_file`]), which knows the engine's figures; the run
+/// loop only calls it when [`RunOptions::figures`] asks.
+pub type Figures<E> = Box<dyn Fn(&Path, Option<&<E as Engine>::CycleState>) -> Result<()> + Send + Sync>;
+
 /// Where the system of a run comes from.
 enum Origin {
     /// A scene file: its path (for the copy and the header) and text.
@@ -221,6 +228,8 @@ pub struct Runner<E: Engine> {
     restart: Option<Restart<E>>,
     /// What the scene resolved to that the system does not say, for `run.json`.
     model: Option<serde_json::Value>,
+    /// The figures drawn at the end when [`RunOptions::figures`] asks.
+    figures: Option<Figures<E>>,
 }
 
 /// The state of a run in progress.
@@ -240,13 +249,27 @@ impl<E: Engine> Runner<E> {
     /// `text`; `restart` writes a system's state as a scene to restart from
     /// (`final_scene.toml`).
     pub fn from_scene(system: E, plan: RunPlan, path: &Path, text: String, restart: Option<Restart<E>>) -> Self {
-        Self { system, plan, origin: Origin::Scene { path: path.to_path_buf(), text }, restart, model: None }
+        Self {
+            system,
+            plan,
+            origin: Origin::Scene { path: path.to_path_buf(), text },
+            restart,
+            model: None,
+            figures: None,
+        }
     }
 
     /// The same run, with `model` (what the scene resolved to: the planar MD
     /// engine's derived stiffness and time step) recorded in `run.json`.
     pub fn with_model(mut self, model: serde_json::Value) -> Self {
         self.model = Some(model);
+        self
+    }
+
+    /// The same run, drawing its figures with `figures` at the end when [`RunOptions::figures`] asks
+    /// ([`super::run_file`] gives each engine's).
+    pub fn with_figures(mut self, figures: Figures<E>) -> Self {
+        self.figures = Some(figures);
         self
     }
 
@@ -260,7 +283,7 @@ impl<E: Engine> Runner<E> {
         }
         let json = serde_json::to_string(&Input { plan: &plan, system: &system })
             .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-        Ok(Self { system, plan, origin: Origin::Code { json }, restart: None, model: None })
+        Ok(Self { system, plan, origin: Origin::Code { json }, restart: None, model: None, figures: None })
     }
 
     /// The plan of the run.
@@ -285,6 +308,13 @@ impl<E: Engine> Runner<E> {
     /// state has been written (`series.csv` row, `final.json`, `summary.json`).
     pub fn run(&self, out: &Path, opts: &RunOptions, progress: &mut dyn FnMut(&Progress)) -> Result<RunOutcome> {
         check_options(opts)?;
+        if opts.figures && self.figures.is_none() {
+            return Err(Error::Scene(
+                "figures: this run has no figure drawer (a run of a scene file draws its engine's; a system built \
+                 in code draws them after the run with ballast::io::run_figures::draw_run_figures)"
+                    .into(),
+            ));
+        }
         let plan = &self.plan;
         if plan.output_every == 0 {
             return Err(Error::Scene("output.every: must be at least 1, got 0".into()));
@@ -407,10 +437,10 @@ impl<E: Engine> Runner<E> {
         }
         let cycle_state = state.map(|(s, _)| s);
         live.sys.final_state().write(&out.join(files::FINAL))?;
-        io::contacts::write(&out.join(files::CONTACTS), &live.sys.contact_rows())?;
+        crate::engine::contacts::write(&out.join(files::CONTACTS), &live.sys.contact_rows())?;
         io::write_json(&out.join(files::SUMMARY), &report)?;
-        if opts.figures {
-            live.sys.figures(out, cycle_state.as_ref())?;
+        if let (true, Some(draw)) = (opts.figures, &self.figures) {
+            draw(out, cycle_state.as_ref())?;
         }
         if let Some(e) = diverged {
             return Err(e);

@@ -355,7 +355,8 @@ pub(crate) fn check_settlement(
     sim: &Simulation,
     mobile_body: impl Fn(&str) -> std::result::Result<SettlementRef, String>,
 ) -> Result<Option<AccelerationPlan>> {
-    use crate::settlement::{relax::Method, Acceleration, Adaptive, Law};
+    use crate::engine::Method;
+    use crate::settlement::{Acceleration, Adaptive, Law};
     let Some(s) = s else { return Ok(None) };
     let Some(c) = cycles else {
         return err("settlement: needs the loading frequency of [output] cycles = { frequency = … }".into());

@@ -45,16 +45,17 @@ pub use rows::{AccelerationOutcome, AccelerationProgress, AccelerationSummary, J
 
 use super::estimate::{chernoff_cycles, extrapolate_within, fit, trend_moves, Training};
 use super::law::{Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
-use super::relax::{RelaxReport, RelaxSettings};
 use super::smooth::Smoothing;
 use super::sweep;
 use crate::clock::cycles_at;
+use crate::engine::{Boundary, Configuration, Engine};
+use crate::engine::{RelaxReport, RelaxSettings};
 use crate::error::{Error, Result};
 use crate::io::checkpoint::{check_origin, crc32, read_checked, write_checked, CHECKPOINT_FILE};
 use crate::io::positions::{PositionsWriter, BODIES_FILE, DISPLACEMENTS_FILE};
 use crate::io::table::TableWriter;
 use crate::io::{self, RunInfo};
-use crate::run::{body_names, files, Boundary, Configuration, Engine, RunOptions};
+use crate::run::{body_names, files, RunOptions};
 use rollback::Landing;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;

@@ -14,8 +14,8 @@
 
 use super::law::{Coefficients, ResidualLaw};
 use super::smooth::Smoothing;
+use crate::engine::Configuration;
 use crate::error::{Error, Result};
-use crate::run::Configuration;
 
 /// The training data of one window: the configurations at the ends of the
 /// computed cycles `N_0 < N_1 < … < N_k` (`N_0` the start of the window), and the

@@ -9,22 +9,19 @@
 //! - [`estimate`]: the fit of a window of computed cycles, the extrapolation, the
 //!   accuracy measures `g_u` and `f_ξ` (eqs. 13–14), the Chernoff bound (eq. 15)
 //!   and the relative configuration error `E_r` (eq. 22);
-//! - [`driver`]: the procedure of Fig. 10 over any [`crate::run::Engine`]
+//! - [`driver`]: the procedure of Fig. 10 over any [`crate::engine::Engine`]
 //!   ([`Accelerated`]), its tables (`settlement.csv`, `jumps.csv`), summary and
 //!   checkpoints;
 //! - [`figures`]: an accelerated run's figures and its errors against a full run;
 //! - [`file`](mod@file): a scene file's `[settlement]` run through it (`ballast run`);
-//! - [`relax`]: the minimisation of an engine's relaxation functional (L-BFGS,
-//!   or the paper's steepest descent as a baseline) until the largest overlap
-//!   is below a tolerance; the functionals are the engines' (MD: eq. 29,
-//!   `crate::md::relax`; NSCD: `crate::nscd::relax`).
+//! - the relaxation after a jump is the engines' service ([`crate::engine::relax`]: an engine's functional
+//!   minimised by L-BFGS, or the paper's steepest descent, until the largest overlap is below a tolerance).
 
 pub mod driver;
 pub mod estimate;
 pub mod figures;
 pub mod file;
 pub mod law;
-pub mod relax;
 pub mod smooth;
 pub mod sweep;
 
@@ -38,5 +35,4 @@ pub use estimate::{
 };
 pub use file::run_file;
 pub use law::{law_named, Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
-pub use relax::{minimise, Functional, Method, RelaxReport, RelaxSettings};
 pub use smooth::Smoothing;

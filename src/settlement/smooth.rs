@@ -25,7 +25,7 @@
 //! (the settlement body, bodies without contact) neither take part in the
 //! others' fits nor take one: they keep their own move.
 
-use crate::run::Configuration;
+use crate::engine::Configuration;
 use std::collections::HashMap;
 
 /// The cut-off of the Gaussian weights, in smoothing lengths.

@@ -28,9 +28,9 @@
 //! `relax_stage` (default [`RELAX_STAGE`]) times the smallest body's size; an
 //! infinite `relax_stage` is the paper's single relaxation.
 
-use super::relax::{RelaxReport, RelaxSettings};
+use crate::engine::{Configuration, Engine};
+use crate::engine::{RelaxReport, RelaxSettings};
 use crate::error::Result;
-use crate::run::{Configuration, Engine};
 
 /// The default `relax_stage`: a stage moves a point of a body by at most a
 /// quarter of the smallest body's size (on the Saussine sample 1.1 mm, a

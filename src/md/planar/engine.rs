@@ -7,17 +7,16 @@
 //! files that compare column by column.
 
 use super::system::{PlanarStepStats, PlanarSystem};
+use crate::engine::contacts::ContactRow;
+use crate::engine::final_state::FinalState;
+use crate::engine::StepSummary;
+use crate::engine::{Configuration, Energies, Engine};
 use crate::error::Result;
-use crate::io::contacts::ContactRow;
 use crate::io::cycles::{NscdCycleRow, NscdCycleState, NSCD_CYCLE_COLUMNS};
-use crate::io::final_state::FinalState;
-use crate::io::run_figures::RunFigures;
 use crate::io::series::{NscdSeriesRow, NSCD_SERIES_COLUMNS};
-use crate::io::summary::StepSummary;
 use crate::io::vtk::PvdCollection;
 use crate::plane::outputs::{self, PlaneSystem};
 use crate::plane::{Bodies, ContactInfo};
-use crate::run::{Configuration, Energies, Engine};
 use std::path::Path;
 
 impl PlaneSystem for PlanarSystem {
@@ -156,11 +155,6 @@ impl Engine for PlanarSystem {
         outputs::settlement(self, c)
     }
 
-    fn figures(&self, dir: &Path, cycles: Option<&NscdCycleState>) -> Result<RunFigures> {
-        let first = cycles.and_then(|c| c.first_cycle_q.as_deref());
-        crate::io::run_figures::nscd_figures(dir, first)
-    }
-
     fn coordination(&self) -> f64 {
         outputs::coordination(self, &outputs::mobile_bodies(&self.bodies), 0.0).z
     }
@@ -190,7 +184,7 @@ impl Engine for PlanarSystem {
         PlanarSystem::set_configuration(self, c)
     }
 
-    fn relax(&mut self, settings: &crate::settlement::RelaxSettings) -> Result<crate::settlement::RelaxReport> {
+    fn relax(&mut self, settings: &crate::engine::RelaxSettings) -> Result<crate::engine::RelaxReport> {
         PlanarSystem::relax(self, settings)
     }
 }

@@ -237,7 +237,7 @@ impl PlanarSystem {
     /// # Errors
     /// [`Error::Scene`] if `c` has not 3 coordinates per body, names an unknown or
     /// fixed body or holds a non-finite value; the system is then unchanged.
-    pub fn set_configuration(&mut self, c: &crate::run::Configuration) -> Result<()> {
+    pub fn set_configuration(&mut self, c: &crate::engine::Configuration) -> Result<()> {
         self.bodies.place(c, self.time())?;
         self.points.clear();
         self.contact_energy = 0.0;
@@ -251,7 +251,7 @@ impl PlanarSystem {
     ///
     /// # Errors
     /// [`Error::Scene`] for settings out of range or a held body that does not exist.
-    pub fn relax(&mut self, settings: &crate::settlement::RelaxSettings) -> Result<crate::settlement::RelaxReport> {
+    pub fn relax(&mut self, settings: &crate::engine::RelaxSettings) -> Result<crate::engine::RelaxReport> {
         let (report, q) = crate::plane::relax::project(&self.bodies, settings)?;
         let mobile = crate::plane::outputs::mobile_bodies(&self.bodies);
         let mut c = crate::plane::outputs::configuration_of(&self.bodies, &mobile);

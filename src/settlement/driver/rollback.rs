@@ -26,8 +26,8 @@
 //! function of the state, so a rolled-back run is as deterministic as any.
 
 use super::{sync_tables, Accelerated, Files, JumpRow, State};
+use crate::engine::Engine;
 use crate::error::{Error, Result};
-use crate::run::Engine;
 use crate::settlement::law::ResidualLaw;
 use std::path::Path;
 use std::time::Instant;

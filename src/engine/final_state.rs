@@ -77,11 +77,11 @@ pub struct FinalState {
 impl FinalState {
     /// Writes the state as pretty JSON to `path`.
     pub fn write(&self, path: &Path) -> Result<PathBuf> {
-        super::write_json(path, self)
+        crate::io::write_json(path, self)
     }
 
     /// Reads a `final.json`; the error names the file.
     pub fn read(path: &Path) -> Result<Self> {
-        super::read_json(path)
+        crate::io::read_json(path)
     }
 }

@@ -1,6 +1,6 @@
 //! `contacts.csv`: the contact list at the end of a run (or, after a
 //! divergence, of its last good step), one row per contact, written by the run
-//! loop for both engines with a [`super::table::TableWriter`] and read back with
+//! loop for both engines with a [`crate::io::table::TableWriter`] and read back with
 //! the same row type ([`read`]).
 //!
 //! Columns ([`ContactRow`]), units in the names:
@@ -26,8 +26,8 @@
 //! force evaluation applied ([`crate::md::MdSystem::contact_forces`]; a contact
 //! with a symmetry image is listed once for each real sphere, the force on it).
 
-use super::table::TableWriter;
 use crate::error::Result;
+use crate::io::table::TableWriter;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -134,7 +134,7 @@ pub fn write(path: &Path, rows: &[ContactRow]) -> Result<()> {
 
 /// Reads a `contacts.csv`; the error names the file and the line.
 pub fn read(path: &Path) -> Result<Vec<ContactRow>> {
-    Ok(super::table::read(path)?.1)
+    Ok(crate::io::table::read(path)?.1)
 }
 
 #[cfg(test)]

@@ -1,4 +1,4 @@
-//! The engine interface: what the run loop ([`super::Runner`]) and a cyclic
+//! The engine interface: what the run loop ([`crate::run::Runner`]) and a cyclic
 //! driver need of an engine, implemented by [`crate::nscd::System`] (rigid 2D
 //! polygons, non-smooth contact dynamics) and [`crate::md::MdSystem`] (soft 3D
 //! spheres, molecular dynamics).
@@ -12,19 +12,14 @@
 //! back with the velocities zeroed and every derived state rebuilt, so that the
 //! next step starts exactly from the written configuration.
 
+use super::{Boundary, Configuration, ContactRow, FinalState, RelaxReport, RelaxSettings, StepSummary};
 use crate::error::Result;
-use crate::io::contacts::ContactRow;
-use crate::io::cycles::CycleCheck;
-use crate::io::run_figures::RunFigures;
-use crate::io::summary::StepSummary;
 use crate::io::vtk::PvdCollection;
-use crate::io::FinalState;
-use crate::settlement::relax::{RelaxReport, RelaxSettings};
 use serde::de::DeserializeOwned;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use std::path::Path;
 
-/// Energies of the equilibrium rule ([`super::Equilibrium`]) at the end of a step (J).
+/// Energies of the equilibrium rule ([`crate::run::Equilibrium`]) at the end of a step (J).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Energies {
     /// Kinetic energy of everything that moves (J).
@@ -33,76 +28,14 @@ pub struct Energies {
     pub potential: f64,
 }
 
-/// The generalised positions of some bodies of an engine: `dof` coordinates per
-/// body, body after body.
-///
-/// In 2D (NSCD) `dof = 3`: the centre of mass `x`, `y` (m) and the angle `θ`
-/// (rad). In 3D (MD) `dof = 6`: the centre `x`, `y`, `z` (m) and the rotation
-/// vector of the orientation (axis × angle, rad, angle in [0, π]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Configuration {
-    /// Coordinates per body.
-    pub dof: usize,
-    /// Index of each body in the engine (its order in the scene).
-    pub bodies: Vec<usize>,
-    /// Coordinate `d` of the `k`-th body is `q[k * dof + d]` (m or rad).
-    pub q: Vec<f64>,
-}
-
-impl Configuration {
-    /// The coordinates of the `k`-th body of the configuration.
-    pub fn body(&self, k: usize) -> &[f64] {
-        &self.q[k * self.dof..(k + 1) * self.dof]
-    }
-
-    /// The coordinates of the `k`-th body, mutable.
-    pub fn body_mut(&mut self, k: usize) -> &mut [f64] {
-        &mut self.q[k * self.dof..(k + 1) * self.dof]
-    }
-
-    /// Number of bodies.
-    pub fn len(&self) -> usize {
-        self.bodies.len()
-    }
-
-    /// True if there are no bodies.
-    pub fn is_empty(&self) -> bool {
-        self.bodies.is_empty()
-    }
-
-    /// Checks the shape of the configuration against an engine with `bodies`
-    /// bodies and `dof` coordinates each, and that every number is finite; the
-    /// message names the first offending body.
-    pub fn check(&self, dof: usize, bodies: usize) -> Result<()> {
-        let bad = |msg: String| Err(crate::Error::Scene(format!("configuration: {msg}")));
-        if self.dof != dof {
-            return bad(format!("{} coordinates per body, the engine has {dof}", self.dof));
-        }
-        if self.q.len() != self.bodies.len() * dof {
-            return bad(format!("{} coordinates for {} bodies of {dof}", self.q.len(), self.bodies.len()));
-        }
-        for (k, &i) in self.bodies.iter().enumerate() {
-            if i >= bodies {
-                return bad(format!("body {i} does not exist (the engine has {bodies})"));
-            }
-            if let Some(d) = self.body(k).iter().position(|x| !x.is_finite()) {
-                return bad(format!("body {i}: coordinate {d} is not finite ({})", self.body(k)[d]));
-            }
-        }
-        Ok(())
-    }
-}
-
-/// A boundary body that moves under its own dynamics, outside the
-/// [`Configuration`] of the bodies (MD: a servo wall, e.g. the loading plate).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Boundary {
-    /// Its name in the scene.
-    pub name: String,
-    /// Its coordinate (m): a servo wall's displacement along its normal since the start.
-    pub s: f64,
-    /// How far it goes down (along gravity) per unit of `s` (dimensionless: `−n·up`).
-    pub down: f64,
+/// The check of a per-cycle state read from a checkpoint.
+pub trait CycleCheck {
+    /// Checks `self`, read from a checkpoint written after `cycles` completed
+    /// cycles of a system of `bodies` bodies, against `start`, the state the
+    /// run started with ([`crate::engine::Engine::cycle_start`]): what the
+    /// per-cycle output follows and starts from, and the shape of what it
+    /// keeps. The message says what differs.
+    fn check(&self, start: &Self, bodies: usize, cycles: u64) -> std::result::Result<(), String>;
 }
 
 /// A time-stepping engine driven by the run loop and by cyclic drivers.
@@ -180,7 +113,7 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     fn final_state(&self) -> FinalState;
 
     /// The contacts of the last step with their forces, for `contacts.csv`
-    /// ([`crate::io::contacts`]).
+    /// ([`crate::engine::contacts`]).
     fn contact_rows(&self) -> Vec<ContactRow>;
 
     /// Writes a ParaView snapshot of the current state into `dir` and lists it in `pvd`.
@@ -212,14 +145,6 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// cycle output follows one.
     fn settlement(&self, _state: &Self::CycleState) -> Option<f64> {
         None
-    }
-
-    /// Draws the figures of a finished run from its folder `dir` (PNG + SVG,
-    /// [`crate::io::run_figures::draw_run_figures`], the same as `ballast
-    /// figures`); `cycles` is the per-cycle state if the run had one, for what
-    /// the files do not hold (NSCD: the positions at the end of the first cycle).
-    fn figures(&self, dir: &Path, _cycles: Option<&Self::CycleState>) -> Result<RunFigures> {
-        crate::io::run_figures::draw_run_figures(dir)
     }
 
     /// The coordination number of the current state, as the engine measures it
