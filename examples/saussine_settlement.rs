@@ -63,7 +63,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let steps = loaded.steps();
         let opts = RunOptions { figures: true, vtk_every: steps, ..RunOptions::default() };
         let run = run_file(&path, &dir, &opts, &mut |_| {})?;
-        assert_eq!(run.status, Status::Ended(ballast::io::RunEnd::Finished));
+        assert_eq!(run.status, Status::Ended(ballast::run::RunEnd::Finished));
         let rows = ballast::io::cycles::read_nscd(&dir.join("cycles.csv"))?;
         for row in &rows {
             println!(

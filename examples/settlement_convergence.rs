@@ -30,7 +30,7 @@
 //! first cycles seat the sleeper and dominate the total.
 
 use ballast::io::figures::{line_chart, Axes, Series};
-use ballast::io::positions::CyclePositions;
+use ballast::run::positions::CyclePositions;
 use ballast::run::{RunOptions, Runner, Status};
 use ballast::scenarios::saussine::{loaded_scene, sample_scene, LoadingSpec, SampleSpec};
 use ballast::scene::Scene;
@@ -193,7 +193,7 @@ fn loaded_sample(grains: usize, cycles: u64, out: &Path) -> Result<Scene, ballas
     let dir = out.join("deposit");
     let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
     let deposit = Runner::from_system(scene.build()?, scene.plan()?)?.run(&dir, &opts, &mut |_| {})?;
-    if deposit.status != Status::Ended(ballast::io::RunEnd::Equilibrium) {
+    if deposit.status != Status::Ended(ballast::run::RunEnd::Equilibrium) {
         eprintln!("warning: the deposit ended without reaching equilibrium ({:?})", deposit.status);
     }
     let fin = ballast::engine::FinalState::read(&dir.join("final.json"))?;
@@ -222,7 +222,7 @@ fn run(scene: &Scene, k: u64, h: u64, cycles: u64, dir: &Path) -> Result<Done, b
     Ok(Done {
         rows: ballast::io::read_csv(&dir.join("settlement.csv"))?,
         summary: outcome.summary,
-        positions: ballast::io::positions::read(dir)?,
+        positions: ballast::run::positions::read(dir)?,
     })
 }
 

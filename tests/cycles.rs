@@ -57,7 +57,7 @@ fn cycle_settlement_of_a_sprung_pad_is_the_quasi_static_deflection() {
         .collect();
     // The positions at the cycle ends: the pad's height is y0 minus the settlement
     // at the cycle's last step, to the float32 resolution of the stored displacement.
-    let positions = ballast::io::positions::read(&dir).unwrap();
+    let positions = ballast::run::positions::read(&dir).unwrap();
     assert_eq!((positions.reference.bodies.clone(), positions.cycles.len()), (vec![p], 3));
     let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(rows.len(), 3, "one row per 20 Hz cycle over 0.15 s");

@@ -19,7 +19,7 @@
 //! Gauss–Seidel) stays within these bounds; a solver that converged worse
 //! would not.
 
-use ballast::io::RunEnd;
+use ballast::run::RunEnd;
 use ballast::run::{RunOptions, Runner};
 use ballast::scenarios::{pentagon_deposit, DepositSpec};
 

@@ -34,7 +34,7 @@
 //! `--nocapture`). Failures in code another session is changing are listed in
 //! [`KNOWN`] (with a TODO) and reported, not failed.
 
-use ballast::io::checkpoint::crc32;
+use ballast::run::checkpoint::crc32;
 use ballast::run::{run_file, Progress, RunOptions, RunOutcome, Status};
 use ballast::scene::{engine_of, MdScene, Scene};
 use ballast::Error;

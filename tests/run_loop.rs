@@ -7,7 +7,7 @@
 
 use ballast::engine::Engine;
 use ballast::engine::FinalState;
-use ballast::io::RunEnd;
+use ballast::run::RunEnd;
 use ballast::run::{RunOptions, RunPlan, Runner, Status};
 use ballast::scene::{MdScene, Scene};
 use ballast::Error;
@@ -272,7 +272,8 @@ fn md_divergence_keeps_the_last_good_state() {
 /// Every CSV of a run of each engine reads back through the library's row types.
 #[test]
 fn outputs_read_back_through_the_row_types() {
-    use ballast::io::{cycles, positions, series};
+    use ballast::io::{cycles, series};
+    use ballast::run::positions;
     let dir = temp_dir("read_back");
     let scene = Scene::from_toml_str(NSCD).unwrap();
     let nscd = dir.join("nscd");

@@ -32,7 +32,7 @@ fn deposit(seed: u64) -> (Scene, f64) {
     let run = Runner::from_system(sys.clone(), scene.plan().unwrap()).unwrap().run(&dir, &opts, &mut |_| {}).unwrap();
     assert_eq!(
         run.status,
-        Status::Ended(ballast::io::RunEnd::Equilibrium),
+        Status::Ended(ballast::run::RunEnd::Equilibrium),
         "the deposit did not reach equilibrium within {} s",
         scene.simulation.duration
     );

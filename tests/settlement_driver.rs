@@ -4,7 +4,7 @@
 //! with 1.8× fewer computed cycles, within the spread of full runs whose start
 //! differs by 1e-9 m; its outputs, its checkpoint and its resume.
 
-use ballast::io::positions::CyclePositions;
+use ballast::run::positions::CyclePositions;
 use ballast::run::{RunOptions, Runner, Status};
 use ballast::scenarios::saussine::{loaded_scene, sample_scene, LoadingSpec, SampleSpec};
 use ballast::scene::Scene;
@@ -35,7 +35,7 @@ fn loaded() -> &'static Scene {
         let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
         let run = Runner::from_system(sys, scene.plan().unwrap()).unwrap();
         let out = run.run(&dir, &opts, &mut |_| {}).unwrap();
-        assert_eq!(out.status, Status::Ended(ballast::io::RunEnd::Equilibrium));
+        assert_eq!(out.status, Status::Ended(ballast::run::RunEnd::Equilibrium));
         let fin = ballast::engine::FinalState::read(&dir.join("final.json")).unwrap();
         let mut sys = scene.build().unwrap();
         for (i, b) in fin.bodies.iter().enumerate() {
@@ -68,7 +68,7 @@ fn accelerate(
     let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
     let out = run.run(&dir, &opts, &mut |_| {}).unwrap();
     let rows: Vec<SettlementRow> = ballast::io::read_csv(&dir.join("settlement.csv")).unwrap();
-    let positions = ballast::io::positions::read(&dir).unwrap();
+    let positions = ballast::run::positions::read(&dir).unwrap();
     let _ = std::fs::remove_dir_all(&dir);
     (rows, out.summary, positions)
 }

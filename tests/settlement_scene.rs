@@ -396,13 +396,13 @@ fn hold_anchored_keeps_the_sprung_bodies_where_the_computed_cycle_left_them() {
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("scene.toml"), t).unwrap();
         run_file(&dir.join("scene.toml"), &dir.join("out"), &opts, &mut |_| {}).unwrap().unwrap();
-        let p = ballast::io::positions::read(&dir.join("out")).unwrap();
+        let p = ballast::run::positions::read(&dir.join("out")).unwrap();
         let jumps = tables(&dir.join("out")).1;
         let _ = std::fs::remove_dir_all(dir);
         (p, jumps)
     };
     // The sprung grains' coordinates at the end of cycle `c` (cycles[0] ends cycle 1).
-    let sprung = |p: &ballast::io::positions::CyclePositions, c: u64| -> Vec<f64> {
+    let sprung = |p: &ballast::run::positions::CyclePositions, c: u64| -> Vec<f64> {
         ["grain1", "grain3"]
             .iter()
             .flat_map(|n| {

@@ -5,7 +5,7 @@
 //! the full run finished later.
 
 use super::{input, Failure};
-use ballast::settlement::driver::SETTLEMENT_FILE;
+use ballast::io::layout::{self, SETTLEMENT};
 use std::path::PathBuf;
 
 /// The arguments of `ballast figures`.
@@ -25,9 +25,9 @@ pub fn main(a: FiguresArgs) -> Result<(), Failure> {
     let figures = match &a.reference {
         None => ballast::io::run_figures::draw_run_figures(&a.dir)?,
         Some(reference) => {
-            if !a.dir.join(SETTLEMENT_FILE).is_file() {
+            if !a.dir.join(layout::SETTLEMENT).is_file() {
                 return Err(input(format!(
-                    "--reference: '{}' has no {SETTLEMENT_FILE} (the errors are those of an accelerated run)",
+                    "--reference: '{}' has no {SETTLEMENT} (the errors are those of an accelerated run)",
                     a.dir.display()
                 )));
             }
@@ -41,8 +41,7 @@ pub fn main(a: FiguresArgs) -> Result<(), Failure> {
         println!("skipped {stem}: {why}");
     }
     if a.reference.is_some() {
-        let summary: ballast::settlement::AccelerationSummary =
-            ballast::io::read_json(&a.dir.join(ballast::run::files::SUMMARY))?;
+        let summary: ballast::settlement::AccelerationSummary = ballast::io::read_json(&a.dir.join(layout::SUMMARY))?;
         super::saussine::print_errors(&a.dir, &summary)?;
     }
     Ok(())

@@ -256,7 +256,7 @@ pub(crate) fn print_outcome(o: &RunOutcome) {
                  energy {:.3e} J, max overlap {:.3e} m at the end ({:.3e} m during the run){solver}; outputs in {}",
                 o.step,
                 o.time,
-                if end == ballast::io::RunEnd::Equilibrium { " (equilibrium reached)" } else { "" },
+                if end == ballast::run::RunEnd::Equilibrium { " (equilibrium reached)" } else { "" },
                 o.elapsed_s,
                 r.body_steps_per_s,
                 r.threads,

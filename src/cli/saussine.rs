@@ -19,6 +19,7 @@
 //! and the load scaled alike (same pressure), unless `--sleeper-width` is given.
 
 use super::{input, print_sample, print_study, Bars, Failure};
+use ballast::io::layout;
 use ballast::run::default_threads;
 use ballast::scenarios::saussine::{Guide, SampleSpec};
 use ballast::studies::campaigns::{self, ConvergenceSpec, EnsembleSpec, StepsSpec, StudyOptions};
@@ -402,8 +403,7 @@ impl AccelerateArgs {
 
 /// The accrued-settlement error at the last cycle of an accelerated run compared with its reference.
 pub(crate) fn print_errors(out: &std::path::Path, s: &ballast::settlement::AccelerationSummary) -> Result<(), Failure> {
-    let rows: Vec<ballast::settlement::figures::ErrorRow> =
-        ballast::io::read_csv(&out.join(ballast::settlement::figures::ERRORS_FILE))?;
+    let rows: Vec<ballast::settlement::figures::ErrorRow> = ballast::io::read_csv(&out.join(layout::ERRORS))?;
     if let Some(last) = rows.last() {
         println!(
             "against the reference at cycle {}: settlement {:.4e} m vs {:.4e} m; error on what accrued after the {} \

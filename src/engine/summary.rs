@@ -1,5 +1,5 @@
 //! [`StepSummary`]: the numbers every engine reports for one step, which the run loop folds into a run's
-//! summary (`summary.json`, [`crate::io::RunSummary`]) and the statistics of Saussine et al. (2006), §3.2 (average
+//! summary (`summary.json`, [`crate::run::RunSummary`]) and the statistics of Saussine et al. (2006), §3.2 (average
 //! number of iterations) and §3.3 (interpenetration) are made of.
 
 use serde::{Deserialize, Serialize};

@@ -25,8 +25,8 @@ use super::figures::{self, Axes, Series};
 use super::run_figures::{max_abs, read_contacts, read_final, require, RunFigures};
 use super::series::{MdSeriesRow, MD_SERIES_COLUMNS};
 use crate::error::{Error, Result};
+use crate::io::layout;
 use crate::md::{MdSystem, Shape, Wall, V3};
-use crate::run::files;
 use std::path::Path;
 
 /// Sides of the polygon a sphere is drawn as.
@@ -39,7 +39,7 @@ const CIRCLE_SIDES: usize = 32;
 /// holds bodies without a 3D position and a radius.
 pub fn md_figures(dir: &Path) -> Result<RunFigures> {
     let fin = read_final(dir)?;
-    let series_path = require(dir, files::SERIES)?;
+    let series_path = require(dir, layout::SERIES)?;
     let (header, rows) = super::series::read_md(&series_path)?;
     let mut out = RunFigures::default();
     let curve = |label: &str, f: &dyn Fn(&MdSeriesRow) -> f64| Series {
@@ -112,7 +112,7 @@ pub fn md_figures(dir: &Path) -> Result<RunFigures> {
 /// `plate_settlement_cycles`: the servo walls' displacements at each cycle end
 /// (the trailing columns of `cycles.csv`, in the order of `servos`).
 fn plate_cycles(dir: &Path, servos: &[(usize, String)], out: &mut RunFigures) -> Result<()> {
-    let path = dir.join(files::CYCLES);
+    let path = dir.join(layout::CYCLES);
     if !path.is_file() {
         out.skip("plate_settlement_cycles", "no cycles.csv (the run had no loading cycles)");
         return Ok(());
@@ -154,7 +154,7 @@ fn side_view(dir: &Path, fin: &crate::engine::FinalState, out: &mut RunFigures) 
         let (Some(r), &[x, y, z]) = (b.radius, &b.position[..]) else {
             return Err(Error::Scene(format!(
                 "{}: body {i} is not a sphere (a 3D position and a radius)",
-                dir.join(files::FINAL).display()
+                dir.join(layout::FINAL).display()
             )));
         };
         centres.push([x, y, z]);
@@ -183,7 +183,7 @@ fn walls_of(dir: &Path) -> Result<Option<Vec<Wall>>> {
     struct Input {
         system: MdSystem,
     }
-    let (scene, initial) = (dir.join(files::SCENE), dir.join(files::INITIAL_STATE));
+    let (scene, initial) = (dir.join(layout::SCENE), dir.join(layout::INITIAL_STATE));
     if scene.is_file() {
         Ok(Some(crate::scene::MdScene::load(&scene)?.build()?.walls))
     } else if initial.is_file() {

@@ -1,40 +1,16 @@
-//! Output files of a run, all in one output directory (the run loop,
-//! [`crate::run::Runner`], writes them; the same files for both engines):
+//! File formats: CSV tables through serde rows ([`table`]), JSON, atomic text writes, the VTK writer
+//! ([`vtk`]), figures as PNG + SVG ([`figures`]), and the layout of a run folder ([`layout`]: every file
+//! name a run writes). Every I/O error names the file it happened on.
 //!
-//! - `series.csv`: one row of step statistics every `output.every` steps
-//!   ([`series`], written with [`table::TableWriter`]);
-//! - `cycles.csv`: per-cycle statistics with `output.cycles` ([`cycles`]), and
-//!   with `output.cycles.positions` the positions of every mobile body at each
-//!   cycle end ([`positions`]);
-//! - `final.json`: the state of every body (and wall) at the end
-//!   ([`crate::engine::FinalState`]);
-//! - `contacts.csv`: every contact at the end with its point, normal and forces
-//!   ([`crate::engine::contacts`]);
-//! - `summary.json`: wall time and speed, mean contacts, overlaps, NLGS
-//!   iterations ([`summary::RunReport`]);
-//! - `scene.toml`: a copy of the input scene (the text the run read), or
-//!   `initial_state.json` for a system built in code;
-//! - `final_scene.toml`: the input scene with the final state, to restart from;
-//! - `run.json`: seed, engine, crate version, number of steps, time step ([`RunInfo`]);
-//! - `checkpoint.json`: the whole state, every few minutes, for `--resume`
-//!   ([`checkpoint::Checkpoint`]);
-//! - with `--vtk-every N`: `vtk/*.vtp` and `run.pvd`, snapshots that ParaView
-//!   opens and animates ([`vtk`]);
-//! - figures as `<stem>.png` + `<stem>.svg`: curves, force chains, displacement
-//!   fields ([`figures`]), those of a run drawn from its folder alone
-//!   ([`run_figures`], [`md_figures`]).
-//!
-//! CSV goes through `csv` and serde row types, JSON through `serde_json`. Every
-//! I/O error names the file it happened on.
+//! Not yet moved out (issue 33): the engines' row types ([`series`], [`cycles`]), their VTK mapping and the
+//! figures drawn from a run folder ([`run_figures`], [`md_figures`]) still live here.
 
-pub mod checkpoint;
 pub mod cycles;
 pub mod figures;
+pub mod layout;
 pub mod md_figures;
-pub mod positions;
 pub mod run_figures;
 pub mod series;
-pub mod summary;
 pub mod table;
 pub mod vtk;
 
@@ -42,8 +18,6 @@ use crate::error::{Error, Result};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
-pub use checkpoint::{Checkpoint, CHECKPOINT_FILE};
-pub use summary::{RunEnd, RunReport, RunSummary};
 pub use table::TableWriter;
 
 /// An I/O error with the path it happened on in its message.

@@ -27,8 +27,8 @@ use super::figures::{self, Arrow, Axes, Series};
 use crate::engine::contacts;
 use crate::engine::FinalState;
 use crate::error::{Error, Result};
+use crate::io::layout;
 use crate::nscd::System;
-use crate::run::files;
 use std::path::{Path, PathBuf};
 
 /// What [`draw_run_figures`] did.
@@ -62,7 +62,7 @@ impl RunFigures {
 /// the others; [`Error::Io`] naming the file if one cannot be read or a figure
 /// written.
 pub fn draw_run_figures(dir: &Path) -> Result<RunFigures> {
-    if dir.join(crate::settlement::driver::SETTLEMENT_FILE).is_file() {
+    if dir.join(layout::SETTLEMENT).is_file() {
         // An accelerated run (either engine).
         return crate::settlement::figures::draw(dir, None);
     }
@@ -70,7 +70,7 @@ pub fn draw_run_figures(dir: &Path) -> Result<RunFigures> {
     match fin.engine.as_str() {
         "nscd" | "md2d" => nscd_figures(dir, None),
         "md" => super::md_figures::md_figures(dir),
-        other => Err(Error::Scene(format!("{}: unknown engine '{other}'", dir.join(files::FINAL).display()))),
+        other => Err(Error::Scene(format!("{}: unknown engine '{other}'", dir.join(layout::FINAL).display()))),
     }
 }
 
@@ -89,12 +89,12 @@ pub(crate) fn require(dir: &Path, name: &str) -> Result<PathBuf> {
 
 /// `dir/final.json`, which must exist.
 pub(crate) fn read_final(dir: &Path) -> Result<FinalState> {
-    FinalState::read(&require(dir, files::FINAL)?)
+    FinalState::read(&require(dir, layout::FINAL)?)
 }
 
 /// Reads `dir/contacts.csv` if it exists (`None` for a run older than the file).
 pub(crate) fn read_contacts(dir: &Path) -> Result<Option<Vec<contacts::ContactRow>>> {
-    let path = dir.join(files::CONTACTS);
+    let path = dir.join(layout::CONTACTS);
     if path.is_file() {
         Ok(Some(contacts::read(&path)?))
     } else {
@@ -148,7 +148,7 @@ fn nscd_final_system(dir: &Path, fin: &FinalState) -> Result<System> {
     struct Input {
         system: System,
     }
-    let (scene, initial) = (dir.join(files::SCENE), dir.join(files::INITIAL_STATE));
+    let (scene, initial) = (dir.join(layout::SCENE), dir.join(layout::INITIAL_STATE));
     let (mut sys, source) = if scene.is_file() {
         (crate::scene::Scene::load(&scene)?.build()?, scene)
     } else if initial.is_file() {
@@ -157,14 +157,14 @@ fn nscd_final_system(dir: &Path, fin: &FinalState) -> Result<System> {
         return Err(Error::Scene(format!(
             "'{}' is not the folder of a finished run: it has neither {} nor {} (the shapes of the bodies)",
             dir.display(),
-            files::SCENE,
-            files::INITIAL_STATE
+            layout::SCENE,
+            layout::INITIAL_STATE
         )));
     };
     if fin.bodies.len() != sys.bodies.len() {
         return Err(Error::Scene(format!(
             "{} has {} bodies, {} has {}",
-            dir.join(files::FINAL).display(),
+            dir.join(layout::FINAL).display(),
             fin.bodies.len(),
             source.display(),
             sys.bodies.len()
@@ -183,10 +183,10 @@ fn nscd_final_system(dir: &Path, fin: &FinalState) -> Result<System> {
 /// the positions files of the run in `dir`, if it has them (the other bodies,
 /// fixed, where `sys` has them).
 fn first_cycle_from_files(dir: &Path, sys: &System) -> Result<Option<Vec<[f64; 3]>>> {
-    if !dir.join(super::positions::DISPLACEMENTS_FILE).is_file() {
+    if !dir.join(layout::CYCLE_DISPLACEMENTS).is_file() {
         return Ok(None);
     }
-    let positions = super::positions::read(dir)?;
+    let positions = crate::run::positions::read(dir)?;
     let Some(first) = positions.cycles.first().filter(|c| c.dof == 3) else { return Ok(None) };
     let mut q = sys.bodies.q.clone();
     for (k, &i) in first.bodies.iter().enumerate() {
@@ -206,9 +206,9 @@ fn first_cycle_from_files(dir: &Path, sys: &System) -> Result<Option<Vec<[f64; 3
 /// As [`draw_run_figures`].
 pub fn nscd_figures(dir: &Path, first_cycle_q: Option<&[[f64; 3]]>) -> Result<RunFigures> {
     let fin = read_final(dir)?;
-    let series_path = require(dir, files::SERIES)?;
+    let series_path = require(dir, layout::SERIES)?;
     let mut out = RunFigures::default();
-    let cycles_path = dir.join(files::CYCLES);
+    let cycles_path = dir.join(layout::CYCLES);
     if cycles_path.is_file() {
         let rows = super::cycles::read_nscd(&cycles_path)?;
         let m = max_abs(rows.iter().flat_map(|r| [r.settlement_mean_m, r.settlement_at_min_load_m]));

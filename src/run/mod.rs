@@ -13,15 +13,20 @@
 //! A system built in code goes through [`Runner::from_system`] with a
 //! [`RunPlan`] (see the crate documentation and `examples/library_run.rs`).
 
+pub mod checkpoint;
 mod equilibrium;
+pub mod positions;
 mod runner;
+pub mod summary;
 
+pub use checkpoint::Checkpoint;
 pub use equilibrium::{Equilibrium, EquilibriumWatch, DEFAULT_EQUILIBRIUM_STEPS};
 pub(crate) use runner::body_names;
 pub use runner::{
-    check_options, cores, default_threads, files, CyclePlan, Figures, Prior, Progress, Restart, RunLength, RunOptions,
+    check_options, cores, default_threads, CyclePlan, Figures, Prior, Progress, Restart, RunLength, RunOptions,
     RunOutcome, RunPlan, Runner, Status,
 };
+pub use summary::{RunEnd, RunReport, RunSummary};
 
 use crate::error::Result;
 use crate::scene::common::RecordedText;

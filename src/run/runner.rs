@@ -19,41 +19,15 @@ use crate::clock::cycles_at;
 use crate::engine::CycleCheck;
 use crate::engine::Engine;
 use crate::error::{Error, Result};
-use crate::io::checkpoint::{crc32, Checkpoint, CHECKPOINT_FILE};
-use crate::io::positions::{PositionsWriter, BODIES_FILE, DISPLACEMENTS_FILE};
-use crate::io::summary::{RunEnd, RunReport, RunSummary};
+use crate::io::layout::{self, CHECKPOINT};
 use crate::io::table::TableWriter;
 use crate::io::vtk::PvdCollection;
 use crate::io::{self, RunInfo};
+use crate::run::checkpoint::{crc32, Checkpoint};
+use crate::run::positions::PositionsWriter;
+use crate::run::summary::{RunEnd, RunReport, RunSummary};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// The output files of a run folder.
-pub mod files {
-    /// Step statistics.
-    pub const SERIES: &str = "series.csv";
-    /// Per-cycle statistics.
-    pub const CYCLES: &str = "cycles.csv";
-    /// State at the end.
-    pub const FINAL: &str = "final.json";
-    /// Statistics of the run.
-    pub const SUMMARY: &str = "summary.json";
-    /// Seed, engine, version, steps.
-    pub const RUN_INFO: &str = "run.json";
-    /// Copy of the scene the run read (the file's text, or its serialised form
-    /// with a [`super::RunOptions::length`] applied).
-    pub const SCENE: &str = "scene.toml";
-    /// Serde form of the initial system of a run built in code.
-    pub const INITIAL_STATE: &str = "initial_state.json";
-    /// The final state as a scene to restart from.
-    pub const FINAL_SCENE: &str = "final_scene.toml";
-    /// The contacts at the end, with their forces.
-    pub const CONTACTS: &str = "contacts.csv";
-    /// ParaView collection of the snapshots.
-    pub const PVD: &str = "run.pvd";
-    /// Folder of the snapshots.
-    pub const VTK_DIR: &str = "vtk";
-}
 
 /// What a run is asked to do, besides its system.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -85,7 +59,7 @@ pub struct CyclePlan {
     /// The followed body (NSCD: the sleeper).
     pub body: Option<usize>,
     /// Write the positions of every mobile body at each cycle end
-    /// ([`crate::io::positions`]).
+    /// ([`crate::run::positions`]).
     pub positions: bool,
 }
 
@@ -327,7 +301,7 @@ impl<E: Engine> Runner<E> {
             let total = end_step.saturating_sub(live.first_step) as f64 * self.system.dt();
             (c.frequency * total).round() as u64
         });
-        let (vtk_dir, pvd_path) = (out.join(files::VTK_DIR), out.join(files::PVD));
+        let (vtk_dir, pvd_path) = (out.join(layout::VTK_DIR), out.join(layout::PVD));
         let wall0 = live.summary.wall_time_s;
         let started = Instant::now();
         let mut checkpointed = Instant::now();
@@ -436,16 +410,16 @@ impl<E: Engine> Runner<E> {
             return Err(e);
         }
         let cycle_state = state.map(|(s, _)| s);
-        live.sys.final_state().write(&out.join(files::FINAL))?;
-        crate::engine::contacts::write(&out.join(files::CONTACTS), &live.sys.contact_rows())?;
-        io::write_json(&out.join(files::SUMMARY), &report)?;
+        live.sys.final_state().write(&out.join(layout::FINAL))?;
+        crate::engine::contacts::write(&out.join(layout::CONTACTS), &live.sys.contact_rows())?;
+        io::write_json(&out.join(layout::SUMMARY), &report)?;
         if let (true, Some(draw)) = (opts.figures, &self.figures) {
             draw(out, cycle_state.as_ref())?;
         }
         if let Some(e) = diverged {
             return Err(e);
         }
-        io::remove_stale(out, CHECKPOINT_FILE)?;
+        io::remove_stale(out, layout::CHECKPOINT)?;
         if let (Some(restart), Origin::Scene { path, .. }) = (&self.restart, &self.origin) {
             let text = format!(
                 "# Written by ballast {}: the state of {} at t = {} s (step {}).\n\
@@ -456,7 +430,7 @@ impl<E: Engine> Runner<E> {
                 live.sys.steps_done(),
                 restart(&live.sys)?
             );
-            io::write_text(out, files::FINAL_SCENE, &text)?;
+            io::write_text(out, layout::FINAL_SCENE, &text)?;
         }
         Ok(outcome(Status::Ended(end)))
     }
@@ -467,28 +441,28 @@ impl<E: Engine> Runner<E> {
         io::create_output_dir(out)?;
         // Files left by an earlier run would pass for this run's.
         for stale in [
-            files::FINAL_SCENE,
-            CHECKPOINT_FILE,
-            files::CYCLES,
-            files::FINAL,
-            files::CONTACTS,
-            files::SUMMARY,
-            BODIES_FILE,
-            DISPLACEMENTS_FILE,
-            files::SCENE,
-            files::INITIAL_STATE,
+            layout::FINAL_SCENE,
+            layout::CHECKPOINT,
+            layout::CYCLES,
+            layout::FINAL,
+            layout::CONTACTS,
+            layout::SUMMARY,
+            layout::CYCLE_BODIES,
+            layout::CYCLE_DISPLACEMENTS,
+            layout::SCENE,
+            layout::INITIAL_STATE,
         ] {
             io::remove_stale(out, stale)?;
         }
         self.write_records(out)?;
-        let series = TableWriter::create(&out.join(files::SERIES), &sys.series_header())?;
+        let series = TableWriter::create(&out.join(layout::SERIES), &sys.series_header())?;
         let mut snapshots = PvdCollection::new();
         if opts.vtk_every > 0 {
             // The initial state is the first snapshot.
-            let vtk_dir = out.join(files::VTK_DIR);
+            let vtk_dir = out.join(layout::VTK_DIR);
             io::create_output_dir(&vtk_dir)?;
             sys.snapshot(&vtk_dir, &mut snapshots)?;
-            snapshots.write(&out.join(files::PVD))?;
+            snapshots.write(&out.join(layout::PVD))?;
         }
         let mut summary = RunSummary::default();
         if let Some(s) = sys.initial_summary() {
@@ -498,7 +472,7 @@ impl<E: Engine> Runner<E> {
         let (cycles, positions) = match self.plan.cycles {
             Some(c) => {
                 let state = sys.cycle_start(c.body)?;
-                let table = TableWriter::create(&out.join(files::CYCLES), &sys.cycle_header())?;
+                let table = TableWriter::create(&out.join(layout::CYCLES), &sys.cycle_header())?;
                 let positions = if c.positions {
                     let reference = sys.configuration();
                     let names = body_names(&sys, &reference.bodies);
@@ -519,10 +493,10 @@ impl<E: Engine> Runner<E> {
     fn write_records(&self, out: &Path) -> Result<()> {
         match &self.origin {
             Origin::Scene { text, .. } => {
-                io::write_text(out, files::SCENE, text)?;
+                io::write_text(out, layout::SCENE, text)?;
             }
             Origin::Code { json } => {
-                io::write_text(out, files::INITIAL_STATE, json)?;
+                io::write_text(out, layout::INITIAL_STATE, json)?;
             }
         }
         let info = RunInfo {
@@ -541,10 +515,10 @@ impl<E: Engine> Runner<E> {
     /// the initial system and the files. The record of the input is written
     /// again (the checkpoint holds the CRC-32 of the scene text: it is the same).
     fn resume(&self, out: &Path) -> Result<Live<E>> {
-        let path = out.join(CHECKPOINT_FILE);
+        let path = out.join(layout::CHECKPOINT);
         if !path.is_file() {
             return Err(Error::Scene(format!(
-                "--resume: no {CHECKPOINT_FILE} in '{}' (nothing to continue: run without --resume)",
+                "--resume: no {CHECKPOINT} in '{}' (nothing to continue: run without --resume)",
                 out.display()
             )));
         }
@@ -574,7 +548,7 @@ impl<E: Engine> Runner<E> {
         if cp.series_rows != rows {
             return Err(bad(format!("{} rows of series.csv, {rows} expected after step {step}", cp.series_rows)));
         }
-        let series = TableWriter::resume(&out.join(files::SERIES), cp.series_bytes, cp.series_rows, cp.series_crc32)?;
+        let series = TableWriter::resume(&out.join(layout::SERIES), cp.series_bytes, cp.series_rows, cp.series_crc32)?;
         let (cycles, positions) = match (plan.cycles, cp.cycles) {
             (Some(c), Some(state)) => {
                 let done = cycles_at(cp.system.time(), c.frequency, cp.system.dt());
@@ -590,7 +564,7 @@ impl<E: Engine> Runner<E> {
                 let start = self.system.cycle_start(c.body)?;
                 state.check(&start, cp.system.body_count(), done).map_err(|e| bad(format!("per-cycle state: {e}")))?;
                 let table =
-                    TableWriter::resume(&out.join(files::CYCLES), cp.cycles_bytes, cp.cycles_rows, cp.cycles_crc32)?;
+                    TableWriter::resume(&out.join(layout::CYCLES), cp.cycles_bytes, cp.cycles_rows, cp.cycles_crc32)?;
                 let positions = match (c.positions, cp.positions) {
                     (true, Some(reference)) => {
                         reference.check(E::DOF, cp.system.body_count()).map_err(|e| bad(e.to_string()))?;
@@ -617,7 +591,7 @@ impl<E: Engine> Runner<E> {
         if cp.snapshots.entries().iter().any(|e| !e.parts.iter().all(|p| out.join(&p.file).is_file())) {
             return Err(bad("a snapshot it lists is missing".into()));
         }
-        io::remove_stale(out, files::FINAL_SCENE)?;
+        io::remove_stale(out, layout::FINAL_SCENE)?;
         self.write_records(out)?;
         Ok(Live {
             sys: cp.system,
@@ -703,7 +677,7 @@ pub enum Prior {
 impl Prior {
     /// The state of `dir` as `--resume` (`resume`) sees it; without `--resume`, always `Nothing`.
     pub fn of(dir: &Path, marker: &str, resume: bool) -> Self {
-        let checkpoint = dir.join(CHECKPOINT_FILE).exists();
+        let checkpoint = dir.join(layout::CHECKPOINT).exists();
         match (resume, checkpoint) {
             (false, _) => Prior::Nothing,
             (true, true) => Prior::Checkpointed,

@@ -34,7 +34,7 @@
 //! the record of the input (`scene.toml` or `initial_state.json`, `run.json`),
 //! with `positions` (a scene's `[output] cycles = { positions = true }`) the
 //! positions of every mobile body at the end of every cycle
-//! ([`crate::io::positions`]: computed, on the fitted trend over extrapolated
+//! ([`crate::run::positions`]: computed, on the fitted trend over extrapolated
 //! cycles, relaxed where a jump lands), and `checkpoint.json` every `checkpoint_every_s` (at a cycle's end) for
 //! `--resume`; with `figures`, the figures of [`super::figures`].
 
@@ -51,21 +51,17 @@ use crate::clock::cycles_at;
 use crate::engine::{Boundary, Configuration, Engine};
 use crate::engine::{RelaxReport, RelaxSettings};
 use crate::error::{Error, Result};
-use crate::io::checkpoint::{check_origin, crc32, read_checked, write_checked, CHECKPOINT_FILE};
-use crate::io::positions::{PositionsWriter, BODIES_FILE, DISPLACEMENTS_FILE};
+use crate::io::layout::{self, CHECKPOINT, JUMPS, SETTLEMENT};
 use crate::io::table::TableWriter;
 use crate::io::{self, RunInfo};
-use crate::run::{body_names, files, RunOptions};
+use crate::run::checkpoint::{check_origin, crc32, read_checked, write_checked};
+use crate::run::positions::PositionsWriter;
+use crate::run::{body_names, RunOptions};
 use rollback::Landing;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// The per-cycle table of an accelerated run.
-pub const SETTLEMENT_FILE: &str = "settlement.csv";
-/// The per-jump table of an accelerated run.
-pub const JUMPS_FILE: &str = "jumps.csv";
 
 /// The residual-displacement law of a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -162,7 +158,7 @@ pub struct Acceleration {
     #[serde(default)]
     pub settlement_boundary: Option<usize>,
     /// Write every mobile body's position at the end of each cycle
-    /// ([`crate::io::positions`]): the computed configuration, the fitted trend
+    /// ([`crate::run::positions`]): the computed configuration, the fitted trend
     /// over extrapolated cycles, the relaxed one where a jump lands. The
     /// configuration error of `--reference` (eq. 22) needs them in both runs.
     #[serde(default)]
@@ -616,10 +612,10 @@ impl<E: Engine> Accelerated<E> {
             wall_time_s: st.wall_time_s,
             steps: st.sys.steps_done(),
         };
-        io::write_json(&out.join(files::SUMMARY), &summary)?;
+        io::write_json(&out.join(layout::SUMMARY), &summary)?;
         if end != "stopped" {
-            st.sys.final_state().write(&out.join(files::FINAL))?;
-            io::remove_stale(out, CHECKPOINT_FILE)?;
+            st.sys.final_state().write(&out.join(layout::FINAL))?;
+            io::remove_stale(out, layout::CHECKPOINT)?;
             if opts.figures {
                 super::figures::draw(out, None)?;
             }
@@ -845,12 +841,12 @@ impl<E: Engine> Accelerated<E> {
     /// A fresh run: the folder prepared, the records and table headers written.
     fn start(&self, out: &Path) -> Result<(State<E>, Files)> {
         io::create_output_dir(out)?;
-        for stale in [CHECKPOINT_FILE, files::SUMMARY, files::FINAL, files::SCENE, files::INITIAL_STATE] {
+        for stale in [layout::CHECKPOINT, layout::SUMMARY, layout::FINAL, layout::SCENE, layout::INITIAL_STATE] {
             io::remove_stale(out, stale)?;
         }
         match &self.origin {
-            Origin::Scene { text } => io::write_text(out, files::SCENE, text)?,
-            Origin::Code { json } => io::write_text(out, files::INITIAL_STATE, json)?,
+            Origin::Scene { text } => io::write_text(out, layout::SCENE, text)?,
+            Origin::Code { json } => io::write_text(out, layout::INITIAL_STATE, json)?,
         };
         let steps = (self.target as f64 / (self.frequency * self.system.dt())).round() as u64;
         RunInfo {
@@ -910,9 +906,9 @@ impl<E: Engine> Accelerated<E> {
             before_jump: None,
             last_jump: None,
         };
-        let rows = TableWriter::create(&out.join(SETTLEMENT_FILE), SettlementRow::COLUMNS)?;
-        let jumps = TableWriter::create(&out.join(JUMPS_FILE), JumpRow::COLUMNS)?;
-        for stale in [BODIES_FILE, DISPLACEMENTS_FILE] {
+        let rows = TableWriter::create(&out.join(layout::SETTLEMENT), SettlementRow::COLUMNS)?;
+        let jumps = TableWriter::create(&out.join(layout::JUMPS), JumpRow::COLUMNS)?;
+        for stale in [layout::CYCLE_BODIES, layout::CYCLE_DISPLACEMENTS] {
             io::remove_stale(out, stale)?;
         }
         let positions = if self.spec.positions {
@@ -926,9 +922,9 @@ impl<E: Engine> Accelerated<E> {
 
     /// The run continued from `OUT/checkpoint.json`.
     fn resume(&self, out: &Path) -> Result<(State<E>, Files)> {
-        if !out.join(CHECKPOINT_FILE).is_file() {
+        if !out.join(layout::CHECKPOINT).is_file() {
             return Err(Error::Scene(format!(
-                "--resume: no {CHECKPOINT_FILE} in '{}' (nothing to continue: run without --resume)",
+                "--resume: no {CHECKPOINT} in '{}' (nothing to continue: run without --resume)",
                 out.display()
             )));
         }
@@ -965,12 +961,12 @@ impl<E: Engine> Accelerated<E> {
         let [(_, rr, _), (_, jr, _)] = st.tables;
         if rr != st.cycle || jr != st.jumps + st.rollbacks {
             return Err(bad(format!(
-                "{rr} rows of {SETTLEMENT_FILE} for {} cycles, {jr} of {JUMPS_FILE} for {} jumps and {} rollbacks",
+                "{rr} rows of {SETTLEMENT} for {} cycles, {jr} of {JUMPS} for {} jumps and {} rollbacks",
                 st.cycle, st.jumps, st.rollbacks
             )));
         }
         let files = self.reopen(out, &st)?;
-        io::remove_stale(out, files::SUMMARY)?;
+        io::remove_stale(out, layout::SUMMARY)?;
         Ok((st, files))
     }
 
@@ -978,8 +974,8 @@ impl<E: Engine> Accelerated<E> {
     /// cycles of positions): cut back to them, checked against their CRCs.
     fn reopen(&self, out: &Path, st: &State<E>) -> Result<Files> {
         let [(rb, rr, rc), (jb, jr, jc)] = st.tables;
-        let rows = TableWriter::resume(&out.join(SETTLEMENT_FILE), rb, rr, rc)?;
-        let jumps = TableWriter::resume(&out.join(JUMPS_FILE), jb, jr, jc)?;
+        let rows = TableWriter::resume(&out.join(layout::SETTLEMENT), rb, rr, rc)?;
+        let jumps = TableWriter::resume(&out.join(layout::JUMPS), jb, jr, jc)?;
         let positions = if self.spec.positions {
             let names = body_names(&self.system, &st.origin.bodies);
             Some(PositionsWriter::resume(out, st.origin.clone(), &names, st.cycle, st.positions_crc32)?)

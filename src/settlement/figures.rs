@@ -11,20 +11,18 @@
 //!   cycles, `|s_acc(N) − s_full(N)| / |s_full(N) − s_full(k_i)|` (the total is
 //!   dominated by the first cycles and would hide a wrong extrapolation), the
 //!   relative error of the coordination number on the computed cycles, and,
-//!   when both folders hold the cycle positions ([`crate::io::positions`]), the
+//!   when both folders hold the cycle positions ([`crate::run::positions`]), the
 //!   relative configuration error `E_r` of eq. (22) over the translations.
 
-use super::driver::{JumpRow, SettlementRow, JUMPS_FILE, SETTLEMENT_FILE};
+use super::driver::{JumpRow, SettlementRow};
 use super::estimate::configuration_error;
 use crate::error::{Error, Result};
 use crate::io::figures::{self, Axes, Series};
-use crate::io::positions::{self, CyclePositions, DISPLACEMENTS_FILE};
+use crate::io::layout::{self, SETTLEMENT};
 use crate::io::run_figures::RunFigures;
+use crate::run::positions::{self, CyclePositions};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
-
-/// The errors file of a run compared with a reference.
-pub const ERRORS_FILE: &str = "errors.csv";
 
 /// One row of `errors.csv`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -48,12 +46,12 @@ pub struct ErrorRow {
 
 /// A reference run's settlement and coordination per cycle (index = cycle − 1).
 pub fn reference_settlement(dir: &Path) -> Result<Vec<(f64, Option<f64>)>> {
-    let s = dir.join(SETTLEMENT_FILE);
+    let s = dir.join(layout::SETTLEMENT);
     if s.is_file() {
         let rows: Vec<SettlementRow> = crate::io::read_csv(&s)?;
         return Ok(rows.iter().map(|r| (r.settlement_m, r.coordination)).collect());
     }
-    let c = dir.join(crate::run::files::CYCLES);
+    let c = dir.join(layout::CYCLES);
     if c.is_file() {
         let cols = crate::io::table::read_columns(&c, &["settlement_at_min_load_m"]).map_err(|e| {
             Error::Scene(format!(
@@ -64,7 +62,7 @@ pub fn reference_settlement(dir: &Path) -> Result<Vec<(f64, Option<f64>)>> {
         return Ok(cols[0].iter().map(|&v| (v, None)).collect());
     }
     Err(Error::Scene(format!(
-        "--reference: '{}' has neither {SETTLEMENT_FILE} nor cycles.csv (the folder of a full run of the same scene)",
+        "--reference: '{}' has neither {SETTLEMENT} nor cycles.csv (the folder of a full run of the same scene)",
         dir.display()
     )))
 }
@@ -129,9 +127,9 @@ pub fn add_configuration_errors(rows: &mut [ErrorRow], run: &CyclePositions, ref
 /// settlement; [`Error::Io`] naming a file; without the `figures` feature, its error.
 pub fn draw(dir: &Path, reference: Option<&Path>) -> Result<RunFigures> {
     figures::require()?;
-    let path = dir.join(SETTLEMENT_FILE);
+    let path = dir.join(layout::SETTLEMENT);
     if !path.is_file() {
-        return Err(Error::Scene(format!("'{}' has no {SETTLEMENT_FILE}", dir.display())));
+        return Err(Error::Scene(format!("'{}' has no {SETTLEMENT}", dir.display())));
     }
     let rows: Vec<SettlementRow> = crate::io::read_csv(&path)?;
     let mut out = RunFigures::default();
@@ -159,12 +157,12 @@ pub fn draw(dir: &Path, reference: Option<&Path>) -> Result<RunFigures> {
                 ..Series::default()
             },
         );
-        let summary: super::AccelerationSummary = crate::io::read_json(&dir.join(crate::run::files::SUMMARY))?;
+        let summary: super::AccelerationSummary = crate::io::read_json(&dir.join(layout::SUMMARY))?;
         let mut table = errors(&rows, &full, summary.initial_cycles);
-        if dir.join(DISPLACEMENTS_FILE).is_file() && reference.join(DISPLACEMENTS_FILE).is_file() {
+        if dir.join(layout::CYCLE_DISPLACEMENTS).is_file() && reference.join(layout::CYCLE_DISPLACEMENTS).is_file() {
             add_configuration_errors(&mut table, &positions::read(dir)?, &positions::read(reference)?)?;
         }
-        crate::io::table::write_all(&dir.join(ERRORS_FILE), &table)?;
+        crate::io::table::write_all(&dir.join(layout::ERRORS), &table)?;
     }
     let stem = dir.join("settlement_accelerated");
     let axes = Axes {
@@ -175,7 +173,7 @@ pub fn draw(dir: &Path, reference: Option<&Path>) -> Result<RunFigures> {
     };
     figures::line_chart(&stem, &axes, &series)?;
     out.wrote(stem);
-    let jumps_path = dir.join(JUMPS_FILE);
+    let jumps_path = dir.join(layout::JUMPS);
     let jumps: Vec<JumpRow> = if jumps_path.is_file() { crate::io::read_csv(&jumps_path)? } else { Vec::new() };
     if jumps.is_empty() {
         out.skip("fit_quality", "no jump");

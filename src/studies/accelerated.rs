@@ -11,7 +11,8 @@ use super::saussine::{finish_replicas, replica_dir, replica_jobs, settle_acceler
 use super::saussine::{Accelerate, Loading, SettleOptions, SettleReplicas};
 use crate::error::Result;
 use crate::io;
-use crate::run::{files, Prior};
+use crate::io::layout;
+use crate::run::Prior;
 use crate::settlement::SettlementRow;
 use std::path::Path;
 
@@ -43,7 +44,7 @@ pub fn settle_accelerated_replicas(
     let threads = replica_jobs(jobs, replicas.count)?;
     io::create_output_dir(&out.join("runs"))?;
     let priors: Vec<Prior> =
-        (0..replicas.count).map(|r| Prior::of(&replica_dir(out, r), files::SUMMARY, opts.resume)).collect();
+        (0..replicas.count).map(|r| Prior::of(&replica_dir(out, r), layout::SUMMARY, opts.resume)).collect();
     let pool = super::campaigns::pool(threads)?;
     let results: Vec<Result<()>> = pool.install(|| {
         use rayon::prelude::*;

@@ -42,12 +42,14 @@ use super::replicas::{
 use super::saussine::{sample, Loading};
 use super::{axes, output_error, run_scene, RunDisplay, SummaryTable};
 use crate::error::{Error, Result};
+use crate::io;
 use crate::io::cycles::NscdCycleRow as CycleRow;
 use crate::io::figures::{self, Series};
+use crate::io::layout;
 use crate::io::series::NscdSeriesRow as SeriesRow;
 use crate::io::table::TableWriter;
-use crate::io::{self, RunReport};
-use crate::run::{cores, default_threads, files, Prior, RunOptions};
+use crate::run::RunReport;
+use crate::run::{cores, default_threads, Prior, RunOptions};
 use crate::scenarios::saussine::{loaded_scene, LoadingSpec, SampleSpec};
 use crate::scene::Scene;
 use rayon::prelude::*;
@@ -317,7 +319,7 @@ pub(super) fn run_jobs(
             .map(|job| {
                 let dir = job.dir(out);
                 // summary.json: a diverged run is finished too (and reported as such).
-                let prior = Prior::of(&dir, files::SUMMARY, study.resume);
+                let prior = Prior::of(&dir, layout::SUMMARY, study.resume);
                 if prior == Prior::Finished {
                     return Ok(());
                 }
@@ -337,7 +339,7 @@ pub(super) fn run_jobs(
         let dir = job.dir(out);
         let status = match result {
             // Skipped on --resume, but diverged in an earlier invocation (no final scene).
-            Ok(()) if !dir.join(files::FINAL_SCENE).exists() => "failed in an earlier invocation".to_string(),
+            Ok(()) if !dir.join(layout::FINAL_SCENE).exists() => "failed in an earlier invocation".to_string(),
             Ok(()) => "ok".to_string(),
             Err(e @ Error::Scene(_)) => return Err(e),
             // A diverged run still wrote its series and summary: keep it in the study.
@@ -346,11 +348,11 @@ pub(super) fn run_jobs(
                 format!("failed: {}", e.one_line())
             }
         };
-        let report = std::fs::read_to_string(dir.join(files::SUMMARY))
+        let report = std::fs::read_to_string(dir.join(layout::SUMMARY))
             .ok()
             .and_then(|t| serde_json::from_str::<RunReport>(&t).ok());
-        let series = io::series::read_nscd(&dir.join(files::SERIES)).unwrap_or_default();
-        let cycles_path = dir.join(files::CYCLES);
+        let series = io::series::read_nscd(&dir.join(layout::SERIES)).unwrap_or_default();
+        let cycles_path = dir.join(layout::CYCLES);
         let cycles = if cycles_path.exists() { io::cycles::read_nscd(&cycles_path)? } else { vec![] };
         outcomes.push(Outcome { status, report, series, cycles });
     }

@@ -303,7 +303,7 @@ pub fn compare(spec: &CompareSpec, study: &StudyOptions, display: &dyn RunDispla
                 _ => None,
             };
             let reports: Vec<_> = runs.iter().filter_map(|o| o.report.as_ref()).collect();
-            let estimate = |f: &dyn Fn(&crate::io::RunReport) -> Option<f64>| {
+            let estimate = |f: &dyn Fn(&crate::run::RunReport) -> Option<f64>| {
                 Estimate::of(&reports.iter().filter_map(|r| f(r)).filter(|x| x.is_finite()).collect::<Vec<_>>())
             };
             SettingSummary {

@@ -10,8 +10,9 @@
 use super::{axes, output_error, run_scene, write_file, RunDisplay};
 use crate::error::{Error, Result};
 use crate::io::figures::{line_chart, Series};
+use crate::io::layout;
 use crate::md::{MdSystem, V3};
-use crate::run::{files, RunOptions, RunOutcome};
+use crate::run::{RunOptions, RunOutcome};
 use crate::scene::MdScene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -112,7 +113,7 @@ impl TestSpec {
 
 /// The system of a finished run's final scene in `dir`.
 pub(crate) fn final_state(dir: &Path) -> Result<MdSystem> {
-    let path = dir.join(files::FINAL_SCENE);
+    let path = dir.join(layout::FINAL_SCENE);
     if !path.exists() {
         return Err(Error::Scene(format!("--from: no finished run in '{}' (no final_scene.toml)", dir.display())));
     }

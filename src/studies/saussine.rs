@@ -26,7 +26,8 @@ use super::{output_error, run_scene, write_file, RunDisplay};
 use crate::error::{Error, Result};
 use crate::io;
 use crate::io::figures::Series;
-use crate::run::{default_threads, files, Prior, RunOptions, RunOutcome};
+use crate::io::layout;
+use crate::run::{default_threads, Prior, RunOptions, RunOutcome};
 use crate::scenarios::saussine::{
     loaded_scene, measure_sample, open_bank, sample_scene, Guide, LoadingSpec, SampleReport, SampleSpec, GRAIN_PREFIX,
 };
@@ -215,13 +216,13 @@ fn run_stage(
     display: &dyn RunDisplay,
     label: &str,
 ) -> Result<Scene> {
-    let prior = Prior::of(dir, files::FINAL_SCENE, resume);
+    let prior = Prior::of(dir, layout::FINAL_SCENE, resume);
     if prior != Prior::Finished {
         let resume = prior == Prior::Checkpointed;
         let opts = RunOptions { checkpoint_every_s: 300.0, resume, threads, ..RunOptions::default() };
         run_scene(scene_path, dir, &opts, display, label)?;
     }
-    Scene::load(dir.join(files::FINAL_SCENE)).map_err(output_error)
+    Scene::load(dir.join(layout::FINAL_SCENE)).map_err(output_error)
 }
 
 /// The loaded scene of the sample at `sample` under `loading` (the sample's
@@ -436,7 +437,7 @@ pub fn settle_replicas(
     let mut priors = Vec::new();
     for r in 0..replicas.count {
         let dir = replica_dir(out, r);
-        let prior = Prior::of(&dir, files::SUMMARY, opts.resume);
+        let prior = Prior::of(&dir, layout::SUMMARY, opts.resume);
         let start = Start { replica: r, perturbation: replicas.perturbation };
         write_start(sample, scene.clone(), &start, &dir, prior != Prior::Nothing, true, "")?;
         priors.push(prior);
@@ -463,7 +464,7 @@ pub fn settle_replicas(
     });
     let seating = replicas.seating_cycles.min(loading.cycles);
     let read = |path: &Path| io::cycles::read_nscd(path).map_err(output_error);
-    finish_replicas(out, results, files::CYCLES, read, seating, "Settlement of the sleeper")
+    finish_replicas(out, results, layout::CYCLES, read, seating, "Settlement of the sleeper")
 }
 
 /// The runs of a replica study at once: `jobs` (`None`: one per core), at most

@@ -16,16 +16,14 @@
 //! state does not hold together; the run loop then checks the state against the
 //! scene and the counters against the files (`crate::run`).
 
-use super::io_error;
-use super::vtk::PvdCollection;
 use super::RunSummary;
 use crate::error::{Error, Result};
+use crate::io::io_error;
+use crate::io::layout;
+use crate::io::vtk::PvdCollection;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-
-/// File name of the checkpoint in the output directory.
-pub const CHECKPOINT_FILE: &str = "checkpoint.json";
 
 /// The first word of a checkpoint file.
 const MAGIC: &str = "ballast-checkpoint";
@@ -100,10 +98,10 @@ fn invalid(path: &Path, msg: impl std::fmt::Display) -> Error {
 /// # Errors
 /// [`Error::Io`] naming the file.
 pub fn write_checked<T: Serialize>(dir: &Path, value: &T) -> Result<PathBuf> {
-    let path = dir.join(CHECKPOINT_FILE);
+    let path = dir.join(layout::CHECKPOINT);
     let json = serde_json::to_string(value).map_err(|e| io_error(&path, "serialize", std::io::Error::other(e)))?;
     let text = format!("{MAGIC} crc32={:08x}\n{json}", crc32(json.as_bytes()));
-    super::write_atomic(&path, &text)?;
+    crate::io::write_atomic(&path, &text)?;
     Ok(path)
 }
 
@@ -114,7 +112,7 @@ pub fn write_checked<T: Serialize>(dir: &Path, value: &T) -> Result<PathBuf> {
 /// [`Error::Io`] if it cannot be read; [`Error::Scene`] `PATH: not a valid
 /// checkpoint: …` if it is not one.
 pub fn read_checked<T: DeserializeOwned>(dir: &Path) -> Result<(PathBuf, T)> {
-    let path = dir.join(CHECKPOINT_FILE);
+    let path = dir.join(layout::CHECKPOINT);
     let bytes = std::fs::read(&path).map_err(|e| io_error(&path, "read checkpoint", e))?;
     let text = String::from_utf8(bytes).map_err(|_| invalid(&path, "not UTF-8 text"))?;
     let (first, json) = text.split_once('\n').ok_or_else(|| invalid(&path, "no header line"))?;

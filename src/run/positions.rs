@@ -17,18 +17,14 @@
 //!
 //! [`read`] gives the positions back as [`Configuration`]s.
 
-use super::io_error;
 use crate::engine::Configuration;
 use crate::error::{Error, Result};
+use crate::io::io_error;
+use crate::io::layout;
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
-
-/// File of the reference coordinates.
-pub const BODIES_FILE: &str = "cycle_bodies.csv";
-/// File of the displacements.
-pub const DISPLACEMENTS_FILE: &str = "cycle_displacements.npy";
 
 /// Length of the `.npy` header, magic included (a multiple of 64, room for any shape).
 const HEADER_LEN: usize = 128;
@@ -97,12 +93,12 @@ impl PositionsWriter {
                 q0: reference.body(k).to_vec(),
             })
             .collect();
-        let mut w = super::table::TableWriter::create(&dir.join(BODIES_FILE), &columns(reference.dof))?;
+        let mut w = crate::io::table::TableWriter::create(&dir.join(layout::CYCLE_BODIES), &columns(reference.dof))?;
         for r in &rows {
             w.write(r)?;
         }
         w.finish()?;
-        let path = dir.join(DISPLACEMENTS_FILE);
+        let path = dir.join(layout::CYCLE_DISPLACEMENTS);
         let mut file = File::create(&path).map_err(|e| io_error(&path, "create", e))?;
         file.write_all(&header(0, reference.len(), reference.dof)).map_err(|e| io_error(&path, "write", e))?;
         Ok(Self { path, file, reference, cycles: 0, record: Vec::new(), crc: crc32fast::Hasher::new() })
@@ -118,8 +114,8 @@ impl PositionsWriter {
     pub fn resume(dir: &Path, reference: Configuration, names: &[String], cycles: u64, crc: u32) -> Result<Self> {
         let invalid =
             |path: &Path, msg: &str| Error::Scene(format!("not a valid checkpoint: '{}' {msg}", path.display()));
-        let bodies = dir.join(BODIES_FILE);
-        let (header, rows): (Vec<String>, Vec<BodyRow>) = match super::table::read(&bodies) {
+        let bodies = dir.join(layout::CYCLE_BODIES);
+        let (header, rows): (Vec<String>, Vec<BodyRow>) = match crate::io::table::read(&bodies) {
             Ok(table) => table,
             Err(_) if !bodies.is_file() => return Err(invalid(&bodies, "is missing")),
             Err(e) => return Err(Error::Scene(format!("not a valid checkpoint: {e}"))),
@@ -138,7 +134,7 @@ impl PositionsWriter {
                 "does not hold the columns, followed bodies, names and start of the checkpoint",
             ));
         }
-        let path = dir.join(DISPLACEMENTS_FILE);
+        let path = dir.join(layout::CYCLE_DISPLACEMENTS);
         let bytes = HEADER_LEN as u64 + cycles * (reference.q.len() as u64 * 4);
         let mut file =
             std::fs::OpenOptions::new().read(true).write(true).open(&path).map_err(|e| io_error(&path, "open", e))?;
@@ -219,15 +215,15 @@ pub struct CyclePositions {
 
 /// Reads `cycle_bodies.csv` and `cycle_displacements.npy` of the run in `dir`.
 pub fn read(dir: &Path) -> Result<CyclePositions> {
-    let (header, rows): (_, Vec<BodyRow>) = super::table::read(&dir.join(BODIES_FILE))?;
+    let (header, rows): (_, Vec<BodyRow>) = crate::io::table::read(&dir.join(layout::CYCLE_BODIES))?;
     let dof = header.len().saturating_sub(2);
-    let bad = |msg: &str| Error::Scene(format!("'{}': {msg}", dir.join(DISPLACEMENTS_FILE).display()));
+    let bad = |msg: &str| Error::Scene(format!("'{}': {msg}", dir.join(layout::CYCLE_DISPLACEMENTS).display()));
     let reference = Configuration {
         dof,
         bodies: rows.iter().map(|r| r.body).collect(),
         q: rows.iter().flat_map(|r| r.q0.iter().copied()).collect(),
     };
-    let path = dir.join(DISPLACEMENTS_FILE);
+    let path = dir.join(layout::CYCLE_DISPLACEMENTS);
     let mut bytes = Vec::new();
     File::open(&path).and_then(|mut f| f.read_to_end(&mut bytes)).map_err(|e| io_error(&path, "read", e))?;
     if bytes.len() < HEADER_LEN || &bytes[..MAGIC.len()] != MAGIC {
