@@ -15,7 +15,7 @@
 //! `settlement.{png,svg}` with the settlement of both runs (Figs. 6/11).
 
 use ballast::io::figures::{self, Axes};
-use ballast::io::run_figures::settlement_series;
+use ballast::report::plane::settlement_series;
 use ballast::run::{run_file, RunOptions, Status};
 use ballast::scenarios::saussine::{loaded_scene, measure_sample, sample_scene, LoadingSpec, SampleSpec};
 use ballast::scene::Scene;

@@ -65,6 +65,7 @@ pub mod io;
 pub mod md;
 pub mod nscd;
 pub mod plane;
+pub mod report;
 pub mod run;
 pub mod scenarios;
 pub mod scene;

@@ -1,9 +1,8 @@
 //! `ballast::io::figures`: each figure is written as a PNG of the right size and an
 //! SVG with the expected elements; bad values are skipped, never a panic.
 
-use ballast::io::figures::{
-    displacement_field, force_chains, force_lines_of, line_chart, polygons_of, Arrow, Axes, ForceLine, Series,
-};
+use ballast::io::figures::{displacement_field, force_chains, line_chart, Arrow, Axes, ForceLine, Series};
+use ballast::report::plane::{force_lines_of, polygons_of};
 use std::path::{Path, PathBuf};
 
 /// A fresh directory under the system's temp dir.

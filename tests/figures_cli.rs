@@ -3,12 +3,12 @@
 //! through the row type and checked against the physics (an NSCD block resting
 //! on a floor carries its weight; an MD run's wall contacts add up to the wall
 //! forces of `final.json`), then their figures drawn from the folder alone by
-//! `ballast::io::run_figures::draw_run_figures`, by `ballast run --figures`'s
+//! `ballast::report::draw_run_figures`, by `ballast run --figures`'s
 //! path (`RunOptions::figures`) and by the `ballast figures DIR` command.
 
 use ballast::engine::contacts::{self, ContactKind};
 use ballast::engine::FinalState;
-use ballast::io::run_figures::draw_run_figures;
+use ballast::report::draw_run_figures;
 use ballast::run::{run_file, RunOptions};
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -66,19 +66,19 @@ fn the_example_runs_through_the_procedure_and_resumes_to_the_same_numbers() {
     assert_eq!(s2.settlement_m.to_bits(), s.settlement_m.to_bits());
     // Figures, and the errors against a reference: the uninterrupted run is the
     // resumed run's reference, so every accrued error is exactly 0.
-    let figs = ballast::settlement::figures::draw(&cut, Some(&whole)).unwrap();
+    let figs = ballast::report::settlement::draw(&cut, Some(&whole)).unwrap();
     assert_eq!(figs.written.len(), 2);
     for stem in &figs.written {
         assert!(stem.with_extension("png").is_file() && stem.with_extension("svg").is_file());
     }
-    let errors: Vec<ballast::settlement::figures::ErrorRow> = ballast::io::read_csv(&cut.join("errors.csv")).unwrap();
+    let errors: Vec<ballast::report::settlement::ErrorRow> = ballast::io::read_csv(&cut.join("errors.csv")).unwrap();
     assert_eq!(errors.len(), 30);
     assert!(errors[..2].iter().all(|e| e.accrued_error.is_none()), "no accrual before k_i");
     assert!(errors[2..].iter().all(|e| e.accrued_error == Some(0.0)));
     // An accelerated run of the same scene as the reference: errors after k_i only.
     let rows: Vec<SettlementRow> = ballast::io::read_csv(&whole.join("settlement.csv")).unwrap();
     let full: Vec<(f64, Option<f64>)> = rows.iter().map(|r| (r.settlement_m + 1e-6, r.coordination)).collect();
-    let e = ballast::settlement::figures::errors(&rows, &full, 2);
+    let e = ballast::report::settlement::errors(&rows, &full, 2);
     // s_full − s_full(2) is s − s(2): the error is 1e-6 m over what accrued.
     let accrued = rows[29].settlement_m - rows[1].settlement_m;
     assert!((e[29].accrued_error.unwrap() - 1e-6 / accrued.abs()).abs() < 1e-9 / accrued.abs());
@@ -98,7 +98,7 @@ fn the_example_runs_through_the_procedure_and_resumes_to_the_same_numbers() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("error on what accrued after the 2 initial cycles: 0.00 %"), "{stdout}");
     assert_eq!(
-        ballast::io::read_csv::<ballast::settlement::figures::ErrorRow>(&cut.join("errors.csv")).unwrap().len(),
+        ballast::io::read_csv::<ballast::report::settlement::ErrorRow>(&cut.join("errors.csv")).unwrap().len(),
         30
     );
     // A scene without [settlement] is not run by it, and its folder has no

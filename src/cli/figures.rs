@@ -1,7 +1,7 @@
 //! `ballast figures DIR`: the figures of a finished run folder of either engine,
-//! drawn from its files alone ([`ballast::io::run_figures::draw_run_figures`]);
+//! drawn from its files alone ([`ballast::report::draw_run_figures`]);
 //! with `--reference FULL`, an accelerated run's errors against a full run
-//! ([`ballast::settlement::figures::draw`]), measured after the run, e.g. when
+//! ([`ballast::report::settlement::draw`]), measured after the run, e.g. when
 //! the full run finished later.
 
 use super::{input, Failure};
@@ -23,7 +23,7 @@ pub struct FiguresArgs {
 /// `ballast figures`: draws, then prints each figure written and each skipped.
 pub fn main(a: FiguresArgs) -> Result<(), Failure> {
     let figures = match &a.reference {
-        None => ballast::io::run_figures::draw_run_figures(&a.dir)?,
+        None => ballast::report::draw_run_figures(&a.dir)?,
         Some(reference) => {
             if !a.dir.join(layout::SETTLEMENT).is_file() {
                 return Err(input(format!(
@@ -31,7 +31,7 @@ pub fn main(a: FiguresArgs) -> Result<(), Failure> {
                     a.dir.display()
                 )));
             }
-            ballast::settlement::figures::draw(&a.dir, Some(reference))?
+            ballast::report::settlement::draw(&a.dir, Some(reference))?
         }
     };
     for stem in &figures.written {

@@ -403,7 +403,7 @@ impl AccelerateArgs {
 
 /// The accrued-settlement error at the last cycle of an accelerated run compared with its reference.
 pub(crate) fn print_errors(out: &std::path::Path, s: &ballast::settlement::AccelerationSummary) -> Result<(), Failure> {
-    let rows: Vec<ballast::settlement::figures::ErrorRow> = ballast::io::read_csv(&out.join(layout::ERRORS))?;
+    let rows: Vec<ballast::report::settlement::ErrorRow> = ballast::io::read_csv(&out.join(layout::ERRORS))?;
     if let Some(last) = rows.last() {
         println!(
             "against the reference at cycle {}: settlement {:.4e} m vs {:.4e} m; error on what accrued after the {} \

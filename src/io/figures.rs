@@ -2,8 +2,8 @@
 //! `data/fonts/`), so nothing depends on the system's fonts or libraries.
 //!
 //! Every function writes both `<stem>.png` and `<stem>.svg`. The inputs are plain
-//! data, so any engine can feed them; [`polygons_of`] and [`force_lines_of`] take
-//! them from an NSCD [`System`]. What they draw, for the figures of Saussine et
+//! data, so any engine can feed them; [`crate::report::plane::polygons_of`] and [`crate::report::plane::force_lines_of`] take
+//! them from an NSCD [`crate::nscd::System`]. What they draw, for the figures of Saussine et
 //! al. (2006):
 //!
 //! - [`line_chart`]: curves with a legend (below the plot, never over the data)
@@ -14,7 +14,7 @@
 //! - [`force_chains`]: the grains with the normal forces as segments between the
 //!   centres of the bodies in contact, or from a grain's centre to its contact
 //!   point with a wall, width proportional to the force (Figs. 8–10);
-//!   [`force_lines`] makes the segments from a contact list;
+//!   [`crate::report::force_lines`] makes the segments from a contact list;
 //! - [`displacement_field`]: the grains with an arrow per grain from its earlier
 //!   centre, coloured by magnitude (Figs. 8–9).
 //!
@@ -26,10 +26,7 @@
 //! `figures` feature (on by default); without it every function here returns an
 //! error saying so, and [`ENABLED`] is false.
 
-use crate::engine::{ContactKind, ContactRow};
 use crate::error::Result;
-use crate::nscd::System;
-use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Size of a chart (px).
@@ -195,61 +192,6 @@ pub fn displacement_field(
     scale: f64,
 ) -> Result<()> {
     draw::displacement_field(stem, title, polygons, fixed, arrows, scale)
-}
-
-/// World vertices (m) of the bodies of `sys` and whether each is fixed: one
-/// polygon per body (a disc as a 32-gon), except a compound, which gives one per
-/// part (so the lists follow the bodies' order but not their indices).
-pub fn polygons_of(sys: &System) -> (Vec<Vec<[f64; 2]>>, Vec<bool>) {
-    let (mut polygons, mut fixed) = (Vec::new(), Vec::new());
-    for (i, info) in sys.bodies.info.iter().enumerate() {
-        for part in crate::nscd::measure::world_parts(sys, i) {
-            polygons.push(part);
-            fixed.push(info.fixed);
-        }
-    }
-    (polygons, fixed)
-}
-
-/// Force chain segments of the last step of `sys` ([`force_lines`] of its
-/// contact list): between the centres of two moving bodies, from a body's
-/// centre to its contact points with a fixed one.
-pub fn force_lines_of(sys: &System) -> Vec<ForceLine> {
-    let rows = crate::engine::Engine::contact_rows(sys);
-    let q = &sys.bodies.q;
-    force_lines(&rows, |i| q.get(i).map(|q| [q[0], q[1], 0.0]), |p| [p[0], p[1]])
-}
-
-/// Force chain segments of a contact list ([`crate::engine::contacts`]), in the plane
-/// `project` maps a point (m) to: one per pair of moving bodies, between their
-/// centres (`centre` of a body index, m), with the sum of the normal forces (N)
-/// of the pair's contact points; one per contact with a wall, a fixed body or a
-/// symmetry image, from the body's centre to the contact point, with its normal
-/// force (so that a wall's forces are drawn where they act, not at its centre).
-/// Contacts whose body has no centre are left out.
-pub fn force_lines(
-    rows: &[ContactRow],
-    centre: impl Fn(usize) -> Option<[f64; 3]>,
-    project: impl Fn([f64; 3]) -> [f64; 2],
-) -> Vec<ForceLine> {
-    let mut pairs = BTreeMap::<(usize, usize), f64>::new();
-    let mut lines = Vec::new();
-    for r in rows {
-        match r.kind {
-            ContactKind::Pair => *pairs.entry((r.a, r.b)).or_default() += r.f_n,
-            ContactKind::Wall | ContactKind::Image => {
-                if let Some(c) = centre(r.a) {
-                    lines.push(ForceLine { from: project(c), to: project(r.point()), normal_force: r.f_n });
-                }
-            }
-        }
-    }
-    for ((a, b), f) in pairs {
-        if let (Some(ca), Some(cb)) = (centre(a), centre(b)) {
-            lines.push(ForceLine { from: project(ca), to: project(cb), normal_force: f });
-        }
-    }
-    lines
 }
 
 /// The SI prefix for values up to `max_abs` in `unit`: the factor to multiply

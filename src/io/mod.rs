@@ -2,14 +2,12 @@
 //! ([`vtk`]), figures as PNG + SVG ([`figures`]), and the layout of a run folder ([`layout`]: every file
 //! name a run writes). Every I/O error names the file it happened on.
 //!
-//! Not yet moved out (issue 33): the engines' row types ([`series`], [`cycles`]), their VTK mapping and the
-//! figures drawn from a run folder ([`run_figures`], [`md_figures`]) still live here.
+//! Not yet moved out (issue 33): the engines' row types ([`series`], [`cycles`]) and their VTK mapping still
+//! live here.
 
 pub mod cycles;
 pub mod figures;
 pub mod layout;
-pub mod md_figures;
-pub mod run_figures;
 pub mod series;
 pub mod table;
 pub mod vtk;

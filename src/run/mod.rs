@@ -56,7 +56,7 @@ pub fn run_file(
             let (system, plan) = (scene.build()?, scene.plan()?);
             let restart: Restart<crate::md::MdSystem> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
             let figures: Figures<crate::md::MdSystem> =
-                Box::new(|dir, _| crate::io::run_figures::draw_run_figures(dir).map(drop));
+                Box::new(|dir, _| crate::report::draw_run_figures(dir).map(drop));
             Runner::from_scene(system, plan, scene_path, text, Some(restart))
                 .with_figures(figures)
                 .run(out, &opts, progress)
@@ -91,6 +91,6 @@ pub fn run_file(
 fn plane_figures<E: crate::engine::Engine<CycleState = crate::io::cycles::NscdCycleState>>() -> Figures<E> {
     Box::new(|dir, cycles| {
         let first = cycles.and_then(|c| c.first_cycle_q.as_deref());
-        crate::io::run_figures::nscd_figures(dir, first).map(drop)
+        crate::report::plane::nscd_figures(dir, first).map(drop)
     })
 }

@@ -285,7 +285,7 @@ impl<E: Engine> Runner<E> {
         if opts.figures && self.figures.is_none() {
             return Err(Error::Scene(
                 "figures: this run has no figure drawer (a run of a scene file draws its engine's; a system built \
-                 in code draws them after the run with ballast::io::run_figures::draw_run_figures)"
+                 in code draws them after the run with ballast::report::draw_run_figures)"
                     .into(),
             ));
         }

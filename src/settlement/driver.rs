@@ -36,7 +36,7 @@
 //! positions of every mobile body at the end of every cycle
 //! ([`crate::run::positions`]: computed, on the fitted trend over extrapolated
 //! cycles, relaxed where a jump lands), and `checkpoint.json` every `checkpoint_every_s` (at a cycle's end) for
-//! `--resume`; with `figures`, the figures of [`super::figures`].
+//! `--resume`; with `figures`, the figures of [`crate::report::settlement`].
 
 pub mod rollback;
 mod rows;
@@ -395,19 +395,31 @@ pub struct Accelerated<E: Engine> {
     origin: Origin,
     /// What the scene resolved to, for `run.json` ([`Accelerated::with_model`]).
     model: Option<serde_json::Value>,
+    /// The figures drawn at the end when [`RunOptions::figures`] asks ([`Accelerated::with_figures`]).
+    figures: Option<FolderFigures>,
 }
+
+/// Draws the figures of a finished accelerated run from its folder (`ballast figures`,
+/// [`crate::report::settlement::draw`]); given by whoever opens the scene ([`super::run_file`]).
+pub type FolderFigures = Box<dyn Fn(&Path) -> Result<()> + Send + Sync>;
 
 impl<E: Engine> Accelerated<E> {
     /// A run of `system` loaded at `frequency` (Hz) to `target` cycles, from the
     /// scene whose text is `text` (recorded as `scene.toml`, its CRC-32 checked on `--resume`).
     pub fn from_scene(system: E, spec: Acceleration, frequency: f64, target: u64, seed: u64, text: String) -> Self {
-        Self { system, spec, frequency, target, seed, origin: Origin::Scene { text }, model: None }
+        Self { system, spec, frequency, target, seed, origin: Origin::Scene { text }, model: None, figures: None }
     }
 
     /// The same run, with `model` (what the scene resolved to: the planar MD
     /// engine's derived stiffness and time step) recorded in `run.json`.
     pub fn with_model(mut self, model: serde_json::Value) -> Self {
         self.model = Some(model);
+        self
+    }
+
+    /// The same run, drawing its figures with `figures` at the end when [`RunOptions::figures`] asks.
+    pub fn with_figures(mut self, figures: FolderFigures) -> Self {
+        self.figures = Some(figures);
         self
     }
 
@@ -418,7 +430,7 @@ impl<E: Engine> Accelerated<E> {
     pub fn from_system(system: E, spec: Acceleration, frequency: f64, target: u64) -> Result<Self> {
         let json = serde_json::to_string(&(&spec, frequency, target, &system))
             .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-        Ok(Self { system, spec, frequency, target, seed: 0, origin: Origin::Code { json }, model: None })
+        Ok(Self { system, spec, frequency, target, seed: 0, origin: Origin::Code { json }, model: None, figures: None })
     }
 
     fn source_crc32(&self) -> u32 {
@@ -460,6 +472,13 @@ impl<E: Engine> Accelerated<E> {
     ) -> Result<AccelerationOutcome<E>> {
         self.check()?;
         crate::run::check_options(opts)?;
+        if opts.figures && self.figures.is_none() {
+            return Err(Error::Scene(
+                "figures: this run has no figure drawer (a run of a scene file draws them; a system built in \
+                 code draws them after the run with ballast::report::settlement::draw)"
+                    .into(),
+            ));
+        }
         let (mut st, mut files) = if opts.resume { self.resume(out)? } else { self.start(out)? };
         st.sys.set_threads(opts.threads.max(1));
         let law = self.spec.law.estimator();
@@ -616,8 +635,8 @@ impl<E: Engine> Accelerated<E> {
         if end != "stopped" {
             st.sys.final_state().write(&out.join(layout::FINAL))?;
             io::remove_stale(out, layout::CHECKPOINT)?;
-            if opts.figures {
-                super::figures::draw(out, None)?;
+            if let (true, Some(draw)) = (opts.figures, &self.figures) {
+                draw(out)?;
             }
         }
         if let Some(e) = failure {

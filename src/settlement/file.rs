@@ -35,7 +35,8 @@ pub fn run_file(
             let Some(plan) = scene.acceleration()? else { return Ok(None) };
             let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts.clone() };
             let run =
-                Accelerated::from_scene(scene.build()?, plan.spec, plan.frequency, plan.cycles, scene.seed(), text);
+                Accelerated::from_scene(scene.build()?, plan.spec, plan.frequency, plan.cycles, scene.seed(), text)
+                    .with_figures(figures());
             Ok(Some(run.run(out, &opts, progress)?.summary))
         }
         SceneKind::PlanarMd => {
@@ -48,7 +49,8 @@ pub fn run_file(
             let Some(plan) = scene.acceleration()? else { return Ok(None) };
             let model = serde_json::to_value(info).map_err(|e| crate::Error::Io(std::io::Error::other(e)))?;
             let run = Accelerated::from_scene(system, plan.spec, plan.frequency, plan.cycles, scene.seed(), text)
-                .with_model(model);
+                .with_model(model)
+                .with_figures(figures());
             Ok(Some(run.run(out, opts, progress)?.summary))
         }
         SceneKind::Nscd => {
@@ -59,8 +61,14 @@ pub fn run_file(
             let text = scene.text_with_length(text, opts.length)?;
             let Some(plan) = scene.acceleration()? else { return Ok(None) };
             let run =
-                Accelerated::from_scene(scene.build()?, plan.spec, plan.frequency, plan.cycles, scene.seed(), text);
+                Accelerated::from_scene(scene.build()?, plan.spec, plan.frequency, plan.cycles, scene.seed(), text)
+                    .with_figures(figures());
             Ok(Some(run.run(out, opts, progress)?.summary))
         }
     }
+}
+
+/// The figures of an accelerated run, from its folder.
+fn figures() -> super::driver::FolderFigures {
+    Box::new(|dir| crate::report::settlement::draw(dir, None).map(drop))
 }

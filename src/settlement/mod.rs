@@ -12,14 +12,13 @@
 //! - [`driver`]: the procedure of Fig. 10 over any [`crate::engine::Engine`]
 //!   ([`Accelerated`]), its tables (`settlement.csv`, `jumps.csv`), summary and
 //!   checkpoints;
-//! - [`figures`]: an accelerated run's figures and its errors against a full run;
+//! - the figures and the errors against a full run are drawn from the folder ([`crate::report::settlement`]);
 //! - [`file`](mod@file): a scene file's `[settlement]` run through it (`ballast run`);
 //! - the relaxation after a jump is the engines' service ([`crate::engine::relax`]: an engine's functional
 //!   minimised by L-BFGS, or the paper's steepest descent, until the largest overlap is below a tolerance).
 
 pub mod driver;
 pub mod estimate;
-pub mod figures;
 pub mod file;
 pub mod law;
 pub mod smooth;

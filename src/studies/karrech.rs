@@ -129,7 +129,7 @@ pub fn load(
 /// relaxation tolerance by default 1 % of the smallest radius) written as
 /// `load.toml` and run through [`crate::settlement::run_file`]: `settlement.csv`,
 /// `jumps.csv`, `summary.json`, the figures; with a reference (a full run through
-/// the driver), `errors.csv` ([`crate::settlement::figures`]).
+/// the driver), `errors.csv` ([`crate::report::settlement`]).
 ///
 /// # Errors
 /// As [`load`], and for invalid acceleration settings.

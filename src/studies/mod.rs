@@ -174,7 +174,7 @@ impl Accelerate {
     /// Runs the scene at `path` (with its `[settlement]` table) into `out`
     /// through [`crate::settlement::run_file`], the reference, if any, checked to
     /// have a settlement first and compared after
-    /// ([`crate::settlement::figures::draw`]: `errors.csv`).
+    /// ([`crate::report::settlement::draw`]: `errors.csv`).
     ///
     /// # Errors
     /// A reference without a settlement, before the run; a scene without
@@ -187,12 +187,12 @@ impl Accelerate {
         progress: &mut dyn FnMut(&crate::settlement::AccelerationProgress),
     ) -> crate::error::Result<crate::settlement::AccelerationSummary> {
         if let Some(r) = &self.reference {
-            crate::settlement::figures::reference_settlement(r)?;
+            crate::report::settlement::reference_settlement(r)?;
         }
         let summary = crate::settlement::run_file(path, out, opts, progress)?
             .ok_or_else(|| crate::error::Error::Scene(format!("{}: no [settlement] table", path.display())))?;
         if let Some(r) = &self.reference {
-            crate::settlement::figures::draw(out, Some(r))?;
+            crate::report::settlement::draw(out, Some(r))?;
         }
         Ok(summary)
     }

@@ -319,7 +319,7 @@ pub use super::Accelerate;
 /// `OUT/loaded.toml`, with its `[settlement]` table, the sleeper as the
 /// settlement body) run through
 /// [`crate::settlement::run_file`]: `settlement.csv`, `jumps.csv`, `summary.json`,
-/// the figures; with a reference, `errors.csv` ([`crate::settlement::figures`]).
+/// the figures; with a reference, `errors.csv` ([`crate::report::settlement`]).
 ///
 /// The run sweeps on `threads` threads (the numbers do not depend on them).
 ///

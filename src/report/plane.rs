@@ -1,9 +1,6 @@
-//! The figures of one finished run, drawn from its output folder alone (`ballast
-//! figures DIR`, and `ballast run --figures` at the end of a run; the Saussine
-//! studies and the example too): [`draw_run_figures`] reads the engine from
-//! `final.json` and draws, as `<stem>.png` + `<stem>.svg` in the folder,
+//! The figures of a finished run of a 2D engine (NSCD, or planar MD, which writes the same files), drawn from
+//! its folder ([`nscd_figures`], through [`super::draw_run_figures`]), as `<stem>.png` + `<stem>.svg`:
 //!
-//! NSCD ([`nscd_figures`]):
 //! - `settlement`: the followed body's settlement vs cycles, mean over each
 //!   cycle and at the load minimum (from `cycles.csv`; Saussine et al. 2006,
 //!   Figs. 6, 11);
@@ -15,98 +12,21 @@
 //!   `contacts.csv`; Figs. 8–10);
 //! - `displacements`: the grains' displacements from the end of the first cycle
 //!   to the end of the run (Figs. 8–9), when that state is known (the positions
-//!   files of `output.cycles.positions`, or the run loop's own record);
-//!
-//! MD: see [`super::md_figures`]. An accelerated run (a folder with
-//! `settlement.csv`): see [`crate::settlement::figures`].
-//!
-//! A figure whose data the folder does not hold (no cycles, an older run
-//! without `contacts.csv`) is skipped and said so in [`RunFigures::skipped`].
+//!   files of `output.cycles.positions`, or the run loop's own record).
 
-use super::figures::{self, Arrow, Axes, Series};
-use crate::engine::contacts;
+use super::{force_lines, max_abs, read_contacts, read_final, require, RunFigures};
 use crate::engine::FinalState;
 use crate::error::{Error, Result};
+use crate::io::figures::{self, Arrow, Axes, ForceLine, Series};
 use crate::io::layout;
 use crate::nscd::System;
-use std::path::{Path, PathBuf};
-
-/// What [`draw_run_figures`] did.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct RunFigures {
-    /// The stems written (each as `<stem>.png` and `<stem>.svg`).
-    pub written: Vec<PathBuf>,
-    /// The figures not drawn, by stem, and why.
-    pub skipped: Vec<(String, String)>,
-}
-
-impl RunFigures {
-    /// Records `stem` as written.
-    pub(crate) fn wrote(&mut self, stem: PathBuf) {
-        self.written.push(stem);
-    }
-
-    /// Records `stem` as skipped for `why`.
-    pub(crate) fn skip(&mut self, stem: &str, why: &str) {
-        self.skipped.push((stem.to_string(), why.to_string()));
-    }
-}
-
-/// Draws the figures of the finished run in `dir`, of either engine, from its
-/// files (see the module documentation and [`super::md_figures`]).
-///
-/// # Errors
-/// [`Error::Scene`] naming the folder and the missing file if `dir` is not the
-/// folder of a finished run (no `final.json` or `series.csv`, or for NSCD
-/// neither `scene.toml` nor `initial_state.json`), or if a file does not fit
-/// the others; [`Error::Io`] naming the file if one cannot be read or a figure
-/// written.
-pub fn draw_run_figures(dir: &Path) -> Result<RunFigures> {
-    if dir.join(layout::SETTLEMENT).is_file() {
-        // An accelerated run (either engine).
-        return crate::settlement::figures::draw(dir, None);
-    }
-    let fin = read_final(dir)?;
-    match fin.engine.as_str() {
-        "nscd" | "md2d" => nscd_figures(dir, None),
-        "md" => super::md_figures::md_figures(dir),
-        other => Err(Error::Scene(format!("{}: unknown engine '{other}'", dir.join(layout::FINAL).display()))),
-    }
-}
-
-/// The path of `dir/name`, which must exist.
-pub(crate) fn require(dir: &Path, name: &str) -> Result<PathBuf> {
-    if !dir.is_dir() {
-        return Err(Error::Scene(format!("'{}' is not a folder", dir.display())));
-    }
-    let path = dir.join(name);
-    if path.is_file() {
-        Ok(path)
-    } else {
-        Err(Error::Scene(format!("'{}' is not the folder of a finished run: it has no {name}", dir.display())))
-    }
-}
-
-/// `dir/final.json`, which must exist.
-pub(crate) fn read_final(dir: &Path) -> Result<FinalState> {
-    FinalState::read(&require(dir, layout::FINAL)?)
-}
-
-/// Reads `dir/contacts.csv` if it exists (`None` for a run older than the file).
-pub(crate) fn read_contacts(dir: &Path) -> Result<Option<Vec<contacts::ContactRow>>> {
-    let path = dir.join(layout::CONTACTS);
-    if path.is_file() {
-        Ok(Some(contacts::read(&path)?))
-    } else {
-        Ok(None)
-    }
-}
+use std::path::Path;
 
 /// Series of a settlement curve from `cycles.csv` rows, multiplied by `scale`
 /// (1e3 for millimetres, or from [`figures::si_scale`]).
-pub fn settlement_series(rows: &[super::cycles::NscdCycleRow], label: &str, scale: f64) -> [Series; 2] {
+pub fn settlement_series(rows: &[crate::io::cycles::NscdCycleRow], label: &str, scale: f64) -> [Series; 2] {
     let pick =
-        |f: fn(&super::cycles::NscdCycleRow) -> f64| rows.iter().map(|r| (r.cycle as f64, scale * f(r))).collect();
+        |f: fn(&crate::io::cycles::NscdCycleRow) -> f64| rows.iter().map(|r| (r.cycle as f64, scale * f(r))).collect();
     let sep = if label.is_empty() { "" } else { ", " };
     [
         Series {
@@ -136,11 +56,6 @@ pub fn displacement_arrows(q0: &[[f64; 3]], sys: &System) -> Vec<Arrow> {
         .collect()
 }
 
-/// The largest absolute value of `v` (finite ones only; 0 if none).
-pub(crate) fn max_abs(v: impl Iterator<Item = f64>) -> f64 {
-    v.filter(|x| x.is_finite()).fold(0.0, |m, x| m.max(x.abs()))
-}
-
 /// The NSCD system of the run in `dir` at its end: the bodies of `scene.toml`
 /// (or of `initial_state.json`) moved to their positions in `fin`.
 fn nscd_final_system(dir: &Path, fin: &FinalState) -> Result<System> {
@@ -152,7 +67,7 @@ fn nscd_final_system(dir: &Path, fin: &FinalState) -> Result<System> {
     let (mut sys, source) = if scene.is_file() {
         (crate::scene::Scene::load(&scene)?.build()?, scene)
     } else if initial.is_file() {
-        (super::read_json::<Input>(&initial)?.system, initial)
+        (crate::io::read_json::<Input>(&initial)?.system, initial)
     } else {
         return Err(Error::Scene(format!(
             "'{}' is not the folder of a finished run: it has neither {} nor {} (the shapes of the bodies)",
@@ -203,14 +118,14 @@ fn first_cycle_from_files(dir: &Path, sys: &System) -> Result<Option<Vec<[f64; 3
 /// if any).
 ///
 /// # Errors
-/// As [`draw_run_figures`].
+/// As [`super::draw_run_figures`].
 pub fn nscd_figures(dir: &Path, first_cycle_q: Option<&[[f64; 3]]>) -> Result<RunFigures> {
     let fin = read_final(dir)?;
     let series_path = require(dir, layout::SERIES)?;
     let mut out = RunFigures::default();
     let cycles_path = dir.join(layout::CYCLES);
     if cycles_path.is_file() {
-        let rows = super::cycles::read_nscd(&cycles_path)?;
+        let rows = crate::io::cycles::read_nscd(&cycles_path)?;
         let m = max_abs(rows.iter().flat_map(|r| [r.settlement_mean_m, r.settlement_at_min_load_m]));
         let (scale, unit) = figures::si_scale(m.max(1e-6), "m");
         let stem = dir.join("settlement");
@@ -225,10 +140,11 @@ pub fn nscd_figures(dir: &Path, first_cycle_q: Option<&[[f64; 3]]>) -> Result<Ru
     } else {
         out.skip("settlement", "no cycles.csv (the run had no loading cycles)");
     }
-    let rows = super::series::read_nscd(&series_path)?;
+    let rows = crate::io::series::read_nscd(&series_path)?;
     // A run without overlaps (or contacts) still gets an axis in µm.
     let (scale, unit) = figures::si_scale(max_abs(rows.iter().map(|r| r.max_overlap_m)).max(1e-12), "m");
-    let pick = |f: fn(&super::series::NscdSeriesRow) -> f64| rows.iter().map(|r| (r.time_s, scale * f(r))).collect();
+    let pick =
+        |f: fn(&crate::io::series::NscdSeriesRow) -> f64| rows.iter().map(|r| (r.time_s, scale * f(r))).collect();
     let stem = dir.join("interpenetration");
     let axes = Axes {
         title: "Interpenetration".into(),
@@ -255,11 +171,11 @@ pub fn nscd_figures(dir: &Path, first_cycle_q: Option<&[[f64; 3]]>) -> Result<Ru
     figures::line_chart(&stem, &axes, &curves)?;
     out.wrote(stem);
     let sys = nscd_final_system(dir, &fin)?;
-    let (polygons, fixed) = figures::polygons_of(&sys);
+    let (polygons, fixed) = polygons_of(&sys);
     match read_contacts(dir)? {
         Some(rows) => {
             let q = &sys.bodies.q;
-            let lines = figures::force_lines(&rows, |i| q.get(i).map(|q| [q[0], q[1], 0.0]), |p| [p[0], p[1]]);
+            let lines = force_lines(&rows, |i| q.get(i).map(|q| [q[0], q[1], 0.0]), |p| [p[0], p[1]]);
             let stem = dir.join("force_chains");
             let title = format!("Force chains at t = {:.3} s (line width ∝ normal force)", fin.time);
             figures::force_chains(&stem, &title, &polygons, &fixed, &lines)?;
@@ -295,4 +211,27 @@ pub fn nscd_figures(dir: &Path, first_cycle_q: Option<&[[f64; 3]]>) -> Result<Ru
         ),
     }
     Ok(out)
+}
+
+/// World vertices (m) of the bodies of `sys` and whether each is fixed: one
+/// polygon per body (a disc as a 32-gon), except a compound, which gives one per
+/// part (so the lists follow the bodies' order but not their indices).
+pub fn polygons_of(sys: &System) -> (Vec<Vec<[f64; 2]>>, Vec<bool>) {
+    let (mut polygons, mut fixed) = (Vec::new(), Vec::new());
+    for (i, info) in sys.bodies.info.iter().enumerate() {
+        for part in crate::nscd::measure::world_parts(sys, i) {
+            polygons.push(part);
+            fixed.push(info.fixed);
+        }
+    }
+    (polygons, fixed)
+}
+
+/// Force chain segments of the last step of `sys` ([`force_lines`] of its
+/// contact list): between the centres of two moving bodies, from a body's
+/// centre to its contact points with a fixed one.
+pub fn force_lines_of(sys: &System) -> Vec<ForceLine> {
+    let rows = crate::engine::Engine::contact_rows(sys);
+    let q = &sys.bodies.q;
+    force_lines(&rows, |i| q.get(i).map(|q| [q[0], q[1], 0.0]), |p| [p[0], p[1]])
 }

@@ -1,5 +1,5 @@
 //! The figures of one finished MD run, drawn from its output folder alone
-//! ([`md_figures`], through [`super::run_figures::draw_run_figures`]), each as
+//! ([`md_figures`], through [`super::draw_run_figures`]), each as
 //! `<stem>.png` + `<stem>.svg`:
 //!
 //! - `energies`: kinetic, elastic and potential energy vs time (from
@@ -21,11 +21,11 @@
 //!   (their shapes from the copy of the scene, `scene.toml`, or
 //!   `initial_state.json`; none without either).
 
-use super::figures::{self, Axes, Series};
-use super::run_figures::{max_abs, read_contacts, read_final, require, RunFigures};
-use super::series::{MdSeriesRow, MD_SERIES_COLUMNS};
+use super::{force_lines, max_abs, read_contacts, read_final, require, RunFigures};
 use crate::error::{Error, Result};
+use crate::io::figures::{self, Axes, Series};
 use crate::io::layout;
+use crate::io::series::{MdSeriesRow, MD_SERIES_COLUMNS};
 use crate::md::{MdSystem, Shape, Wall, V3};
 use std::path::Path;
 
@@ -35,12 +35,12 @@ const CIRCLE_SIDES: usize = 32;
 /// Draws the MD figures of the run in `dir` (see the module documentation).
 ///
 /// # Errors
-/// As [`super::run_figures::draw_run_figures`]; [`Error::Scene`] if `final.json`
+/// As [`super::draw_run_figures`]; [`Error::Scene`] if `final.json`
 /// holds bodies without a 3D position and a radius.
 pub fn md_figures(dir: &Path) -> Result<RunFigures> {
     let fin = read_final(dir)?;
     let series_path = require(dir, layout::SERIES)?;
-    let (header, rows) = super::series::read_md(&series_path)?;
+    let (header, rows) = crate::io::series::read_md(&series_path)?;
     let mut out = RunFigures::default();
     let curve = |label: &str, f: &dyn Fn(&MdSeriesRow) -> f64| Series {
         label: label.into(),
@@ -117,7 +117,7 @@ fn plate_cycles(dir: &Path, servos: &[(usize, String)], out: &mut RunFigures) ->
         out.skip("plate_settlement_cycles", "no cycles.csv (the run had no loading cycles)");
         return Ok(());
     }
-    let rows = super::cycles::read_md(&path)?;
+    let rows = crate::io::cycles::read_md(&path)?;
     let (s, unit) = figures::si_scale(max_abs(rows.iter().flat_map(|r| r.walls.iter().copied())).max(1e-12), "m");
     let series: Vec<Series> = servos
         .iter()
@@ -164,7 +164,7 @@ fn side_view(dir: &Path, fin: &crate::engine::FinalState, out: &mut RunFigures) 
         });
         circles.push(circle.collect::<Vec<_>>());
     }
-    let lines = figures::force_lines(&rows, |i| centres.get(i).copied(), |p| [p[0], p[2]]);
+    let lines = force_lines(&rows, |i| centres.get(i).copied(), |p| [p[0], p[2]]);
     let title = format!("Side view (x–z) at t = {:.4} s (line width ∝ normal force)", fin.time);
     let stem = dir.join("side_view");
     let mut polygons = wall_strips(dir, fin, &circles)?;
@@ -187,7 +187,7 @@ fn walls_of(dir: &Path) -> Result<Option<Vec<Wall>>> {
     if scene.is_file() {
         Ok(Some(crate::scene::MdScene::load(&scene)?.build()?.walls))
     } else if initial.is_file() {
-        Ok(Some(super::read_json::<Input>(&initial)?.system.walls))
+        Ok(Some(crate::io::read_json::<Input>(&initial)?.system.walls))
     } else {
         Ok(None)
     }

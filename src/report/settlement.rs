@@ -14,13 +14,13 @@
 //!   when both folders hold the cycle positions ([`crate::run::positions`]), the
 //!   relative configuration error `E_r` of eq. (22) over the translations.
 
-use super::driver::{JumpRow, SettlementRow};
-use super::estimate::configuration_error;
+use super::RunFigures;
 use crate::error::{Error, Result};
 use crate::io::figures::{self, Axes, Series};
 use crate::io::layout::{self, SETTLEMENT};
-use crate::io::run_figures::RunFigures;
 use crate::run::positions::{self, CyclePositions};
+use crate::settlement::driver::{JumpRow, SettlementRow};
+use crate::settlement::estimate::configuration_error;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -157,7 +157,7 @@ pub fn draw(dir: &Path, reference: Option<&Path>) -> Result<RunFigures> {
                 ..Series::default()
             },
         );
-        let summary: super::AccelerationSummary = crate::io::read_json(&dir.join(layout::SUMMARY))?;
+        let summary: crate::settlement::AccelerationSummary = crate::io::read_json(&dir.join(layout::SUMMARY))?;
         let mut table = errors(&rows, &full, summary.initial_cycles);
         if dir.join(layout::CYCLE_DISPLACEMENTS).is_file() && reference.join(layout::CYCLE_DISPLACEMENTS).is_file() {
             add_configuration_errors(&mut table, &positions::read(dir)?, &positions::read(reference)?)?;
