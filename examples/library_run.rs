@@ -10,7 +10,8 @@
 use ballast::engine::Engine;
 use ballast::md::{Ghosts, LawTable, Material, MdSettings, MdSystem, Motion, PairLaw, Particles, Wall, V3};
 use ballast::nscd::{BodyInfo, ContactLaw, NscdParams, System};
-use ballast::run::{run_file, RunOptions, RunPlan, Runner};
+use ballast::open::run_file;
+use ballast::run::{RunOptions, RunPlan, Runner};
 use std::path::PathBuf;
 
 fn main() -> Result<(), ballast::Error> {

@@ -15,8 +15,9 @@
 //! `settlement.{png,svg}` with the settlement of both runs (Figs. 6/11).
 
 use ballast::io::figures::{self, Axes};
+use ballast::open::run_file;
 use ballast::report::plane::settlement_series;
-use ballast::run::{run_file, RunOptions, Status};
+use ballast::run::{RunOptions, Status};
 use ballast::scenarios::saussine::{loaded_scene, measure_sample, sample_scene, LoadingSpec, SampleSpec};
 use ballast::scene::Scene;
 use std::path::PathBuf;

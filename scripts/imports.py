@@ -16,13 +16,13 @@ LAYERS = [
     ["engine"],
     ["plane"],
     ["nscd", "md"],
-    ["scene"],
     ["run"],
     ["settlement"],
+    ["scene"],
     ["report"],
+    ["open"],
     ["scenarios"],
     ["studies"],
-    ["cli", "main"],
 ]
 LAYER = {name: i for i, names in enumerate(LAYERS) for name in names}
 

@@ -60,3 +60,14 @@ impl Error {
 
 /// The crate's result type.
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// A user's string for an error message: at most 64 characters (longer ones cut
+/// with `…`), control characters replaced.
+pub fn clip(s: &str) -> String {
+    const MAX: usize = 64;
+    let mut out: String = s.chars().take(MAX).map(|c| if c.is_control() { '?' } else { c }).collect();
+    if s.chars().count() > MAX {
+        out.push('…');
+    }
+    out
+}

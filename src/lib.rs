@@ -8,14 +8,18 @@
 //!   linear spring–dashpot laws, Verlet and Gear integrators, walls, servo walls,
 //!   symmetry planes; Karrech et al. 2007, David et al.).
 //!
-//! Around them:
-//! - [`run`]: the run loop shared by both engines (equilibrium stop, outputs,
-//!   checkpoints and resume, divergence handling, progress callback) and the
-//!   write-back of generalised positions that a cyclic driver needs;
+//! Around them, bottom to top (ARCHITECTURE.md draws the layers):
+//! - [`engine`]: the engine contract (the trait, what a step reports, contacts, final state, the
+//!   generalised positions a cyclic driver reads and writes back, the relaxation service);
+//! - [`run`]: the run loop shared by the engines (equilibrium stop, outputs,
+//!   checkpoints and resume, divergence handling, progress callback);
+//! - [`settlement`]: the settlement-acceleration driver (Karrech et al. 2007, Fig. 10) over any engine;
 //! - [`scene`]: TOML scene files of either engine, their validation (one-line
 //!   errors naming the field), building a system, saving a state as a scene;
-//! - [`io`]: the output files (CSV through serde row types, JSON, VTK for
-//!   ParaView, figures);
+//! - [`report`]: the figures of a run drawn from its folder;
+//! - [`open`]: a scene file opened on its engine and run (the one registration point of the engines);
+//! - [`io`]: file formats (CSV through serde row types, JSON, VTK for ParaView, PNG + SVG figures) and the
+//!   layout of a run folder;
 //! - [`scenarios`]: ready-made scenes (the Saussine pentagon sample and its
 //!   loading, the Karrech sphere sample, the Luding triaxial box, the peers' bed);
 //! - [`studies`]: the papers' experiments run end to end (the Saussine sample,
@@ -30,7 +34,8 @@
 //!
 //! A scene file, run into an output folder (as `ballast run` does):
 //! ```no_run
-//! use ballast::run::{run_file, RunOptions};
+//! use ballast::open::run_file;
+//! use ballast::run::RunOptions;
 //! let out = run_file("examples/sleeper_load.toml".as_ref(), "out/sleeper".as_ref(), &RunOptions::default(), &mut |_| {})?;
 //! println!("{} steps, t = {} s, max overlap {:e} m", out.step, out.time, out.report.max_overlap_m);
 //! # Ok::<(), ballast::Error>(())
@@ -38,7 +43,8 @@
 //! A system built in code (here from a scene, then changed), stepped through the
 //! same loop, with its generalised positions read and written back:
 //! ```
-//! use ballast::run::{Engine, RunOptions, RunPlan, Runner};
+//! use ballast::engine::Engine;
+//! use ballast::run::{RunOptions, RunPlan, Runner};
 //! let scene = ballast::scene::Scene::load("examples/block_on_floor.toml")?;
 //! let mut sys = scene.build()?; // nscd::System: plain serde data
 //! let mut c = sys.configuration(); // (x, y, θ) of every mobile body
@@ -64,6 +70,7 @@ pub mod geometry;
 pub mod io;
 pub mod md;
 pub mod nscd;
+pub mod open;
 pub mod plane;
 pub mod report;
 pub mod run;

@@ -8,8 +8,9 @@
 
 use ballast::engine::contacts::{self, ContactKind};
 use ballast::engine::FinalState;
+use ballast::open::run_file;
 use ballast::report::draw_run_figures;
-use ballast::run::{run_file, RunOptions};
+use ballast::run::RunOptions;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

@@ -34,8 +34,9 @@
 //! `--nocapture`). Failures in code another session is changing are listed in
 //! [`KNOWN`] (with a TODO) and reported, not failed.
 
+use ballast::open::run_file;
 use ballast::run::checkpoint::crc32;
-use ballast::run::{run_file, Progress, RunOptions, RunOutcome, Status};
+use ballast::run::{Progress, RunOptions, RunOutcome, Status};
 use ballast::scene::{engine_of, MdScene, Scene};
 use ballast::Error;
 use rand::{RngExt, SeedableRng};

@@ -529,7 +529,7 @@ fn a_failed_step_leaves_the_last_good_state() {
 /// in the first step (x = 1e9 + 0.5 mm), and the system holds the start.
 #[test]
 fn a_sphere_beyond_the_scene_bounds_diverges() {
-    let x0 = ballast::scene::MAX_LENGTH - 5e-4;
+    let x0 = ballast::geometry::MAX_LENGTH - 5e-4;
     let mut p = Particles::default();
     p.push("runaway", 0, 2000.0, 0.01, V3::new(x0, 0.0, 0.0), V3::new(1.0, 0.0, 0.0), V3::zeros());
     let law = PairLaw::hertz(&material(1e8), &material(1e8), 0.3, 0.3, 0.5);

@@ -5,7 +5,8 @@
 //! the same bytes, the settlement driver runs on it, and bad `[soft]` tables or
 //! time steps are one-line errors naming the key and the numbers.
 
-use ballast::run::{run_file, RunOptions};
+use ballast::open::run_file;
+use ballast::run::RunOptions;
 use ballast::scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -105,7 +106,7 @@ fn a_planar_run_stopped_and_resumed_writes_the_same_bytes() {
 fn the_settlement_driver_runs_on_the_planar_md_engine() {
     let scene = "examples/settlement_sleeper.toml";
     let out = out_dir("driver");
-    let s = ballast::settlement::run_file(scene.as_ref(), &out, &opts(Some("md")), &mut |_| {}).unwrap().unwrap();
+    let s = ballast::open::settle_file(scene.as_ref(), &out, &opts(Some("md")), &mut |_| {}).unwrap().unwrap();
     assert_eq!((s.total_cycles, s.computed_cycles, s.jumps), (30, 18, 3));
     assert_eq!(json(&out.join("run.json"))["engine"], "md2d");
     let jumps: Vec<ballast::settlement::JumpRow> = ballast::io::read_csv(&out.join("jumps.csv")).unwrap();
@@ -115,10 +116,10 @@ fn the_settlement_driver_runs_on_the_planar_md_engine() {
     }
     let cut = out_dir("driver-cut");
     let stop = RunOptions { stop_after: Some(20_000), ..opts(Some("md")) };
-    let s1 = ballast::settlement::run_file(scene.as_ref(), &cut, &stop, &mut |_| {}).unwrap().unwrap();
+    let s1 = ballast::open::settle_file(scene.as_ref(), &cut, &stop, &mut |_| {}).unwrap().unwrap();
     assert_eq!(s1.end, "stopped");
     let resume = RunOptions { resume: true, ..opts(Some("md")) };
-    let s2 = ballast::settlement::run_file(scene.as_ref(), &cut, &resume, &mut |_| {}).unwrap().unwrap();
+    let s2 = ballast::open::settle_file(scene.as_ref(), &cut, &resume, &mut |_| {}).unwrap().unwrap();
     assert_eq!(s2.settlement_m.to_bits(), s.settlement_m.to_bits());
 }
 

@@ -114,7 +114,7 @@ fn a_stalled_step_is_accepted_extended_or_stops_the_run() {
     let scene_path = dir.join("stall.toml");
     std::fs::write(&scene_path, &text).unwrap();
     let out = dir.join("out");
-    let err = ballast::run::run_file(&scene_path, &out, &RunOptions::default(), &mut |_| {}).unwrap_err();
+    let err = ballast::open::run_file(&scene_path, &out, &RunOptions::default(), &mut |_| {}).unwrap_err();
     match &err {
         Error::Stalled { step, iterations, criterion, tolerance } => {
             assert_eq!((*step, *iterations), (1, 3));

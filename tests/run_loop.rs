@@ -327,7 +327,8 @@ fn outputs_read_back_through_the_row_types() {
 /// that of the last row of `series.csv`.
 #[test]
 fn a_run_length_replaces_the_scene_duration() {
-    use ballast::run::{run_file, RunLength};
+    use ballast::open::run_file;
+    use ballast::run::RunLength;
     let dir = temp_dir("length");
     let md = dir.join("md.toml");
     std::fs::write(&md, md_scene(0.01, false)).unwrap();
@@ -337,7 +338,7 @@ fn a_run_length_replaces_the_scene_duration() {
         let out = dir.join(format!("out-{}", scene.file_stem().unwrap().to_string_lossy()));
         for (length, steps) in [(RunLength::Steps(7), 7), (RunLength::Duration(11.0 * dt), 11)] {
             let opts = RunOptions { length: Some(length), ..quiet() };
-            let run = ballast::run::run_file(scene, &out, &opts, &mut |_| {}).unwrap();
+            let run = ballast::open::run_file(scene, &out, &opts, &mut |_| {}).unwrap();
             assert_eq!(run.step, steps, "{}", scene.display());
             // The final overlap reported is the last row's; the run's largest bounds it.
             let last = if scene == &md {

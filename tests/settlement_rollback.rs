@@ -5,8 +5,9 @@
 //! for bit; a landing rolled back after its window (`rollback_rate`) from a
 //! checkpoint taken on probation resumes to the uninterrupted run's numbers.
 
+use ballast::open::settle_file;
 use ballast::run::RunOptions;
-use ballast::settlement::{run_file, AccelerationSummary, JumpRow, SettlementRow};
+use ballast::settlement::{AccelerationSummary, JumpRow, SettlementRow};
 use std::path::{Path, PathBuf};
 
 const SCENE: &str = "examples/settlement_sleeper.toml";
@@ -51,7 +52,7 @@ fn run(dir: &Path, text: &str, opts: &RunOptions) -> AccelerationSummary {
     std::fs::create_dir_all(dir).unwrap();
     let scene = dir.join("scene.toml");
     std::fs::write(&scene, text).unwrap();
-    run_file(&scene, &dir.join("out"), opts, &mut |_| {}).unwrap().unwrap()
+    settle_file(&scene, &dir.join("out"), opts, &mut |_| {}).unwrap().unwrap()
 }
 
 fn opts() -> RunOptions {
@@ -119,7 +120,7 @@ fn a_landing_rolled_back_after_its_window_resumes_to_the_same_numbers() {
     let checkpoint = std::fs::read_to_string(cut_dir.join("out/checkpoint.json")).unwrap();
     assert!(checkpoint.contains("\"before_jump\":{"), "the checkpoint keeps the state before the jump on probation");
     let resume = RunOptions { resume: true, ..opts() };
-    let s2 = run_file(&cut_dir.join("scene.toml"), &cut_dir.join("out"), &resume, &mut |_| {}).unwrap().unwrap();
+    let s2 = settle_file(&cut_dir.join("scene.toml"), &cut_dir.join("out"), &resume, &mut |_| {}).unwrap().unwrap();
     assert_eq!(s2.end, "finished");
     assert_eq!((s2.rollbacks, s2.jumps, s2.computed_cycles), (s.rollbacks, s.jumps, s.computed_cycles));
     assert_eq!(tables(&cut_dir.join("out")), (rows, jumps), "the resumed run's tables are the uninterrupted run's");

@@ -2,8 +2,9 @@
 //! runs the procedure; a stopped run resumes to the same numbers; bad tables are
 //! one-line errors naming the key.
 
+use ballast::open::settle_file;
 use ballast::run::RunOptions;
-use ballast::settlement::{run_file, AccelerationSummary, JumpRow, SettlementRow};
+use ballast::settlement::{AccelerationSummary, JumpRow, SettlementRow};
 use std::path::{Path, PathBuf};
 
 const SCENE: &str = "examples/settlement_sleeper.toml";
@@ -31,7 +32,7 @@ fn run_text(name: &str, text: &str) -> (AccelerationSummary, (Vec<SettlementRow>
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("scene.toml");
     std::fs::write(&scene, text).unwrap();
-    let s = run_file(&scene, &dir.join("out"), &opts, &mut |_| {}).unwrap().unwrap();
+    let s = settle_file(&scene, &dir.join("out"), &opts, &mut |_| {}).unwrap().unwrap();
     let t = tables(&dir.join("out"));
     let _ = std::fs::remove_dir_all(dir);
     (s, t)
@@ -41,7 +42,7 @@ fn run_text(name: &str, text: &str) -> (AccelerationSummary, (Vec<SettlementRow>
 fn the_example_runs_through_the_procedure_and_resumes_to_the_same_numbers() {
     let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
     let whole = out_dir("whole");
-    let s = run_file(SCENE.as_ref(), &whole, &opts, &mut |_| {}).unwrap().expect("the example has [settlement]");
+    let s = settle_file(SCENE.as_ref(), &whole, &opts, &mut |_| {}).unwrap().expect("the example has [settlement]");
     // 30 cycles: 2 initial, then 4 computed + 4 extrapolated, three times, and 4 computed.
     assert_eq!((s.total_cycles, s.computed_cycles, s.jumps), (30, 18, 3));
     assert!((s.gained - 30.0 / 18.0).abs() < 1e-12);
@@ -56,11 +57,11 @@ fn the_example_runs_through_the_procedure_and_resumes_to_the_same_numbers() {
     // Stopped after 1000 steps (cycle 14, inside the second window), resumed.
     let cut = out_dir("cut");
     let stop = RunOptions { stop_after: Some(1000), ..opts.clone() };
-    let s1 = run_file(SCENE.as_ref(), &cut, &stop, &mut |_| {}).unwrap().unwrap();
+    let s1 = settle_file(SCENE.as_ref(), &cut, &stop, &mut |_| {}).unwrap().unwrap();
     assert_eq!(s1.end, "stopped");
     assert!(cut.join("checkpoint.json").is_file());
     let resume = RunOptions { resume: true, ..opts.clone() };
-    let s2 = run_file(SCENE.as_ref(), &cut, &resume, &mut |_| {}).unwrap().unwrap();
+    let s2 = settle_file(SCENE.as_ref(), &cut, &resume, &mut |_| {}).unwrap().unwrap();
     assert_eq!(s2.end, "finished");
     assert_eq!(tables(&cut), (rows, jumps), "the resumed run's tables are the uninterrupted run's");
     assert_eq!(s2.settlement_m.to_bits(), s.settlement_m.to_bits());
@@ -104,7 +105,7 @@ fn the_example_runs_through_the_procedure_and_resumes_to_the_same_numbers() {
     // A scene without [settlement] is not run by it, and its folder has no
     // accelerated run to measure: one line naming the file, exit code 2.
     let none = out_dir("none");
-    assert!(run_file("examples/sleeper_load.toml".as_ref(), &none, &opts, &mut |_| {}).unwrap().is_none());
+    assert!(settle_file("examples/sleeper_load.toml".as_ref(), &none, &opts, &mut |_| {}).unwrap().is_none());
     std::fs::create_dir_all(&none).unwrap();
     let out = figures(&none);
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -351,7 +352,7 @@ fn a_body_that_leaves_the_domain_stops_the_run_naming_it() {
     let scene = dir.join("stray.toml");
     std::fs::write(&scene, text).unwrap();
     let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
-    let e = run_file(&scene, &dir.join("out"), &opts, &mut |_| {}).unwrap_err().to_string();
+    let e = settle_file(&scene, &dir.join("out"), &opts, &mut |_| {}).unwrap_err().to_string();
     assert!(e.contains("'stray'") && e.contains("computed cycle 1 carried it out of the domain"), "{e}");
     assert!(!e.contains('\n'), "one line: {e}");
     let summary: serde_json::Value =
@@ -395,7 +396,7 @@ fn hold_anchored_keeps_the_sprung_bodies_where_the_computed_cycle_left_them() {
         let dir = out_dir(name);
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("scene.toml"), t).unwrap();
-        run_file(&dir.join("scene.toml"), &dir.join("out"), &opts, &mut |_| {}).unwrap().unwrap();
+        settle_file(&dir.join("scene.toml"), &dir.join("out"), &opts, &mut |_| {}).unwrap().unwrap();
         let p = ballast::run::positions::read(&dir.join("out")).unwrap();
         let jumps = tables(&dir.join("out")).1;
         let _ = std::fs::remove_dir_all(dir);

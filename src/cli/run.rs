@@ -1,12 +1,12 @@
 //! `ballast run SCENE --out DIR`: one scene file of either engine through the
-//! library's run loop ([`ballast::run::run_file`]), or, if it has a
-//! `[settlement]` table, through the settlement-acceleration procedure
-//! ([`ballast::settlement::run_file`]).
+//! library's run loop, or, if it has a `[settlement]` table, through the
+//! settlement-acceleration procedure: opened once ([`ballast::open::open`]), then
+//! [`ballast::open::Loaded::run`] or [`ballast::open::Loaded::settle`].
 
 use super::{Bars, Failure};
 use ballast::run::{default_threads, RunLength, RunOptions};
 use ballast::settlement::AccelerationProgress;
-use ballast::studies::run_scene;
+use ballast::studies::run_loaded;
 use std::path::PathBuf;
 
 /// The arguments of `ballast run`.
@@ -78,12 +78,16 @@ pub fn main(a: RunArgs) -> Result<(), Failure> {
     // A scene with `[settlement]` runs the settlement-acceleration procedure.
     let bar = super::cycle_bar(a.quiet);
     let mut show = |p: &AccelerationProgress| super::show_cycles(&bar, p);
-    if let Some(s) = ballast::settlement::run_file(&a.scene, &a.out, &opts, &mut show)? {
+    let loaded = ballast::open::open(&a.scene, &opts)?;
+    if loaded.settles() {
+        let summary = loaded.settle(&a.out, &opts, &mut show)?;
         bar.finish_and_clear();
-        super::print_acceleration(&s, &a.out);
+        if let Some(s) = summary {
+            super::print_acceleration(&s, &a.out);
+        }
         return Ok(());
     }
     bar.finish_and_clear();
-    run_scene(&a.scene, &a.out, &opts, &Bars::single(a.quiet), "run")?;
+    run_loaded(loaded, &a.out, &opts, &Bars::single(a.quiet), "run")?;
     Ok(())
 }

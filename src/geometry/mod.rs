@@ -31,3 +31,9 @@ pub fn perp(a: Vec2) -> Vec2 {
 pub fn rotate(v: Vec2, c: f64, s: f64) -> Vec2 {
     Vec2::new(c * v.x - s * v.y, s * v.x + c * v.y)
 }
+
+/// Largest coordinate or size (m) a scene may use, so that the contact
+/// detection grid stays finite.
+pub const MAX_LENGTH: f64 = 1.0e9;
+/// Smallest size (radius of the enclosing circle, m) of a body.
+pub const MIN_SIZE: f64 = 1.0e-9;

@@ -263,7 +263,7 @@ impl LawTable {
     /// `'name'` of material `i` if the table has names, else `material i`.
     pub fn material_name(&self, i: usize) -> String {
         match self.names.get(i) {
-            Some(name) => format!("'{}'", crate::scene::clip(name)),
+            Some(name) => format!("'{}'", crate::error::clip(name)),
             None => format!("material {i}"),
         }
     }
@@ -290,11 +290,11 @@ impl LawTable {
         }
         let sphere = |i: usize| match particles.name[i].as_str() {
             "" => format!("sphere {i}"),
-            name => format!("sphere {i} '{}'", crate::scene::clip(name)),
+            name => format!("sphere {i} '{}'", crate::error::clip(name)),
         };
         let wall = |k: usize| match walls[k].name.as_str() {
             "" => format!("wall {k}"),
-            name => format!("wall {k} '{}'", crate::scene::clip(name)),
+            name => format!("wall {k} '{}'", crate::error::clip(name)),
         };
         if let Some(i) = (0..particles.len()).find(|&i| particles.material[i] as usize >= n) {
             return bad(format!("{}: material {} of {n}", sphere(i), particles.material[i]));

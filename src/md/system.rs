@@ -221,9 +221,9 @@ pub const CHUNKS: usize = 2;
 const BACKUP_EVERY: u64 = 100;
 
 /// A sphere whose centre leaves `±POSITION_BOUND` (m) on an axis ends the step
-/// with a divergence: the bounds of a scene ([`crate::scene::MAX_LENGTH`]), so
+/// with a divergence: the bounds of a scene ([`crate::geometry::MAX_LENGTH`]), so
 /// that the state of a run can always be written back as a valid scene.
-pub const POSITION_BOUND: f64 = crate::scene::MAX_LENGTH;
+pub const POSITION_BOUND: f64 = crate::geometry::MAX_LENGTH;
 
 /// The energy-growth check stops a run whose spheres hold more than
 /// `E_0 + W + ENERGY_GROWTH (|E_0| + W)`, with `E_0` the mechanical energy at the
@@ -725,7 +725,7 @@ impl MdSystem {
             return bad("symmetry images: origins, masks and keys do not match".into());
         }
         if let Some(w) = self.walls.iter().find(|w| w.candidates.iter().any(|&i| i as usize >= n)) {
-            return bad(format!("wall '{}': a candidate sphere out of range", crate::scene::clip(&w.name)));
+            return bad(format!("wall '{}': a candidate sphere out of range", crate::error::clip(&w.name)));
         }
         if !(self.settings.dt.is_finite() && self.settings.dt > 0.0) {
             return bad(format!("time step {} s", self.settings.dt));
@@ -745,7 +745,7 @@ impl MdSystem {
             return bad("symmetry images: not the images of the spheres at the last build".into());
         }
         if let Some((w, _)) = self.walls.iter().zip(&again.walls).find(|(w, v)| w.candidates != v.candidates) {
-            let name = crate::scene::clip(&w.name);
+            let name = crate::error::clip(&w.name);
             return bad(format!("wall '{name}': not the candidate spheres of the last build"));
         }
         if again.wall_hist != self.wall_hist {
@@ -777,7 +777,7 @@ impl MdSystem {
                 && a.inv_i[i].to_bits() == b.inv_i[i].to_bits()
                 && a.material[i] == b.material[i];
             if !same {
-                return bad(format!("sphere {i} ('{}')", crate::scene::clip(&b.name[i])));
+                return bad(format!("sphere {i} ('{}')", crate::error::clip(&b.name[i])));
             }
         }
         if self.walls.len() != fresh.walls.len() {
@@ -785,7 +785,7 @@ impl MdSystem {
         }
         for (w, f) in self.walls.iter().zip(&fresh.walls) {
             if w.name != f.name || w.material != f.material || w.shape != f.shape || w.motion != f.motion {
-                return bad(format!("wall '{}'", crate::scene::clip(&f.name)));
+                return bad(format!("wall '{}'", crate::error::clip(&f.name)));
             }
         }
         let same = |x: &dyn Fn(&MdSystem) -> serde_json::Value| x(self) == x(fresh);

@@ -218,7 +218,7 @@ impl System {
         // Scenes place bodies within ±MAX_LENGTH (the detection grid and the
         // restart scene, `final_scene.toml`, rely on it): a body carried beyond
         // has run away.
-        let far = crate::scene::MAX_LENGTH;
+        let far = crate::geometry::MAX_LENGTH;
         if let Some(i) = (0..n).find(|&i| failure.is_none() && self.bodies.q[i][..2].iter().any(|x| x.abs() > far)) {
             failure = Some((i, format!("runaway position: its centre of mass is beyond ±{far:e} m")));
         }

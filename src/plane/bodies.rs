@@ -72,7 +72,7 @@ impl BodyInfo {
     /// the mass or inertia is not (a shape too small or too large for `f64`).
     pub fn new(name: impl Into<String>, shape: Shape, material: usize, density: f64, thickness: f64) -> Result<Self> {
         let name = name.into();
-        let who = || crate::scene::clip(&name);
+        let who = || crate::error::clip(&name);
         for (what, v, unit) in [("density", density, "kg/m^3"), ("thickness", thickness, "m")] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(Error::Scene(format!(
@@ -336,7 +336,7 @@ impl Bodies {
         if let Some(&i) = c.bodies.iter().find(|&&i| self.info[i].fixed) {
             return Err(Error::Scene(format!(
                 "configuration: body {i} ('{}') is fixed",
-                crate::scene::clip(&self.info[i].name)
+                crate::error::clip(&self.info[i].name)
             )));
         }
         for (k, &i) in c.bodies.iter().enumerate() {

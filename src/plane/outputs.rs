@@ -278,7 +278,7 @@ pub fn check_same_bodies(state: (&Bodies, &[super::Spring]), fresh: (&Bodies, &[
     }
     for (i, (a, b)) in bodies.info.iter().zip(&fresh_bodies.info).enumerate() {
         if !same(a, b) {
-            return bad(format!("body {i} ('{}')", crate::scene::clip(&b.name)));
+            return bad(format!("body {i} ('{}')", crate::error::clip(&b.name)));
         }
     }
     if springs.len() != fresh_springs.len() {
@@ -292,7 +292,7 @@ pub fn check_same_bodies(state: (&Bodies, &[super::Spring]), fresh: (&Bodies, &[
         }
     }
     if let Some(i) = (0..bodies.len()).find(|&i| !same(&bodies.inv_m[i], &fresh_bodies.inv_m[i])) {
-        return bad(format!("the inverse masses of body {i} ('{}')", crate::scene::clip(&fresh_bodies.info[i].name)));
+        return bad(format!("the inverse masses of body {i} ('{}')", crate::error::clip(&fresh_bodies.info[i].name)));
     }
     Ok(())
 }

@@ -139,7 +139,7 @@ pub fn check_origin(path: &Path, (engine, version, source_crc32): (&str, &str, u
     if engine != want.0 {
         return Err(invalid(
             path,
-            format!("written by the {} engine, the scene is for {}", crate::scene::clip(engine), want.0),
+            format!("written by the {} engine, the scene is for {}", crate::error::clip(engine), want.0),
         ));
     }
     let this = env!("CARGO_PKG_VERSION");
@@ -148,7 +148,7 @@ pub fn check_origin(path: &Path, (engine, version, source_crc32): (&str, &str, u
             path,
             format!(
                 "written by ballast {}, this is {this}; run without --resume to start again",
-                crate::scene::clip(version)
+                crate::error::clip(version)
             ),
         ));
     }

@@ -76,7 +76,7 @@ pub struct RunOptions {
     pub vtk_every: u64,
     /// Threads of a step (1 or 2).
     pub threads: usize,
-    /// Draw the run's figures at the end (a run of a scene file, [`super::run_file`], or one given
+    /// Draw the run's figures at the end (a run of a scene file, [`crate::open::run_file`], or one given
     /// [`Runner::with_figures`]; else the run refuses it).
     pub figures: bool,
     /// A scene file's `[simulation] duration` replaced for this run (for quick
@@ -182,7 +182,7 @@ pub type Restart<E> = Box<dyn Fn(&E) -> Result<String> + Send + Sync>;
 
 /// Draws the figures of a finished run from its folder (`ballast figures`); the per-cycle state the run
 /// ended with, if it had one, gives what the files do not hold (NSCD: the positions at the end of the first
-/// cycle). Given by whoever opens the scene ([`super::run_file`]), which knows the engine's figures; the run
+/// cycle). Given by whoever opens the scene ([`crate::open::run_file`]), which knows the engine's figures; the run
 /// loop only calls it when [`RunOptions::figures`] asks.
 pub type Figures<E> = Box<dyn Fn(&Path, Option<&<E as Engine>::CycleState>) -> Result<()> + Send + Sync>;
 
@@ -241,7 +241,7 @@ impl<E: Engine> Runner<E> {
     }
 
     /// The same run, drawing its figures with `figures` at the end when [`RunOptions::figures`] asks
-    /// ([`super::run_file`] gives each engine's).
+    /// ([`crate::open::run_file`] gives each engine's).
     pub fn with_figures(mut self, figures: Figures<E>) -> Self {
         self.figures = Some(figures);
         self
@@ -282,6 +282,7 @@ impl<E: Engine> Runner<E> {
     /// state has been written (`series.csv` row, `final.json`, `summary.json`).
     pub fn run(&self, out: &Path, opts: &RunOptions, progress: &mut dyn FnMut(&Progress)) -> Result<RunOutcome> {
         check_options(opts)?;
+        check_built(opts)?;
         if opts.figures && self.figures.is_none() {
             return Err(Error::Scene(
                 "figures: this run has no figure drawer (a run of a scene file draws its engine's; a system built \
@@ -659,6 +660,28 @@ pub fn check_options(opts: &RunOptions) -> Result<()> {
     }
     if opts.threads == 0 {
         return Err(Error::Scene("--threads: must be at least 1, got 0".into()));
+    }
+    Ok(())
+}
+
+/// Refuses the options that change a scene (`length`, `engine`): they are applied when a scene file is opened
+/// ([`crate::open::open`]), and a run of a system already built cannot take them.
+///
+/// # Errors
+/// [`Error::Scene`] naming the option.
+pub fn check_built(opts: &RunOptions) -> Result<()> {
+    if opts.length.is_some() {
+        return Err(Error::Scene(
+            "length: a built system runs its plan's length; apply it to the scene when opening it (ballast::open)"
+                .into(),
+        ));
+    }
+    if let Some(engine) = &opts.engine {
+        return Err(Error::Scene(format!(
+            "engine: a built system runs on its own engine, not '{}'; choose the engine when opening the scene \
+             (ballast::open)",
+            crate::error::clip(engine)
+        )));
     }
     Ok(())
 }

@@ -122,14 +122,14 @@ pub(crate) fn check_simulation(sim: &Simulation, engine: &str, dimension: i64) -
     if !super::ENGINES.contains(&sim.engine.as_str()) {
         return err(format!(
             "simulation.engine: unknown engine '{}', expected 'nscd' or 'md'",
-            super::clip(&sim.engine)
+            crate::error::clip(&sim.engine)
         ));
     }
     if sim.engine != engine {
         let other = if engine == "nscd" { "scene::MdScene" } else { "scene::Scene" };
         return err(format!(
             "simulation.engine: expected '{engine}', got '{}' (read it with {other})",
-            super::clip(&sim.engine)
+            crate::error::clip(&sim.engine)
         ));
     }
     if let Some(d) = sim.dimension.filter(|&d| d != dimension) {
@@ -175,7 +175,7 @@ pub(crate) fn check_output(
     let body = match (&c.body, need_body) {
         (Some(name), true) => match body_index(name).filter(|_| !name.is_empty()) {
             Some(i) => Some(i),
-            None => return err(format!("output.cycles.body: unknown body '{}'", super::clip(name))),
+            None => return err(format!("output.cycles.body: unknown body '{}'", crate::error::clip(name))),
         },
         (None, true) => return err("output.cycles.body: name the followed body (the sleeper)".into()),
         (Some(_), false) => {
@@ -400,7 +400,7 @@ pub(crate) fn check_settlement(
         Some(m) => {
             return err(format!(
                 "settlement.relax_method: unknown method '{}' (expected \"lbfgs\" or \"gradient_descent\")",
-                super::clip(m)
+                crate::error::clip(m)
             ))
         }
     };

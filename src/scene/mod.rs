@@ -40,7 +40,7 @@ pub use soft::{
 };
 pub use validate::{MAX_LENGTH, MAX_SIDES, MAX_STEPS, MIN_SIZE};
 
-use crate::error::{Error, Result};
+use crate::error::{clip, Error, Result};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -178,15 +178,4 @@ impl Scene {
             }
         })
     }
-}
-
-/// A user's string for an error message: at most 64 characters (longer ones cut
-/// with `…`), control characters replaced.
-pub fn clip(s: &str) -> String {
-    const MAX: usize = 64;
-    let mut out: String = s.chars().take(MAX).map(|c| if c.is_control() { '?' } else { c }).collect();
-    if s.chars().count() > MAX {
-        out.push('…');
-    }
-    out
 }

@@ -100,7 +100,10 @@ pub(crate) fn check_soft(s: &SoftSection) -> Result<SoftModel> {
     let model = match s.model.as_deref() {
         None => SoftModel::Linear,
         Some(name) => SoftModel::from_name(name).ok_or_else(|| {
-            Error::Scene(format!("soft.model: unknown model '{}', expected 'linear' or 'hertz'", super::clip(name)))
+            Error::Scene(format!(
+                "soft.model: unknown model '{}', expected 'linear' or 'hertz'",
+                crate::error::clip(name)
+            ))
         })?,
     };
     if s.normal_stiffness.is_some() && s.max_overlap_ratio.is_some() {
@@ -126,7 +129,7 @@ pub(crate) fn check_soft(s: &SoftSection) -> Result<SoftModel> {
             return err(format!("soft.dt: must be a positive time step (s) or \"auto\", got {}", num(*dt)));
         }
         Some(SoftDt::Word(w)) if w != "auto" => {
-            return err(format!("soft.dt: must be a time step (s) or \"auto\", got '{}'", super::clip(w)));
+            return err(format!("soft.dt: must be a time step (s) or \"auto\", got '{}'", crate::error::clip(w)));
         }
         _ => {}
     }
@@ -168,7 +171,12 @@ impl Scene {
                 out.simulation.engine = "md".into();
                 out.simulation.dimension = Some(2);
             }
-            other => return err(format!("--engine: unknown engine '{}', expected 'nscd' or 'md'", super::clip(other))),
+            other => {
+                return err(format!(
+                    "--engine: unknown engine '{}', expected 'nscd' or 'md'",
+                    crate::error::clip(other)
+                ))
+            }
         }
         out.validate()?;
         Ok(out)
@@ -309,7 +317,9 @@ impl SceneKind {
                 err("--engine nscd: this is a 3D MD scene (spheres); the NSCD engine runs 2D scenes".into())
             }
             Some("nscd") => Ok(SceneKind::Nscd),
-            Some(other) => err(format!("--engine: unknown engine '{}', expected 'nscd' or 'md'", super::clip(other))),
+            Some(other) => {
+                err(format!("--engine: unknown engine '{}', expected 'nscd' or 'md'", crate::error::clip(other)))
+            }
         }
     }
 }

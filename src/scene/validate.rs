@@ -14,11 +14,7 @@ use std::collections::HashMap;
 /// Largest number of steps a scene may ask for (2⁵³, where `f64` stops counting exactly).
 pub const MAX_STEPS: f64 = 9.007_199_254_740_992e15;
 
-/// Largest coordinate or size (m) a scene may use, so that the contact
-/// detection grid stays finite.
-pub const MAX_LENGTH: f64 = 1.0e9;
-/// Smallest size (radius of the enclosing circle, m) of a body.
-pub const MIN_SIZE: f64 = 1.0e-9;
+pub use crate::geometry::{MAX_LENGTH, MIN_SIZE};
 
 /// Largest number of sides of a `regular` polygon.
 pub const MAX_SIDES: usize = 10_000;
@@ -80,7 +76,7 @@ fn tidy(msg: &str) -> String {
     let plain = |s: &str| s.chars().map(|c| if c.is_control() { '?' } else { c }).collect::<String>();
     msg.split('\'')
         .enumerate()
-        .map(|(k, s)| if k % 2 == 1 { super::clip(s) } else { plain(s) })
+        .map(|(k, s)| if k % 2 == 1 { crate::error::clip(s) } else { plain(s) })
         .collect::<Vec<_>>()
         .join("'")
 }
@@ -147,7 +143,7 @@ pub(crate) fn label(section: &str, i: usize, name: &str) -> String {
     if name.is_empty() {
         format!("{section}[{i}]")
     } else {
-        format!("{section}[{i}] '{}'", super::clip(name))
+        format!("{section}[{i}] '{}'", crate::error::clip(name))
     }
 }
 
@@ -226,8 +222,10 @@ fn named<T>(
 ) -> Result<T> {
     match given {
         None => Ok(default),
-        Some(name) => from_name(name)
-            .map_or_else(|| err(format!("{key}: unknown {what} '{}', expected {expected}", super::clip(name))), Ok),
+        Some(name) => from_name(name).map_or_else(
+            || err(format!("{key}: unknown {what} '{}', expected {expected}", crate::error::clip(name))),
+            Ok,
+        ),
     }
 }
 
@@ -381,7 +379,7 @@ fn check_materials(scene: &Scene) -> Result<HashMap<&str, usize>> {
         if let Some(j) = materials.insert(m.name.as_str(), i) {
             return err(format!(
                 "material[{i}].name: duplicate material '{}' (also material[{j}])",
-                super::clip(&m.name)
+                crate::error::clip(&m.name)
             ));
         }
         positive(&format!("{}: density", label("material", i, &m.name)), m.density)?;
@@ -398,15 +396,15 @@ fn check_contacts(scene: &Scene, materials: &HashMap<&str, usize>) -> Result<()>
         for (k, name) in c.between.iter().enumerate() {
             match materials.get(name.as_str()) {
                 Some(&m) => ids[k] = m,
-                None => return err(format!("contact[{i}].between: unknown material '{}'", super::clip(name))),
+                None => return err(format!("contact[{i}].between: unknown material '{}'", crate::error::clip(name))),
             }
         }
         let key = (ids[0].min(ids[1]), ids[0].max(ids[1]));
         if let Some(j) = pairs.insert(key, i) {
             return err(format!(
                 "contact[{i}].between: duplicate law for materials '{}' and '{}' (also contact[{j}])",
-                super::clip(&c.between[0]),
-                super::clip(&c.between[1])
+                crate::error::clip(&c.between[0]),
+                crate::error::clip(&c.between[1])
             ));
         }
         non_negative(&format!("contact[{i}].friction"), c.friction)?;
@@ -438,7 +436,7 @@ fn check_bodies<'a>(
             }
         }
         let Some(&material) = materials.get(b.material.as_str()) else {
-            return err(format!("{}: unknown material '{}'", ctx("material"), super::clip(&b.material)));
+            return err(format!("{}: unknown material '{}'", ctx("material"), crate::error::clip(&b.material)));
         };
         let (shape, centroid) = shape_of(b).map_err(|e| Error::Scene(format!("{label}: {e}")))?;
         let size = shape.bounding_radius() + centroid.norm();
@@ -503,7 +501,7 @@ fn check_springs(scene: &Scene, names: &HashMap<&str, usize>) -> Result<Vec<Chec
     for (i, s) in scene.springs.iter().enumerate() {
         let ctx = |field: &str| format!("spring[{i}].{field}");
         let Some(&a) = names.get(s.body.as_str()) else {
-            return err(format!("{}: unknown body '{}'", ctx("body"), super::clip(&s.body)));
+            return err(format!("{}: unknown body '{}'", ctx("body"), crate::error::clip(&s.body)));
         };
         let point_a = coordinates(&ctx("point"), s.point.unwrap_or([0.0, 0.0]))?;
         let (b, point_b, end_b) = match (&s.anchor, &s.other) {
@@ -518,10 +516,14 @@ fn check_springs(scene: &Scene, names: &HashMap<&str, usize>) -> Result<Vec<Chec
             }
             (None, Some(other)) => {
                 let Some(&b) = names.get(other.as_str()) else {
-                    return err(format!("{}: unknown body '{}'", ctx("other"), super::clip(other)));
+                    return err(format!("{}: unknown body '{}'", ctx("other"), crate::error::clip(other)));
                 };
                 if b == a {
-                    return err(format!("{}: the spring joins body '{}' to itself", ctx("other"), super::clip(other)));
+                    return err(format!(
+                        "{}: the spring joins body '{}' to itself",
+                        ctx("other"),
+                        crate::error::clip(other)
+                    ));
                 }
                 let p = coordinates(&ctx("other_point"), s.other_point.unwrap_or([0.0, 0.0]))?;
                 (Some(b), p, world(b, p))

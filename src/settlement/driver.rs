@@ -111,7 +111,7 @@ impl Law {
             _ => Err(Error::Scene(format!(
                 "{field}: unknown law '{}' (expected \"linear\", \"shenton\", \"shenton_decelerating\" or \
                  \"shenton_origin\")",
-                crate::scene::clip(name)
+                crate::error::clip(name)
             ))),
         }
     }
@@ -400,7 +400,7 @@ pub struct Accelerated<E: Engine> {
 }
 
 /// Draws the figures of a finished accelerated run from its folder (`ballast figures`,
-/// [`crate::report::settlement::draw`]); given by whoever opens the scene ([`super::run_file`]).
+/// [`crate::report::settlement::draw`]); given by whoever opens the scene ([`crate::open::settle_file`]).
 pub type FolderFigures = Box<dyn Fn(&Path) -> Result<()> + Send + Sync>;
 
 impl<E: Engine> Accelerated<E> {
@@ -472,6 +472,14 @@ impl<E: Engine> Accelerated<E> {
     ) -> Result<AccelerationOutcome<E>> {
         self.check()?;
         crate::run::check_options(opts)?;
+        crate::run::check_built(opts)?;
+        if opts.vtk_every > 0 {
+            return Err(Error::Scene(format!(
+                "vtk_every: an accelerated run writes no snapshots (its extrapolated cycles have no steps); got \
+                 {}, use 0",
+                opts.vtk_every
+            )));
+        }
         if opts.figures && self.figures.is_none() {
             return Err(Error::Scene(
                 "figures: this run has no figure drawer (a run of a scene file draws them; a system built in \

@@ -13,25 +13,23 @@
 //!   ([`Accelerated`]), its tables (`settlement.csv`, `jumps.csv`), summary and
 //!   checkpoints;
 //! - the figures and the errors against a full run are drawn from the folder ([`crate::report::settlement`]);
-//! - [`file`](mod@file): a scene file's `[settlement]` run through it (`ballast run`);
+//! - a scene file's `[settlement]` table is run through it by [`crate::open::settle_file`] (`ballast run`);
 //! - the relaxation after a jump is the engines' service ([`crate::engine::relax`]: an engine's functional
 //!   minimised by L-BFGS, or the paper's steepest descent, until the largest overlap is below a tolerance).
 
 pub mod driver;
 pub mod estimate;
-pub mod file;
 pub mod law;
 pub mod smooth;
 pub mod sweep;
 
 pub use driver::{
-    Accelerated, Acceleration, AccelerationOutcome, AccelerationProgress, AccelerationSummary, Adaptive, JumpRow, Law,
-    SettlementRow,
+    Accelerated, Acceleration, AccelerationOutcome, AccelerationProgress, AccelerationSummary, Adaptive, FolderFigures,
+    JumpRow, Law, SettlementRow,
 };
 pub use estimate::{
     chernoff_cycles, chernoff_probability, configuration_error, extrapolate, extrapolate_within, fit, trend_moves, Fit,
     Training,
 };
-pub use file::run_file;
 pub use law::{law_named, Linear, ResidualLaw, Shenton, ShentonDecelerating, ShentonOrigin};
 pub use smooth::Smoothing;

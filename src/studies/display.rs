@@ -6,7 +6,8 @@
 
 use super::saussine::Sample;
 use crate::error::Result;
-use crate::run::{run_file, Progress, RunOptions, RunOutcome};
+use crate::open::Loaded;
+use crate::run::{Progress, RunOptions, RunOutcome};
 use std::path::Path;
 
 /// What a study shows while it goes. Every method may be called from several
@@ -40,11 +41,11 @@ impl RunDisplay for Quiet {
     }
 }
 
-/// Runs the scene file `scene` into `out` ([`run_file`]) with the progress
+/// Runs the scene file `scene` into `out` ([`crate::open::run_file`]) with the progress
 /// callback of `display` for `label`, then tells `display` that it has ended.
 ///
 /// # Errors
-/// As [`run_file`].
+/// As [`crate::open::run_file`].
 pub fn run_scene(
     scene: &Path,
     out: &Path,
@@ -52,9 +53,23 @@ pub fn run_scene(
     display: &dyn RunDisplay,
     label: &str,
 ) -> Result<RunOutcome> {
+    run_loaded(crate::open::open(scene, opts)?, out, opts, display, label)
+}
+
+/// Runs a scene already opened ([`crate::open::open`] with the same `opts`) into `out` as [`run_scene`] does.
+///
+/// # Errors
+/// As [`Loaded::run`].
+pub fn run_loaded(
+    loaded: Loaded,
+    out: &Path,
+    opts: &RunOptions,
+    display: &dyn RunDisplay,
+    label: &str,
+) -> Result<RunOutcome> {
     let result = {
         let mut progress = display.run(label);
-        run_file(scene, out, opts, &mut *progress)
+        loaded.run(out, opts, &mut *progress)
     };
     let outcome = result?;
     display.ended(label, &outcome);

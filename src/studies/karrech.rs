@@ -127,7 +127,7 @@ pub fn load(
 /// [`load`] accelerated (Karrech et al. 2007, Fig. 10), from `start`: the loading scene with
 /// its `[settlement]` table (the plate's displacement is the settlement; the
 /// relaxation tolerance by default 1 % of the smallest radius) written as
-/// `load.toml` and run through [`crate::settlement::run_file`]: `settlement.csv`,
+/// `load.toml` and run through [`crate::open::settle_file`]: `settlement.csv`,
 /// `jumps.csv`, `summary.json`, the figures; with a reference (a full run through
 /// the driver), `errors.csv` ([`crate::report::settlement`]).
 ///

@@ -48,7 +48,7 @@ pub mod md_stage;
 pub mod replicas;
 pub mod saussine;
 
-pub use display::{run_scene, Quiet, RunDisplay};
+pub use display::{run_loaded, run_scene, Quiet, RunDisplay};
 
 use crate::error::{Error, Result};
 use crate::io::figures::Axes;
@@ -172,13 +172,13 @@ impl Accelerate {
     }
 
     /// Runs the scene at `path` (with its `[settlement]` table) into `out`
-    /// through [`crate::settlement::run_file`], the reference, if any, checked to
+    /// through [`crate::open::settle_file`], the reference, if any, checked to
     /// have a settlement first and compared after
     /// ([`crate::report::settlement::draw`]: `errors.csv`).
     ///
     /// # Errors
     /// A reference without a settlement, before the run; a scene without
-    /// `[settlement]`; else as [`crate::settlement::run_file`] and the figures.
+    /// `[settlement]`; else as [`crate::open::settle_file`] and the figures.
     pub fn run_scene(
         &self,
         path: &Path,
@@ -189,7 +189,7 @@ impl Accelerate {
         if let Some(r) = &self.reference {
             crate::report::settlement::reference_settlement(r)?;
         }
-        let summary = crate::settlement::run_file(path, out, opts, progress)?
+        let summary = crate::open::settle_file(path, out, opts, progress)?
             .ok_or_else(|| crate::error::Error::Scene(format!("{}: no [settlement] table", path.display())))?;
         if let Some(r) = &self.reference {
             crate::report::settlement::draw(out, Some(r))?;

@@ -318,7 +318,7 @@ pub use super::Accelerate;
 /// §4 accelerated: [`settle`]'s loaded scene from `start` (written as
 /// `OUT/loaded.toml`, with its `[settlement]` table, the sleeper as the
 /// settlement body) run through
-/// [`crate::settlement::run_file`]: `settlement.csv`, `jumps.csv`, `summary.json`,
+/// [`crate::open::settle_file`]: `settlement.csv`, `jumps.csv`, `summary.json`,
 /// the figures; with a reference, `errors.csv` ([`crate::report::settlement`]).
 ///
 /// The run sweeps on `threads` threads (the numbers do not depend on them).

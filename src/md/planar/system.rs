@@ -460,8 +460,8 @@ impl PlanarSystem {
             let laws = self.point_laws[ia.material * self.materials + ib.material].as_ref().ok_or_else(|| {
                 Error::Scene(format!(
                     "bodies {a} ('{}') and {b} ('{}') touch, but there is no soft law between their materials {} and {}",
-                    crate::scene::clip(&ia.name),
-                    crate::scene::clip(&ib.name),
+                    crate::error::clip(&ia.name),
+                    crate::error::clip(&ib.name),
                     ia.material,
                     ib.material
                 ))

@@ -136,9 +136,9 @@ impl MdScene {
                 Some(j) => Ok(SettlementRef::Boundary(j)),
                 None if self.walls.iter().any(|w| w.name == name) => Err(format!(
                     "wall '{}' does not move (only a servo wall, like the plate, can)",
-                    crate::scene::clip(name)
+                    crate::error::clip(name)
                 )),
-                None => Err(format!("unknown sphere or servo wall '{}'", crate::scene::clip(name))),
+                None => Err(format!("unknown sphere or servo wall '{}'", crate::error::clip(name))),
             }
         })
     }

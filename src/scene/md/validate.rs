@@ -170,7 +170,7 @@ fn check_md(ms: &super::format::MdSection, defaults: &MdSettings) -> Result<(Int
                 None => {
                     return err(format!(
                         "md.gear: unknown set '{}', expected one of 'karrech', 'gear3', 'gear4', 'gear5', 'gear6'",
-                        crate::scene::clip(name)
+                        crate::error::clip(name)
                     ))
                 }
             }
@@ -178,7 +178,7 @@ fn check_md(ms: &super::format::MdSection, defaults: &MdSettings) -> Result<(Int
         other => {
             return err(format!(
                 "md.integrator: unknown integrator '{}', expected 'verlet' or 'gear'",
-                crate::scene::clip(other)
+                crate::error::clip(other)
             ))
         }
     };
@@ -233,7 +233,7 @@ fn check_materials(scene: &MdScene) -> Result<(HashMap<&str, usize>, Vec<md::Mat
         if let Some(j) = names.insert(m.name.as_str(), i) {
             return err(format!(
                 "material[{i}].name: duplicate material '{}' (also material[{j}])",
-                crate::scene::clip(&m.name)
+                crate::error::clip(&m.name)
             ));
         }
         let ctx = |field: &str| format!("{}: {field}", label("material", i, &m.name));
@@ -251,7 +251,7 @@ fn check_materials(scene: &MdScene) -> Result<(HashMap<&str, usize>, Vec<md::Mat
 fn material_index(names: &HashMap<&str, usize>, ctx: &str, name: &str) -> Result<usize> {
     match names.get(name) {
         Some(&m) => Ok(m),
-        None => err(format!("{ctx}: unknown material '{}'", crate::scene::clip(name))),
+        None => err(format!("{ctx}: unknown material '{}'", crate::error::clip(name))),
     }
 }
 
@@ -328,7 +328,7 @@ fn check_walls(scene: &MdScene, names: &HashMap<&str, usize>) -> Result<Vec<Wall
             return err(format!("wall[{i}].name: must not be empty"));
         }
         if let Some(j) = wall_names.insert(w.name.as_str(), i) {
-            return err(format!("wall[{i}].name: duplicate wall '{}' (also wall[{j}])", crate::scene::clip(&w.name)));
+            return err(format!("wall[{i}].name: duplicate wall '{}' (also wall[{j}])", crate::error::clip(&w.name)));
         }
         let name = label("wall", i, &w.name);
         let m = material_index(names, &format!("{name}: material"), &w.material)?;
@@ -429,7 +429,7 @@ fn check_contact(i: usize, c: &MdContact, a: usize, b: usize) -> Result<CheckedL
             return err(format!(
                 "{}: unknown model '{}', expected 'hertz' or 'linear'",
                 ctx("model"),
-                crate::scene::clip(other)
+                crate::error::clip(other)
             ))
         }
     };
@@ -459,7 +459,7 @@ fn check_contact(i: usize, c: &MdContact, a: usize, b: usize) -> Result<CheckedL
         return err(format!(
             "{}: not a key of model '{}' (only of '{other}'){hint}",
             ctx(key),
-            crate::scene::clip(&c.model)
+            crate::error::clip(&c.model)
         ));
     }
     // Friction: one coefficient, or static and dynamic.

@@ -1,0 +1,218 @@
+//! Opening a scene file: the one registration point of the engines. [`open`] reads a scene, picks its engine
+//! (`[simulation] engine` and `dimension`, or the `engine` override of [`RunOptions`]), applies a length
+//! override, and builds the system as a [`Loaded`] value; [`Loaded::run`] runs it through the run loop
+//! ([`crate::run::Runner`]) and [`Loaded::settle`] through the settlement driver
+//! ([`crate::settlement::Accelerated`], when the scene has a `[settlement]` table), each with its engine's
+//! figures ([`crate::report`]); [`run_file`] and [`settle_file`] do both steps. The command line, the studies
+//! and library callers all open scenes here.
+//!
+//! Adding an engine: a variant of [`Loaded`], its arm in [`open`], and its arms in [`Loaded::run`] and
+//! [`Loaded::settle`] (ARCHITECTURE.md, "Adding an engine").
+
+use crate::error::{Error, Result};
+use crate::md::planar::PlanarSystem;
+use crate::md::MdSystem;
+use crate::nscd::System;
+use crate::run::{Figures, Progress, Restart, RunOptions, RunOutcome, Runner};
+use crate::scene::common::{AccelerationPlan, RecordedText};
+use crate::scene::{planar_length, scene_on, MdScene, Scene, SceneKind, SoftModelInfo};
+use crate::settlement::{Accelerated, AccelerationProgress, AccelerationSummary, FolderFigures};
+use std::path::{Path, PathBuf};
+
+/// A scene as read: its serde form, the text a run records (`scene.toml`: the file's text, or its serialised
+/// form with a length override applied), the system built from it, and its `[settlement]` plan, checked, if
+/// it has one.
+pub struct Opened<S, E> {
+    /// The scene file's path (recorded in the outputs' headers).
+    pub path: PathBuf,
+    /// The scene.
+    pub scene: S,
+    /// The text recorded as `scene.toml`.
+    pub text: String,
+    /// The system built from it.
+    pub system: E,
+    /// The settlement-acceleration plan of its `[settlement]` table.
+    pub acceleration: Option<AccelerationPlan>,
+}
+
+/// A scene file opened on its engine.
+pub enum Loaded {
+    /// Rigid 2D polygons, non-smooth contact dynamics (`engine = "nscd"`).
+    Nscd(Box<Opened<Scene, System>>),
+    /// A 2D scene on soft contacts (`engine = "md"`, `dimension = 2`, or the `engine` override), with the
+    /// stiffness and time step its `[soft]` table resolved to (recorded in `run.json`).
+    PlanarMd(Box<Opened<Scene, PlanarSystem>>, SoftModelInfo),
+    /// Soft 3D spheres, molecular dynamics (`engine = "md"`).
+    Md(Box<Opened<MdScene, MdSystem>>),
+}
+
+/// Opens the scene file at `path` with the `engine` and `length` overrides of `opts`: its engine, its
+/// recorded text, its system and its `[settlement]` plan, if any.
+///
+/// # Errors
+/// [`Error::Io`] naming the file if it cannot be read; [`Error::Scene`] (one line naming the key) for an
+/// invalid scene or override.
+pub fn open(path: &Path, opts: &RunOptions) -> Result<Loaded> {
+    let text = Scene::read_text(path)?;
+    let name = path.display().to_string();
+    match SceneKind::of(&text, &name, opts.engine.as_deref())? {
+        SceneKind::Md => {
+            let mut scene = MdScene::from_toml_str_named(&text, &name)?;
+            let text = scene.text_with_length(text, opts.length)?;
+            let acceleration = if scene.settlement.is_some() { scene.acceleration()? } else { None };
+            let system = scene.build()?;
+            Ok(Loaded::Md(Box::new(Opened { path: path.to_path_buf(), scene, text, system, acceleration })))
+        }
+        SceneKind::PlanarMd => {
+            let (mut scene, text) = scene_on(&text, &name, SceneKind::PlanarMd, opts.engine.is_some())?;
+            let (system, info) = scene.build_planar()?;
+            let text = scene.text_with_length(text, planar_length(opts.length, system.params.dt))?;
+            let acceleration = if scene.settlement.is_some() { scene.acceleration()? } else { None };
+            Ok(Loaded::PlanarMd(Box::new(Opened { path: path.to_path_buf(), scene, text, system, acceleration }), info))
+        }
+        SceneKind::Nscd => {
+            let (mut scene, text) = scene_on(&text, &name, SceneKind::Nscd, opts.engine.is_some())?;
+            let text = scene.text_with_length(text, opts.length)?;
+            let acceleration = if scene.settlement.is_some() { scene.acceleration()? } else { None };
+            let system = scene.build()?;
+            Ok(Loaded::Nscd(Box::new(Opened { path: path.to_path_buf(), scene, text, system, acceleration })))
+        }
+    }
+}
+
+impl Loaded {
+    /// Whether the scene has a `[settlement]` table that asks for an accelerated run.
+    pub fn settles(&self) -> bool {
+        match self {
+            Loaded::Nscd(o) => o.acceleration.is_some(),
+            Loaded::PlanarMd(o, _) => o.acceleration.is_some(),
+            Loaded::Md(o) => o.acceleration.is_some(),
+        }
+    }
+
+    /// Runs the scene into the folder `out` through the run loop, calling `progress` after every step (a
+    /// `[settlement]` table is not read: see [`Loaded::settle`]). `opts` are those the scene was opened with
+    /// (its `length` and `engine` are already applied); an MD scene's `md.threads` wins over `opts.threads`.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] (one line naming the field) for invalid options or checkpoint; else as
+    /// [`Runner::run`].
+    pub fn run(self, out: &Path, opts: &RunOptions, progress: &mut dyn FnMut(&Progress)) -> Result<RunOutcome> {
+        let opts = RunOptions { length: None, engine: None, ..opts.clone() };
+        match self {
+            Loaded::Md(o) => {
+                let Opened { path, scene, text, system, .. } = *o;
+                let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts };
+                let plan = scene.plan()?;
+                let restart: Restart<MdSystem> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
+                let figures: Figures<MdSystem> = Box::new(|dir, _| crate::report::draw_run_figures(dir).map(drop));
+                Runner::from_scene(system, plan, &path, text, Some(restart))
+                    .with_figures(figures)
+                    .run(out, &opts, progress)
+            }
+            Loaded::PlanarMd(o, info) => {
+                let Opened { path, scene, text, system, .. } = *o;
+                let plan = scene.plan_planar(system.params.dt)?;
+                let model = serde_json::to_value(info).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+                let restart: Restart<PlanarSystem> =
+                    Box::new(move |sys| scene.with_bodies(&sys.bodies).to_toml_string());
+                Runner::from_scene(system, plan, &path, text, Some(restart))
+                    .with_model(model)
+                    .with_figures(plane_figures::<PlanarSystem>())
+                    .run(out, &opts, progress)
+            }
+            Loaded::Nscd(o) => {
+                let Opened { path, scene, text, system, .. } = *o;
+                let plan = scene.plan()?;
+                let restart: Restart<System> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
+                Runner::from_scene(system, plan, &path, text, Some(restart))
+                    .with_figures(plane_figures::<System>())
+                    .run(out, &opts, progress)
+            }
+        }
+    }
+
+    /// Runs the scene's settlement-acceleration procedure into `out`, calling `progress` after each cycle;
+    /// `None` (nothing run) if the scene has no `[settlement]`. `opts` are those the scene was opened with (its
+    /// `length`, which sets the cycles to reach, and `engine` are already applied); an MD scene's
+    /// `md.threads` wins.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] (one line naming the key) for invalid options; else as [`Accelerated::run`].
+    pub fn settle(
+        self,
+        out: &Path,
+        opts: &RunOptions,
+        progress: &mut dyn FnMut(&AccelerationProgress),
+    ) -> Result<Option<AccelerationSummary>> {
+        let opts = RunOptions { length: None, engine: None, ..opts.clone() };
+        match self {
+            Loaded::Md(o) => {
+                let Opened { scene, text, system, acceleration, .. } = *o;
+                let Some(plan) = acceleration else { return Ok(None) };
+                let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts };
+                let run = Accelerated::from_scene(system, plan.spec, plan.frequency, plan.cycles, scene.seed(), text)
+                    .with_figures(settlement_figures());
+                Ok(Some(run.run(out, &opts, progress)?.summary))
+            }
+            Loaded::PlanarMd(o, info) => {
+                let Opened { scene, text, system, acceleration, .. } = *o;
+                let Some(plan) = acceleration else { return Ok(None) };
+                let model = serde_json::to_value(info).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+                let run = Accelerated::from_scene(system, plan.spec, plan.frequency, plan.cycles, scene.seed(), text)
+                    .with_model(model)
+                    .with_figures(settlement_figures());
+                Ok(Some(run.run(out, &opts, progress)?.summary))
+            }
+            Loaded::Nscd(o) => {
+                let Opened { scene, text, system, acceleration, .. } = *o;
+                let Some(plan) = acceleration else { return Ok(None) };
+                let run = Accelerated::from_scene(system, plan.spec, plan.frequency, plan.cycles, scene.seed(), text)
+                    .with_figures(settlement_figures());
+                Ok(Some(run.run(out, &opts, progress)?.summary))
+            }
+        }
+    }
+}
+
+/// Runs the scene file at `scene_path` (either engine: `[simulation] engine`) into the folder `out` through
+/// the run loop ([`open`], then [`Loaded::run`]), calling `progress` after every step.
+///
+/// # Errors
+/// As [`open`] and [`Loaded::run`].
+pub fn run_file(
+    scene_path: &Path,
+    out: &Path,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<RunOutcome> {
+    open(scene_path, opts)?.run(out, opts, progress)
+}
+
+/// Runs the settlement-acceleration procedure of the scene file at `path` into `out` ([`open`], then
+/// [`Loaded::settle`]); `None` (nothing run) if the scene has no `[settlement]`.
+///
+/// # Errors
+/// As [`open`] and [`Loaded::settle`].
+pub fn settle_file(
+    path: &Path,
+    out: &Path,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(&AccelerationProgress),
+) -> Result<Option<AccelerationSummary>> {
+    open(path, opts)?.settle(out, opts, progress)
+}
+
+/// The figures of a run of either 2D engine: from its folder, with the positions at the end of the first
+/// cycle kept by its per-cycle state (the reference of the displacement field).
+fn plane_figures<E: crate::engine::Engine<CycleState = crate::io::cycles::NscdCycleState>>() -> Figures<E> {
+    Box::new(|dir, cycles| {
+        let first = cycles.and_then(|c| c.first_cycle_q.as_deref());
+        crate::report::plane::nscd_figures(dir, first).map(drop)
+    })
+}
+
+/// The figures of an accelerated run, from its folder.
+fn settlement_figures() -> FolderFigures {
+    Box::new(|dir| crate::report::settlement::draw(dir, None).map(drop))
+}
