@@ -48,7 +48,7 @@ fn main() -> Result<(), ballast::Error> {
         sys.set_threads(1);
         let dir = out.join(format!("{order}-{i}"));
         let run = Runner::from_system(sys, start.plan()?)?.run(&dir, &RunOptions::default(), &mut |_| {})?;
-        let series = ballast::io::series::read_nscd(&dir.join("series.csv"))?;
+        let series = ballast::plane::rows::read_series(&dir.join("series.csv"))?;
         let last = series.last().expect("a run writes at least one row");
         let r = &run.report;
         println!(

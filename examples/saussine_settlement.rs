@@ -65,7 +65,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let opts = RunOptions { figures: true, vtk_every: steps, ..RunOptions::default() };
         let run = run_file(&path, &dir, &opts, &mut |_| {})?;
         assert_eq!(run.status, Status::Ended(ballast::run::RunEnd::Finished));
-        let rows = ballast::io::cycles::read_nscd(&dir.join("cycles.csv"))?;
+        let rows = ballast::plane::rows::read_cycles(&dir.join("cycles.csv"))?;
         for row in &rows {
             println!(
                 "k_N × {factor}: cycle {}: settlement {:.3} mm (mean), {:.3} mm (load minimum), {:.0} sweeps/step",

@@ -205,7 +205,7 @@ pub fn settle_file(
 
 /// The figures of a run of either 2D engine: from its folder, with the positions at the end of the first
 /// cycle kept by its per-cycle state (the reference of the displacement field).
-fn plane_figures<E: crate::engine::Engine<CycleState = crate::io::cycles::NscdCycleState>>() -> Figures<E> {
+fn plane_figures<E: crate::engine::Engine<CycleState = crate::plane::rows::PlaneCycleState>>() -> Figures<E> {
     Box::new(|dir, cycles| {
         let first = cycles.and_then(|c| c.first_cycle_q.as_deref());
         crate::report::plane::nscd_figures(dir, first).map(drop)

@@ -48,7 +48,7 @@ fn cycle_settlement_of_a_sprung_pad_is_the_quasi_static_deflection() {
     };
     let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
     Runner::from_system(s, plan).unwrap().run(&dir, &opts, &mut |_| {}).unwrap();
-    let rows: Vec<Vec<f64>> = ballast::io::cycles::read_nscd(&dir.join("cycles.csv"))
+    let rows: Vec<Vec<f64>> = ballast::plane::rows::read_cycles(&dir.join("cycles.csv"))
         .unwrap()
         .iter()
         .map(|r| {

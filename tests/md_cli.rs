@@ -216,7 +216,7 @@ fn legacy_spheres_snapshot() {
     let dir = temp_dir("legacy");
     let sys = ballast::scene::MdScene::from_toml_str(&example()).unwrap().build().unwrap();
     let path = dir.join("spheres.vtk");
-    ballast::io::vtk::write_spheres(&path, &sys).unwrap();
+    ballast::md::vtk::write_spheres(&path, &sys).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(text.starts_with("# vtk DataFile Version 3.0\nballast MD spheres, step 0"), "{text}");
     for line in [

@@ -370,7 +370,7 @@ fn vtk_writes_one_cell_per_part() {
     let dir = std::env::temp_dir().join(format!("ballast_compound_vtk_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("bodies.vtk");
-    ballast::io::vtk::write_bodies(&path, &sys).unwrap();
+    ballast::plane::vtk::write_bodies(&path, &sys).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
     let mut lines = text.lines();

@@ -272,7 +272,6 @@ fn md_divergence_keeps_the_last_good_state() {
 /// Every CSV of a run of each engine reads back through the library's row types.
 #[test]
 fn outputs_read_back_through_the_row_types() {
-    use ballast::io::{cycles, series};
     use ballast::run::positions;
     let dir = temp_dir("read_back");
     let scene = Scene::from_toml_str(NSCD).unwrap();
@@ -281,10 +280,10 @@ fn outputs_read_back_through_the_row_types() {
         .unwrap()
         .run(&nscd, &quiet(), &mut |_| {})
         .unwrap();
-    let rows = series::read_nscd(&nscd.join("series.csv")).unwrap();
+    let rows = ballast::plane::rows::read_series(&nscd.join("series.csv")).unwrap();
     assert_eq!(rows.len(), 8, "steps 7, 14, …, 49 and 50");
     assert_eq!(rows.last().unwrap().time_s, 0.05);
-    let c = cycles::read_nscd(&nscd.join("cycles.csv")).unwrap();
+    let c = ballast::plane::rows::read_cycles(&nscd.join("cycles.csv")).unwrap();
     assert_eq!(c.iter().map(|r| r.cycle).collect::<Vec<_>>(), [1, 2, 3, 4, 5]);
     let p = positions::read(&nscd).unwrap();
     assert_eq!((p.reference.bodies.clone(), p.cycles.len()), (vec![1, 2], 5));
@@ -307,11 +306,11 @@ fn outputs_read_back_through_the_row_types() {
         .unwrap()
         .run(&md, &quiet(), &mut |_| {})
         .unwrap();
-    let (header, rows) = series::read_md(&md.join("series.csv")).unwrap();
+    let (header, rows) = ballast::md::rows::read_series(&md.join("series.csv")).unwrap();
     assert_eq!(&header[header.len() - 4..], ["base_force_N", "mould_force_N", "lid_force_N", "lid_position_m"]);
     assert!(rows.iter().all(|r| r.walls.len() == 4), "three wall forces and one servo position per row");
     assert!(rows.last().unwrap().walls[3] > 0.0, "the lid moved down along its normal");
-    let c = cycles::read_md(&md.join("cycles.csv")).unwrap();
+    let c = ballast::md::rows::read_cycles(&md.join("cycles.csv")).unwrap();
     assert_eq!(c.len(), 2, "two 5 ms cycles in 10 ms");
     assert_eq!(c[1].walls, [rows.last().unwrap().walls[3]], "the lid at the end of the run");
     let p = positions::read(&md).unwrap();
@@ -342,9 +341,9 @@ fn a_run_length_replaces_the_scene_duration() {
             assert_eq!(run.step, steps, "{}", scene.display());
             // The final overlap reported is the last row's; the run's largest bounds it.
             let last = if scene == &md {
-                ballast::io::series::read_md(&out.join("series.csv")).unwrap().1.last().unwrap().max_overlap_m
+                ballast::md::rows::read_series(&out.join("series.csv")).unwrap().1.last().unwrap().max_overlap_m
             } else {
-                ballast::io::series::read_nscd(&out.join("series.csv")).unwrap().last().unwrap().max_overlap_m
+                ballast::plane::rows::read_series(&out.join("series.csv")).unwrap().last().unwrap().max_overlap_m
             };
             assert_eq!(run.report.final_max_overlap_m, last);
             assert!(run.report.max_overlap_m >= last);

@@ -73,7 +73,7 @@ fn settle(scene: &Scene, cycles: u64, stiffness_factor: f64) -> Vec<(f64, f64)> 
     let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
     let runner = Runner::from_system(loaded.build().unwrap(), loaded.plan().unwrap()).unwrap();
     runner.run(&dir, &opts, &mut |_| {}).unwrap();
-    let rows = ballast::io::cycles::read_nscd(&dir.join("cycles.csv")).unwrap();
+    let rows = ballast::plane::rows::read_cycles(&dir.join("cycles.csv")).unwrap();
     let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(rows.len() as u64, cycles);
     rows.iter().map(|r| (r.settlement_mean_m, r.settlement_at_min_load_m)).collect()

@@ -173,7 +173,7 @@ fn saussine_ensemble_of_two_samples() {
         .iter()
         .map(|seed| {
             let c =
-                ballast::io::cycles::read_nscd(&dir.join(format!("ens/runs/seed_{seed}_k_1e0/cycles.csv"))).unwrap();
+                ballast::plane::rows::read_cycles(&dir.join(format!("ens/runs/seed_{seed}_k_1e0/cycles.csv"))).unwrap();
             c[0].settlement_mean_m
         })
         .collect();

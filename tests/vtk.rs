@@ -1,8 +1,9 @@
 //! VTK snapshots: the files are parsed back by the small readers below (legacy
 //! ASCII and XML PolyData) and checked against the system they were written from.
 
-use ballast::io::vtk::{write_bodies, write_contacts, PvdCollection, DISC_VERTICES};
+use ballast::io::vtk::PvdCollection;
 use ballast::nscd::System;
+use ballast::plane::vtk::{write_bodies, write_contacts, DISC_VERTICES};
 use ballast::scene::Scene;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -517,7 +518,7 @@ fn pvd_lists_the_snapshots_with_increasing_timesteps() {
     for k in 1..=20 {
         sys.step().unwrap();
         if k % 5 == 0 {
-            let (b, c) = pvd.write_snapshot(&dir.0, &sys).unwrap();
+            let (b, c) = ballast::plane::vtk::write_snapshot(&mut pvd, &dir.0, &sys).unwrap();
             assert_eq!(b, dir.0.join(format!("bodies_{k:09}.vtp")));
             assert_eq!(c, dir.0.join(format!("contacts_{k:09}.vtp")));
             pvd.write(&dir.0.join("run.pvd")).unwrap();

@@ -57,8 +57,8 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     const ITERATIVE: bool;
     /// What one step measured.
     type Stats: Copy + std::fmt::Debug;
-    /// One row of `series.csv` (serde, written and read back by
-    /// [`crate::io::series`]; the columns carry their unit in their name).
+    /// One row of `series.csv` (serde, written by the run loop and read back by the engine's rows module, e.g.
+    /// [`crate::plane::rows`]; the columns carry their unit in their name).
     type Row: Serialize + DeserializeOwned + Clone + std::fmt::Debug;
     /// What the per-cycle output accumulates over the steps of a cycle (kept in
     /// checkpoints, checked on resume against the state [`Engine::cycle_start`]

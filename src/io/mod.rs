@@ -2,13 +2,10 @@
 //! ([`vtk`]), figures as PNG + SVG ([`figures`]), and the layout of a run folder ([`layout`]: every file
 //! name a run writes). Every I/O error names the file it happened on.
 //!
-//! Not yet moved out (issue 33): the engines' row types ([`series`], [`cycles`]) and their VTK mapping still
-//! live here.
+//! Not yet moved out (issue 33): the engines' VTK mapping still lives in [`vtk`].
 
-pub mod cycles;
 pub mod figures;
 pub mod layout;
-pub mod series;
 pub mod table;
 pub mod vtk;
 

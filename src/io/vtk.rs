@@ -1,10 +1,11 @@
-//! VTK snapshots for ParaView: the bodies and the contact force network of a
-//! 2D system (NSCD [`crate::nscd::System`] or planar MD), the spheres of an MD [`MdSystem`], and a `.pvd` collection
-//! that animates them.
+//! VTK snapshots for ParaView: the writer of format-neutral poly data ([`PolyData`], [`write_poly`]) and the
+//! `.pvd` collection that animates them ([`PvdCollection`]). What the engines write is theirs: the bodies and the
+//! contact force network of a 2D system ([`crate::plane::vtk`]: NSCD and planar MD), the spheres of an MD
+//! system ([`crate::md::vtk`]).
 //!
 //! # Files
 //!
-//! [`write_bodies`] and [`write_contacts`] pick the format from the extension:
+//! [`write_poly`] picks the format from the extension:
 //!
 //! - `.vtp`: VTK XML PolyData, ASCII inline (`<DataArray format="ascii">`);
 //! - `.vtk`: legacy VTK, `# vtk DataFile Version 3.0`, `ASCII`, `DATASET POLYDATA`.
@@ -18,7 +19,7 @@
 //! `vtkXMLCollectionReader`, which picks the reader of each listed file from its
 //! extension among the XML formats only (`vtp`, `vtu`, `vti`, `vtr`, `vts`,
 //! `vtm` and their parallel forms); a legacy `.vtk` listed in a `.pvd` is not read.
-//! So [`PvdCollection::write_snapshot`] writes `.vtp` files. The legacy `.vtk`
+//! So the engines' snapshots are `.vtp` files. The legacy `.vtk`
 //! form holds exactly the same data and is there for single snapshots and for
 //! tools that read only legacy VTK.
 //!
@@ -26,88 +27,14 @@
 //! `f64` (a non-finite value would be written `NaN` or `inf`, which VTK readers
 //! refuse; the stepper never leaves one in the state: it rolls back); integers
 //! as `Int32` (`int`), coordinates and floats as `Float64` (`double`).
-//! Everything is planar: z = 0 everywhere. Forces are the mean forces over the
-//! last step (N), for the out-of-plane thickness of the scene.
+
 //!
-//! # Bodies file
-//!
-//! One polygon cell per body (`POLYGONS` / `<Polys>`), in body order, whose
-//! points are the body's world vertices: centre of mass `(q[0], q[1])` plus the
-//! body-frame vertices rotated by `q[2]`, counter-clockwise. A disc is written as
-//! the inscribed polygon of [`DISC_VERTICES`] vertices on its circle, the first
-//! at angle `q[2]` (so that the spin shows). A compound body (a rigid union of
-//! convex parts) is written as one polygon cell per part, consecutive, in part
-//! order; each cell data array has one value per **cell**, the body's value
-//! repeated for each of its parts (so `body_id` tells which cells make one body,
-//! and the number of cells exceeds the number of bodies when there are
-//! compounds). Points are not shared between cells.
-//! Cell data:
-//!
-//! | array      | kind                | unit  | meaning                                     |
-//! |------------|---------------------|-------|---------------------------------------------|
-//! | `body_id`  | int scalar          | –     | index of the body in the system             |
-//! | `fixed`    | int scalar          | –     | 1 for a fixed body, else 0                  |
-//! | `velocity` | vector (3)          | m/s   | velocity of the centre of mass, z = 0       |
-//! | `spin`     | float scalar        | rad/s | angular velocity, counter-clockwise         |
-//! | `radius`   | float scalar        | m     | bounding radius (disc radius, circumradius) |
-//!
-//! # Contacts file
-//!
-//! The force network of the last step ([`PlaneSystem::plane_contacts`]): points are
-//! the centres of mass of all bodies (point `i` is body `i`), and each contact is
-//! one line cell (`LINES` / `<Lines>`) from its candidate's centre of mass to
-//! its antagonist's. No point data. Cell data:
-//!
-//! | array              | kind               | unit | meaning                                      |
-//! |--------------------|--------------------|------|----------------------------------------------|
-//! | `normal_force`     | float scalar       | N    | `r_n`, ≥ 0 (compression)                     |
-//! | `tangential_force` | float scalar       | N    | `r_t`, along `t`                             |
-//! | `gap`              | float scalar       | m    | gap at `q_m` (negative: overlap)             |
-//! | `force`            | vector (3)         | N    | `r_n n + r_t t` on the candidate, z = 0      |
-//! | `normal`           | field, 3 comps     | –    | unit normal `n`, towards the candidate       |
-//! | `point`            | field, 3 comps     | m    | contact point at `q_m`, z = 0                |
-//! | `candidate`        | int scalar         | –    | body on which `force` acts                   |
-//! | `antagonist`       | int scalar         | –    | the other body (it feels `-force`)           |
-//!
-//! `t` is `n` rotated by +90°; `q_m` is the intermediate configuration of the
-//! θ-method at which the contacts were detected. `normal_force` is the active
-//! scalar and `force` the active vector (ParaView colours and glyphs by them by
-//! default); in the bodies file they are `body_id` and `velocity`. In legacy
-//! files `normal` and `point` are the arrays of a `FIELD` block of the cell
-//! data; in `.vtp` files all arrays are plain `DataArray`s. A Threshold on
-//! `normal_force` and a Tube filter whose radius follows it give the usual
-//! force-chain picture; `point` locates the contacts themselves (the line's
-//! ends are the centres of mass).
-//!
-//! # Spheres file (MD)
-//!
-//! [`write_spheres`]: one point per sphere at its centre (m), in sphere order, each
-//! a vertex cell (`VERTICES` / `<Verts>`), so ParaView shows them as points; a
-//! Glyph filter with a sphere source, scaled by `radius` (scale factor 2: the
-//! glyph is a unit-diameter sphere), draws the spheres at their size. No cell
-//! data. Point data:
-//!
-//! | array      | kind           | unit  | meaning                         |
-//! |------------|----------------|-------|---------------------------------|
-//! | `radius`   | float scalar   | m     | radius                          |
-//! | `id`       | int scalar     | –     | index of the sphere             |
-//! | `material` | int scalar     | –     | index of its material           |
-//! | `velocity` | vector (3)     | m/s   | velocity of the centre          |
-//! | `spin`     | field, 3 comps | rad/s | angular velocity                |
-//!
-//! `radius` is the active scalar and `velocity` the active vector.
 
 use super::io_error;
 use crate::error::Result;
-use crate::geometry::{perp, rotate, Shape, Vec2};
-use crate::md::MdSystem;
-use crate::plane::outputs::PlaneSystem;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// Number of vertices of the polygon that stands for a disc in the bodies file.
-pub const DISC_VERTICES: usize = 24;
 
 /// File format of a snapshot, chosen by [`Format::from_path`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -135,38 +62,6 @@ impl Format {
             )),
         }
     }
-}
-
-/// Writes the bodies of `sys` to `path`: one polygon cell per body with its world
-/// vertices (m) and the cell arrays `body_id`, `fixed`, `velocity` (m/s), `spin`
-/// (rad/s) and `radius` (m); see the [module documentation](self). The format
-/// follows the extension: `.vtk` legacy, `.vtp` XML.
-pub fn write_bodies(path: &Path, sys: &impl PlaneSystem) -> Result<()> {
-    let format = Format::from_path(path)?;
-    let title = format!("ballast 2D bodies, step {}, time {:e} s", sys.plane_step(), sys.plane_time());
-    write_file(path, &render(&bodies_data(sys), format, &title))
-}
-
-/// Writes the contacts of the last step of `sys` to `path`: one line cell per
-/// contact, from the candidate's centre of mass to the antagonist's, with the
-/// cell arrays `candidate`, `antagonist`, `normal_force` (N), `tangential_force`
-/// (N), `gap` (m), `force` (N), `normal` and `point` (m); see the
-/// [module documentation](self). The format follows the extension: `.vtk`
-/// legacy, `.vtp` XML.
-pub fn write_contacts(path: &Path, sys: &impl PlaneSystem) -> Result<()> {
-    let format = Format::from_path(path)?;
-    let title = format!("ballast 2D contacts, step {}, time {:e} s", sys.plane_step(), sys.plane_time());
-    write_file(path, &render(&contacts_data(sys), format, &title))
-}
-
-/// Writes the spheres of `sys` to `path`: one vertex cell per sphere at its centre
-/// (m) with the point arrays `radius` (m), `id`, `material`, `velocity` (m/s) and
-/// `spin` (rad/s); see the [module documentation](self). The format follows the
-/// extension: `.vtk` legacy, `.vtp` XML.
-pub fn write_spheres(path: &Path, sys: &MdSystem) -> Result<()> {
-    let format = Format::from_path(path)?;
-    let title = format!("ballast MD spheres, step {}, time {:e} s", sys.step, sys.time);
-    write_file(path, &render(&spheres_data(sys), format, &title))
 }
 
 /// One file of a time step of a [`PvdCollection`]: a block of the data set.
@@ -262,30 +157,6 @@ impl PvdCollection {
         self.entries.push(PvdEntry { time, parts });
     }
 
-    /// Writes `dir/bodies_SSSSSSSSS.vtp` and `dir/contacts_SSSSSSSSS.vtp` (`S`: the
-    /// step number, 9 digits or more) for the current state of `sys`, adds them
-    /// at time `sys.time` (s) and returns their paths. The `.pvd` itself is
-    /// written by [`PvdCollection::write`].
-    pub fn write_snapshot(&mut self, dir: &Path, sys: &impl PlaneSystem) -> Result<(PathBuf, PathBuf)> {
-        let bodies = dir.join(format!("bodies_{:09}.vtp", sys.plane_step()));
-        let contacts = dir.join(format!("contacts_{:09}.vtp", sys.plane_step()));
-        write_bodies(&bodies, sys)?;
-        write_contacts(&contacts, sys)?;
-        self.push(sys.plane_time(), bodies.clone(), contacts.clone());
-        Ok((bodies, contacts))
-    }
-
-    /// Writes `dir/spheres_SSSSSSSSS.vtp` (`S`: the step number, 9 digits or more)
-    /// for the current state of the MD system `sys`, adds it as part `spheres` at
-    /// time `sys.time` (s) and returns its path. The `.pvd` itself is written by
-    /// [`PvdCollection::write`].
-    pub fn write_spheres_snapshot(&mut self, dir: &Path, sys: &MdSystem) -> Result<PathBuf> {
-        let file = dir.join(format!("spheres_{:09}.vtp", sys.step));
-        write_spheres(&file, sys)?;
-        self.push_parts(sys.time, vec![PvdPart { name: "spheres".into(), file: file.clone() }]);
-        Ok(file)
-    }
-
     /// The time steps, in increasing time.
     pub fn entries(&self) -> &[PvdEntry] {
         &self.entries
@@ -367,6 +238,16 @@ fn xml_escape(s: &str) -> String {
     out
 }
 
+/// Writes `data` to `path` under the title `title`, in the format of the extension ([`Format::from_path`]:
+/// `.vtk` legacy, `.vtp` XML).
+///
+/// # Errors
+/// An unknown extension or a failed write, naming the path.
+pub fn write_poly(path: &Path, data: &PolyData, title: &str) -> Result<()> {
+    let format = Format::from_path(path)?;
+    write_file(path, &render(data, format, title))
+}
+
 fn write_file(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).map_err(|e| io_error(path, "write", e))
 }
@@ -374,10 +255,14 @@ fn write_file(path: &Path, text: &str) -> Result<()> {
 // ---------------------------------------------------------------------------
 // Format-neutral poly data, then its two serializations.
 
+/// The kind of the cells of a [`PolyData`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum CellKind {
+pub enum CellKind {
+    /// Polygons (`POLYGONS` / `<Polys>`).
     Polys,
+    /// Lines (`LINES` / `<Lines>`).
     Lines,
+    /// Vertices (`VERTICES` / `<Verts>`).
     Verts,
 }
 
@@ -395,8 +280,9 @@ enum Values {
     Float(Vec<f64>),
 }
 
+/// A named data array of a [`PolyData`]: one tuple per cell or per point.
 #[derive(Debug, Clone)]
-struct Array {
+pub struct Array {
     name: &'static str,
     role: Role,
     components: usize,
@@ -404,19 +290,23 @@ struct Array {
 }
 
 impl Array {
-    fn int(name: &'static str, v: Vec<i64>) -> Self {
+    /// An integer scalar.
+    pub fn int(name: &'static str, v: Vec<i64>) -> Self {
         Self { name, role: Role::Scalars, components: 1, values: Values::Int(v) }
     }
 
-    fn float(name: &'static str, v: Vec<f64>) -> Self {
+    /// A float scalar.
+    pub fn float(name: &'static str, v: Vec<f64>) -> Self {
         Self { name, role: Role::Scalars, components: 1, values: Values::Float(v) }
     }
 
-    fn vectors(name: &'static str, v: Vec<[f64; 3]>) -> Self {
+    /// A vector of 3 components (the active vectors in a legacy file).
+    pub fn vectors(name: &'static str, v: Vec<[f64; 3]>) -> Self {
         Self { name, role: Role::Vectors, components: 3, values: Values::Float(v.concat()) }
     }
 
-    fn field3(name: &'static str, v: Vec<[f64; 3]>) -> Self {
+    /// A field of 3 components (a `FIELD` block in a legacy file).
+    pub fn field3(name: &'static str, v: Vec<[f64; 3]>) -> Self {
         Self { name, role: Role::Field, components: 3, values: Values::Float(v.concat()) }
     }
 
@@ -436,17 +326,22 @@ impl Array {
     }
 }
 
+/// Format-neutral poly data: points, cells of one kind, and their data arrays; what an engine maps its state
+/// onto (its `vtk.rs`) and [`write_poly`] serialises.
 #[derive(Debug, Clone)]
-struct PolyData {
-    points: Vec<[f64; 3]>,
-    kind: CellKind,
+pub struct PolyData {
+    /// Point coordinates (m).
+    pub points: Vec<[f64; 3]>,
+    /// The kind of every cell.
+    pub kind: CellKind,
     /// Point indices of every cell, one after the other.
-    connectivity: Vec<usize>,
+    pub connectivity: Vec<usize>,
     /// End of each cell in `connectivity` (the XML `offsets`).
-    offsets: Vec<usize>,
-    cell_data: Vec<Array>,
-    /// Arrays of one tuple per point (none for the NSCD files).
-    point_data: Vec<Array>,
+    pub offsets: Vec<usize>,
+    /// Arrays of one tuple per cell.
+    pub cell_data: Vec<Array>,
+    /// Arrays of one tuple per point (none for the 2D engines' files).
+    pub point_data: Vec<Array>,
 }
 
 impl PolyData {
@@ -457,99 +352,6 @@ impl PolyData {
     fn cell(&self, i: usize) -> &[usize] {
         let start = if i == 0 { 0 } else { self.offsets[i - 1] };
         &self.connectivity[start..self.offsets[i]]
-    }
-}
-
-fn bodies_data(sys: &impl PlaneSystem) -> PolyData {
-    let b = sys.plane_bodies();
-    let mut d = PolyData {
-        points: Vec::new(),
-        kind: CellKind::Polys,
-        connectivity: Vec::new(),
-        offsets: Vec::with_capacity(b.len()),
-        cell_data: Vec::new(),
-        point_data: Vec::new(),
-    };
-    // Body of each cell: a compound has one cell per part.
-    let mut owner: Vec<usize> = Vec::with_capacity(b.len());
-    for (i, (info, q)) in b.info.iter().zip(&b.q).enumerate() {
-        let centre = Vec2::new(q[0], q[1]);
-        let (sin, cos) = q[2].sin_cos();
-        let mut cell = |vertices: &mut dyn Iterator<Item = Vec2>| {
-            for v in vertices {
-                let w = centre + rotate(v, cos, sin);
-                d.connectivity.push(d.points.len());
-                d.points.push([w.x, w.y, 0.0]);
-            }
-            d.offsets.push(d.connectivity.len());
-            owner.push(i);
-        };
-        match &info.shape {
-            Shape::Polygon(p) => cell(&mut p.vertices.iter().copied()),
-            Shape::Disc(r) => cell(&mut (0..DISC_VERTICES).map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / DISC_VERTICES as f64;
-                Vec2::new(r * a.cos(), r * a.sin())
-            })),
-            Shape::Compound(c) => c.parts.iter().for_each(|p| cell(&mut p.vertices.iter().copied())),
-        }
-    }
-    d.cell_data = vec![
-        Array::int("body_id", owner.iter().map(|&i| i as i64).collect()),
-        Array::int("fixed", owner.iter().map(|&i| i64::from(b.info[i].fixed)).collect()),
-        Array::vectors("velocity", owner.iter().map(|&i| [b.u[i][0], b.u[i][1], 0.0]).collect()),
-        Array::float("spin", owner.iter().map(|&i| b.u[i][2]).collect()),
-        Array::float("radius", owner.iter().map(|&i| b.info[i].shape.bounding_radius()).collect()),
-    ];
-    d
-}
-
-fn contacts_data(sys: &impl PlaneSystem) -> PolyData {
-    let contacts = sys.plane_contacts();
-    let mut connectivity = Vec::with_capacity(2 * contacts.len());
-    for c in &contacts {
-        connectivity.extend([c.candidate, c.antagonist]);
-    }
-    let force = |c: &crate::nscd::ContactInfo| {
-        let n = Vec2::new(c.normal[0], c.normal[1]);
-        let f = n * c.r_n + perp(n) * c.r_t;
-        [f.x, f.y, 0.0]
-    };
-    PolyData {
-        points: sys.plane_bodies().q.iter().map(|q| [q[0], q[1], 0.0]).collect(),
-        kind: CellKind::Lines,
-        connectivity,
-        offsets: (1..=contacts.len()).map(|k| 2 * k).collect(),
-        cell_data: vec![
-            Array::float("normal_force", contacts.iter().map(|c| c.r_n).collect()),
-            Array::float("tangential_force", contacts.iter().map(|c| c.r_t).collect()),
-            Array::float("gap", contacts.iter().map(|c| c.gap).collect()),
-            Array::vectors("force", contacts.iter().map(force).collect()),
-            Array::field3("normal", contacts.iter().map(|c| [c.normal[0], c.normal[1], 0.0]).collect()),
-            Array::field3("point", contacts.iter().map(|c| [c.point[0], c.point[1], 0.0]).collect()),
-            Array::int("candidate", contacts.iter().map(|c| c.candidate as i64).collect()),
-            Array::int("antagonist", contacts.iter().map(|c| c.antagonist as i64).collect()),
-        ],
-        point_data: Vec::new(),
-    }
-}
-
-fn spheres_data(sys: &MdSystem) -> PolyData {
-    let p = &sys.particles;
-    let n = p.len();
-    let v3 = |v: &crate::md::V3| [v[0], v[1], v[2]];
-    PolyData {
-        points: p.x.iter().map(v3).collect(),
-        kind: CellKind::Verts,
-        connectivity: (0..n).collect(),
-        offsets: (1..=n).collect(),
-        cell_data: Vec::new(),
-        point_data: vec![
-            Array::float("radius", p.r.clone()),
-            Array::int("id", (0..n as i64).collect()),
-            Array::int("material", p.material.iter().map(|&m| i64::from(m)).collect()),
-            Array::vectors("velocity", p.v.iter().map(v3).collect()),
-            Array::field3("spin", p.w.iter().map(v3).collect()),
-        ],
     }
 }
 

@@ -17,9 +17,9 @@ use crate::engine::final_state::{BodyState, FinalState, Spin, WallState};
 use crate::engine::StepSummary;
 use crate::engine::{Configuration, Energies, Engine};
 use crate::error::{Error, Result};
-use crate::io::cycles::{MdCycleRow, MdCycleState, MD_CYCLE_COLUMNS};
-use crate::io::series::{MdSeriesRow, MD_SERIES_COLUMNS};
 use crate::io::vtk::PvdCollection;
+use crate::md::rows::{MdCycleRow, MdCycleState, MD_CYCLE_COLUMNS};
+use crate::md::rows::{MdSeriesRow, MD_SERIES_COLUMNS};
 use std::path::Path;
 
 impl MdSystem {
@@ -170,7 +170,7 @@ impl Engine for MdSystem {
     }
 
     fn snapshot(&self, dir: &Path, pvd: &mut PvdCollection) -> Result<()> {
-        pvd.write_spheres_snapshot(dir, self).map(|_| ())
+        super::vtk::write_snapshot(pvd, dir, self).map(|_| ())
     }
 
     fn check_state(&self) -> Result<()> {

@@ -60,7 +60,9 @@ pub mod neighbours;
 pub mod particles;
 pub mod planar;
 pub mod relax;
+pub mod rows;
 pub mod system;
+pub mod vtk;
 pub mod walls;
 
 pub use contacts::{MdContactInfo, MdContactKind};

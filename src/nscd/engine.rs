@@ -10,10 +10,10 @@ use crate::engine::final_state::FinalState;
 use crate::engine::StepSummary;
 use crate::engine::{Configuration, Energies, Engine};
 use crate::error::Result;
-use crate::io::cycles::{NscdCycleRow, NscdCycleState, NSCD_CYCLE_COLUMNS};
-use crate::io::series::{NscdSeriesRow, NSCD_SERIES_COLUMNS};
 use crate::io::vtk::PvdCollection;
 use crate::plane::outputs::{self, PlaneSystem};
+use crate::plane::rows::{PlaneCycleRow, PlaneCycleState, PLANE_CYCLE_COLUMNS};
+use crate::plane::rows::{PlaneSeriesRow, PLANE_SERIES_COLUMNS};
 use crate::plane::{Bodies, ContactInfo};
 use std::path::Path;
 
@@ -42,9 +42,9 @@ impl Engine for System {
     const EXTRAPOLATED: usize = 2;
     const ITERATIVE: bool = true;
     type Stats = StepStats;
-    type Row = NscdSeriesRow;
-    type CycleState = NscdCycleState;
-    type CycleRow = NscdCycleRow;
+    type Row = PlaneSeriesRow;
+    type CycleState = PlaneCycleState;
+    type CycleRow = PlaneCycleRow;
 
     fn step(&mut self) -> Result<StepStats> {
         System::step(self)
@@ -88,11 +88,11 @@ impl Engine for System {
     }
 
     fn series_header(&self) -> Vec<String> {
-        NSCD_SERIES_COLUMNS.iter().map(|s| s.to_string()).collect()
+        PLANE_SERIES_COLUMNS.iter().map(|s| s.to_string()).collect()
     }
 
-    fn series_row(&self, s: &StepStats) -> NscdSeriesRow {
-        NscdSeriesRow {
+    fn series_row(&self, s: &StepStats) -> PlaneSeriesRow {
+        PlaneSeriesRow {
             time_s: s.time,
             kinetic_energy_j: s.kinetic_energy,
             contacts: s.contacts,
@@ -116,7 +116,7 @@ impl Engine for System {
     }
 
     fn snapshot(&self, dir: &Path, pvd: &mut PvdCollection) -> Result<()> {
-        pvd.write_snapshot(dir, self).map(|_| ())
+        crate::plane::vtk::write_snapshot(pvd, dir, self).map(|_| ())
     }
 
     fn check_state(&self) -> Result<()> {
@@ -127,11 +127,11 @@ impl Engine for System {
         System::check_same_model(self, fresh)
     }
 
-    fn cycle_start(&self, body: Option<usize>) -> Result<NscdCycleState> {
+    fn cycle_start(&self, body: Option<usize>) -> Result<PlaneCycleState> {
         outputs::cycle_start(self, body)
     }
 
-    fn cycle_step(&self, c: &mut NscdCycleState, stats: &StepStats) {
+    fn cycle_step(&self, c: &mut PlaneCycleState, stats: &StepStats) {
         outputs::cycle_step(
             self,
             c,
@@ -144,15 +144,15 @@ impl Engine for System {
         );
     }
 
-    fn cycle_end(&self, c: &mut NscdCycleState, cycle: u64) -> NscdCycleRow {
+    fn cycle_end(&self, c: &mut PlaneCycleState, cycle: u64) -> PlaneCycleRow {
         outputs::cycle_end(self, c, cycle)
     }
 
     fn cycle_header(&self) -> Vec<String> {
-        NSCD_CYCLE_COLUMNS.iter().map(|s| s.to_string()).collect()
+        PLANE_CYCLE_COLUMNS.iter().map(|s| s.to_string()).collect()
     }
 
-    fn settlement(&self, c: &NscdCycleState) -> Option<f64> {
+    fn settlement(&self, c: &PlaneCycleState) -> Option<f64> {
         outputs::settlement(self, c)
     }
 

@@ -13,8 +13,10 @@ pub mod loads;
 pub mod narrow_phase;
 pub mod outputs;
 pub mod relax;
+pub mod rows;
 pub mod shadow_overlap;
 pub mod springs;
+pub mod vtk;
 
 use serde::Serialize;
 

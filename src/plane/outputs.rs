@@ -10,7 +10,7 @@ use crate::engine::contacts::{ContactKind, ContactRow};
 use crate::engine::final_state::{BodyState, FinalState, Spin};
 use crate::engine::Configuration;
 use crate::error::{Error, Result};
-use crate::io::cycles::{NscdCycleRow, NscdCycleState};
+use crate::plane::rows::{PlaneCycleRow, PlaneCycleState};
 
 /// A 2D system as the shared outputs see it.
 pub trait PlaneSystem {
@@ -87,13 +87,13 @@ pub fn contact_rows(sys: &impl PlaneSystem) -> Vec<ContactRow> {
 ///
 /// # Errors
 /// [`Error::Scene`] if there is no body or it does not exist.
-pub fn cycle_start(sys: &impl PlaneSystem, body: Option<usize>) -> Result<NscdCycleState> {
+pub fn cycle_start(sys: &impl PlaneSystem, body: Option<usize>) -> Result<PlaneCycleState> {
     let bodies = sys.plane_bodies();
     let body = body.ok_or_else(|| Error::Scene("output.cycles.body: name the followed body (the sleeper)".into()))?;
     let q = bodies.q.get(body).ok_or_else(|| {
         Error::Scene(format!("output.cycles.body: body {body} does not exist ({} bodies)", bodies.len()))
     })?;
-    Ok(NscdCycleState::new(body, q[1]))
+    Ok(PlaneCycleState::new(body, q[1]))
 }
 
 /// What one step adds to the cycle under way, besides the bodies' state.
@@ -111,7 +111,7 @@ pub struct CycleStepStats {
 
 /// Adds a step to the cycle under way: the followed body's position and the
 /// load minimum, the other mobile bodies' mean speed, the step's `stats`.
-pub fn cycle_step(sys: &impl PlaneSystem, c: &mut NscdCycleState, stats: CycleStepStats) {
+pub fn cycle_step(sys: &impl PlaneSystem, c: &mut PlaneCycleState, stats: CycleStepStats) {
     let CycleStepStats { contacts, iterations, max_overlap, mean_overlap } = stats;
     let bodies = sys.plane_bodies();
     let y = bodies.q[c.body][1];
@@ -141,9 +141,9 @@ pub fn cycle_step(sys: &impl PlaneSystem, c: &mut NscdCycleState, stats: CycleSt
 }
 
 /// Closes cycle `cycle` at the current step: its row; the accumulators start again.
-pub fn cycle_end(sys: &impl PlaneSystem, c: &mut NscdCycleState, cycle: u64) -> NscdCycleRow {
+pub fn cycle_end(sys: &impl PlaneSystem, c: &mut PlaneCycleState, cycle: u64) -> PlaneCycleRow {
     let k = c.steps.max(1) as f64;
-    let row = NscdCycleRow {
+    let row = PlaneCycleRow {
         cycle,
         time_s: sys.plane_time(),
         settlement_mean_m: c.y0 - c.sum_y / k,
@@ -166,7 +166,7 @@ pub fn cycle_end(sys: &impl PlaneSystem, c: &mut NscdCycleState, cycle: u64) -> 
 }
 
 /// The settlement of the followed body since the start (m, positive downwards).
-pub fn settlement(sys: &impl PlaneSystem, c: &NscdCycleState) -> Option<f64> {
+pub fn settlement(sys: &impl PlaneSystem, c: &PlaneCycleState) -> Option<f64> {
     sys.plane_bodies().q.get(c.body).map(|q| c.y0 - q[1])
 }
 

@@ -25,7 +25,7 @@ use super::{force_lines, max_abs, read_contacts, read_final, require, RunFigures
 use crate::error::{Error, Result};
 use crate::io::figures::{self, Axes, Series};
 use crate::io::layout;
-use crate::io::series::{MdSeriesRow, MD_SERIES_COLUMNS};
+use crate::md::rows::{MdSeriesRow, MD_SERIES_COLUMNS};
 use crate::md::{MdSystem, Shape, Wall, V3};
 use std::path::Path;
 
@@ -40,7 +40,7 @@ const CIRCLE_SIDES: usize = 32;
 pub fn md_figures(dir: &Path) -> Result<RunFigures> {
     let fin = read_final(dir)?;
     let series_path = require(dir, layout::SERIES)?;
-    let (header, rows) = crate::io::series::read_md(&series_path)?;
+    let (header, rows) = crate::md::rows::read_series(&series_path)?;
     let mut out = RunFigures::default();
     let curve = |label: &str, f: &dyn Fn(&MdSeriesRow) -> f64| Series {
         label: label.into(),
@@ -117,7 +117,7 @@ fn plate_cycles(dir: &Path, servos: &[(usize, String)], out: &mut RunFigures) ->
         out.skip("plate_settlement_cycles", "no cycles.csv (the run had no loading cycles)");
         return Ok(());
     }
-    let rows = crate::io::cycles::read_md(&path)?;
+    let rows = crate::md::rows::read_cycles(&path)?;
     let (s, unit) = figures::si_scale(max_abs(rows.iter().flat_map(|r| r.walls.iter().copied())).max(1e-12), "m");
     let series: Vec<Series> = servos
         .iter()

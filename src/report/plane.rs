@@ -24,9 +24,10 @@ use std::path::Path;
 
 /// Series of a settlement curve from `cycles.csv` rows, multiplied by `scale`
 /// (1e3 for millimetres, or from [`figures::si_scale`]).
-pub fn settlement_series(rows: &[crate::io::cycles::NscdCycleRow], label: &str, scale: f64) -> [Series; 2] {
-    let pick =
-        |f: fn(&crate::io::cycles::NscdCycleRow) -> f64| rows.iter().map(|r| (r.cycle as f64, scale * f(r))).collect();
+pub fn settlement_series(rows: &[crate::plane::rows::PlaneCycleRow], label: &str, scale: f64) -> [Series; 2] {
+    let pick = |f: fn(&crate::plane::rows::PlaneCycleRow) -> f64| {
+        rows.iter().map(|r| (r.cycle as f64, scale * f(r))).collect()
+    };
     let sep = if label.is_empty() { "" } else { ", " };
     [
         Series {
@@ -125,7 +126,7 @@ pub fn nscd_figures(dir: &Path, first_cycle_q: Option<&[[f64; 3]]>) -> Result<Ru
     let mut out = RunFigures::default();
     let cycles_path = dir.join(layout::CYCLES);
     if cycles_path.is_file() {
-        let rows = crate::io::cycles::read_nscd(&cycles_path)?;
+        let rows = crate::plane::rows::read_cycles(&cycles_path)?;
         let m = max_abs(rows.iter().flat_map(|r| [r.settlement_mean_m, r.settlement_at_min_load_m]));
         let (scale, unit) = figures::si_scale(m.max(1e-6), "m");
         let stem = dir.join("settlement");
@@ -140,11 +141,11 @@ pub fn nscd_figures(dir: &Path, first_cycle_q: Option<&[[f64; 3]]>) -> Result<Ru
     } else {
         out.skip("settlement", "no cycles.csv (the run had no loading cycles)");
     }
-    let rows = crate::io::series::read_nscd(&series_path)?;
+    let rows = crate::plane::rows::read_series(&series_path)?;
     // A run without overlaps (or contacts) still gets an axis in µm.
     let (scale, unit) = figures::si_scale(max_abs(rows.iter().map(|r| r.max_overlap_m)).max(1e-12), "m");
     let pick =
-        |f: fn(&crate::io::series::NscdSeriesRow) -> f64| rows.iter().map(|r| (r.time_s, scale * f(r))).collect();
+        |f: fn(&crate::plane::rows::PlaneSeriesRow) -> f64| rows.iter().map(|r| (r.time_s, scale * f(r))).collect();
     let stem = dir.join("interpenetration");
     let axes = Axes {
         title: "Interpenetration".into(),

@@ -43,11 +43,11 @@ use super::saussine::{sample, Loading};
 use super::{axes, output_error, run_scene, RunDisplay, SummaryTable};
 use crate::error::{Error, Result};
 use crate::io;
-use crate::io::cycles::NscdCycleRow as CycleRow;
 use crate::io::figures::{self, Series};
 use crate::io::layout;
-use crate::io::series::NscdSeriesRow as SeriesRow;
 use crate::io::table::TableWriter;
+use crate::plane::rows::PlaneCycleRow as CycleRow;
+use crate::plane::rows::PlaneSeriesRow as SeriesRow;
 use crate::run::RunReport;
 use crate::run::{cores, default_threads, Prior, RunOptions};
 use crate::scenarios::saussine::{loaded_scene, LoadingSpec, SampleSpec};
@@ -351,9 +351,9 @@ pub(super) fn run_jobs(
         let report = std::fs::read_to_string(dir.join(layout::SUMMARY))
             .ok()
             .and_then(|t| serde_json::from_str::<RunReport>(&t).ok());
-        let series = io::series::read_nscd(&dir.join(layout::SERIES)).unwrap_or_default();
+        let series = crate::plane::rows::read_series(&dir.join(layout::SERIES)).unwrap_or_default();
         let cycles_path = dir.join(layout::CYCLES);
-        let cycles = if cycles_path.exists() { io::cycles::read_nscd(&cycles_path)? } else { vec![] };
+        let cycles = if cycles_path.exists() { crate::plane::rows::read_cycles(&cycles_path)? } else { vec![] };
         outcomes.push(Outcome { status, report, series, cycles });
     }
     Ok(outcomes)
@@ -385,7 +385,7 @@ pub struct RunColumns {
     pub cycles: u64,
     /// Column `settlement_mean_m`: the sleeper's settlement averaged over the last
     /// completed cycle (m, positive downwards; see
-    /// [`crate::io::cycles::NscdCycleRow::settlement_mean_m`]).
+    /// [`crate::plane::rows::PlaneCycleRow::settlement_mean_m`]).
     pub settlement_mean_m: f64,
     /// Column `settlement_at_min_load_m`: the sleeper's settlement at the smallest load of
     /// the last completed cycle (m, positive downwards).

@@ -23,7 +23,7 @@
 //!   with each setting's mean and 95 % band.
 //!
 //! Settlements are those at the load minimum of each cycle
-//! ([`crate::io::cycles::NscdCycleRow::settlement_at_min_load_m`]), the accrued
+//! ([`crate::plane::rows::PlaneCycleRow::settlement_at_min_load_m`]), the accrued
 //! settlement is counted from the seating cycle `S` ([`Replicas::seating_cycles`]).
 
 use super::campaigns::{

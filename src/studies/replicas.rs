@@ -29,7 +29,7 @@
 //!   or more on each side.
 //! - **Seating and accrued settlement** ([`settlement_ensemble`],
 //!   [`SettlementSummary`]): from each replica's `cycles.csv`
-//!   ([`NscdCycleRow::settlement_at_min_load_m`], the settlement at the load
+//!   ([`PlaneCycleRow::settlement_at_min_load_m`], the settlement at the load
 //!   minimum of each cycle), the seating is the settlement at cycle `S`
 //!   ([`DEFAULT_SEATING_CYCLES`], clipped to the cycles run; `S = 0` is the
 //!   start, where the settlement is 0) and the accrued settlement of cycle
@@ -47,7 +47,7 @@
 //! ```
 
 use crate::error::{Error, Result};
-use crate::io::cycles::NscdCycleRow;
+use crate::plane::rows::PlaneCycleRow;
 use crate::scene::{MdScene, Scene};
 use crate::settlement::SettlementRow;
 use rand::{RngExt, SeedableRng};
@@ -372,7 +372,7 @@ pub struct SettlementEnsembleRow {
 }
 
 /// A row of a run's per-cycle table with the settlement at the cycle's end, the
-/// load minimum: `cycles.csv` of a plain run ([`NscdCycleRow`]), `settlement.csv`
+/// load minimum: `cycles.csv` of a plain run ([`PlaneCycleRow`]), `settlement.csv`
 /// of an accelerated one ([`SettlementRow`]: computed cycles measured there, the
 /// extrapolated ones on the fitted law).
 pub trait CycleSettlement {
@@ -382,7 +382,7 @@ pub trait CycleSettlement {
     fn settlement_at_min_load(&self) -> f64;
 }
 
-impl CycleSettlement for NscdCycleRow {
+impl CycleSettlement for PlaneCycleRow {
     fn cycle(&self) -> u64 {
         self.cycle
     }
@@ -729,8 +729,8 @@ mod tests {
         assert_eq!((d.diff, d.ci95, d.dof), (-1.0, (-1.0, -1.0), 3.0));
     }
 
-    fn row(cycle: u64, s: f64) -> NscdCycleRow {
-        NscdCycleRow {
+    fn row(cycle: u64, s: f64) -> PlaneCycleRow {
+        PlaneCycleRow {
             cycle,
             time_s: cycle as f64 * 0.05,
             settlement_mean_m: s,

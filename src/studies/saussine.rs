@@ -463,7 +463,7 @@ pub fn settle_replicas(
             .collect()
     });
     let seating = replicas.seating_cycles.min(loading.cycles);
-    let read = |path: &Path| io::cycles::read_nscd(path).map_err(output_error);
+    let read = |path: &Path| crate::plane::rows::read_cycles(path).map_err(output_error);
     finish_replicas(out, results, layout::CYCLES, read, seating, "Settlement of the sleeper")
 }
 

@@ -12,10 +12,10 @@ use crate::engine::final_state::FinalState;
 use crate::engine::StepSummary;
 use crate::engine::{Configuration, Energies, Engine};
 use crate::error::Result;
-use crate::io::cycles::{NscdCycleRow, NscdCycleState, NSCD_CYCLE_COLUMNS};
-use crate::io::series::{NscdSeriesRow, NSCD_SERIES_COLUMNS};
 use crate::io::vtk::PvdCollection;
 use crate::plane::outputs::{self, PlaneSystem};
+use crate::plane::rows::{PlaneCycleRow, PlaneCycleState, PLANE_CYCLE_COLUMNS};
+use crate::plane::rows::{PlaneSeriesRow, PLANE_SERIES_COLUMNS};
 use crate::plane::{Bodies, ContactInfo};
 use std::path::Path;
 
@@ -44,9 +44,9 @@ impl Engine for PlanarSystem {
     const EXTRAPOLATED: usize = 2;
     const ITERATIVE: bool = false;
     type Stats = PlanarStepStats;
-    type Row = NscdSeriesRow;
-    type CycleState = NscdCycleState;
-    type CycleRow = NscdCycleRow;
+    type Row = PlaneSeriesRow;
+    type CycleState = PlaneCycleState;
+    type CycleRow = PlaneCycleRow;
 
     fn step(&mut self) -> Result<PlanarStepStats> {
         PlanarSystem::step(self)
@@ -88,11 +88,11 @@ impl Engine for PlanarSystem {
     }
 
     fn series_header(&self) -> Vec<String> {
-        NSCD_SERIES_COLUMNS.iter().map(|s| s.to_string()).collect()
+        PLANE_SERIES_COLUMNS.iter().map(|s| s.to_string()).collect()
     }
 
-    fn series_row(&self, s: &PlanarStepStats) -> NscdSeriesRow {
-        NscdSeriesRow {
+    fn series_row(&self, s: &PlanarStepStats) -> PlaneSeriesRow {
+        PlaneSeriesRow {
             time_s: s.time,
             kinetic_energy_j: s.kinetic_energy,
             contacts: s.contacts,
@@ -115,7 +115,7 @@ impl Engine for PlanarSystem {
     }
 
     fn snapshot(&self, dir: &Path, pvd: &mut PvdCollection) -> Result<()> {
-        pvd.write_snapshot(dir, self).map(|_| ())
+        crate::plane::vtk::write_snapshot(pvd, dir, self).map(|_| ())
     }
 
     fn check_state(&self) -> Result<()> {
@@ -126,11 +126,11 @@ impl Engine for PlanarSystem {
         PlanarSystem::check_same_model(self, fresh)
     }
 
-    fn cycle_start(&self, body: Option<usize>) -> Result<NscdCycleState> {
+    fn cycle_start(&self, body: Option<usize>) -> Result<PlaneCycleState> {
         outputs::cycle_start(self, body)
     }
 
-    fn cycle_step(&self, c: &mut NscdCycleState, stats: &PlanarStepStats) {
+    fn cycle_step(&self, c: &mut PlaneCycleState, stats: &PlanarStepStats) {
         outputs::cycle_step(
             self,
             c,
@@ -143,15 +143,15 @@ impl Engine for PlanarSystem {
         );
     }
 
-    fn cycle_end(&self, c: &mut NscdCycleState, cycle: u64) -> NscdCycleRow {
+    fn cycle_end(&self, c: &mut PlaneCycleState, cycle: u64) -> PlaneCycleRow {
         outputs::cycle_end(self, c, cycle)
     }
 
     fn cycle_header(&self) -> Vec<String> {
-        NSCD_CYCLE_COLUMNS.iter().map(|s| s.to_string()).collect()
+        PLANE_CYCLE_COLUMNS.iter().map(|s| s.to_string()).collect()
     }
 
-    fn settlement(&self, c: &NscdCycleState) -> Option<f64> {
+    fn settlement(&self, c: &PlaneCycleState) -> Option<f64> {
         outputs::settlement(self, c)
     }
 

@@ -1,9 +1,18 @@
-//! `cycles.csv`: one row per loading cycle of a cyclically loaded run. A cycle of
-//! frequency `f` lasts `1/f` from t = 0; the step that ends within half a step
-//! of `c/f` or past it closes cycle `c` ([`crate::clock::cycles_at`], one clock
-//! for both engines).
+//! The output rows of the 2D engines (NSCD and planar MD write the same files), read back with the same
+//! types; column names carry their unit (`_s`, `_J`, `_m`, `_N`), counts and ratios have none.
 //!
-//! NSCD ([`NscdCycleRow`]; Saussine et al. 2006, §4: settlement of the sleeper,
+//! `series.csv`, one row every `output.every` steps and at the last step ([`PlaneSeriesRow`]):
+//! `time_s`, `kinetic_energy_J`, `contacts` (detected,
+//! open ones within the alert distance included), `active_contacts` (carrying a
+//! force or overlapping), `iterations` (NLGS sweeps), `criterion` (final value of
+//! the convergence norm), `converged` (1, or 0 when the step hit the iteration
+//! cap), `mean_overlap_m` (over the active contacts), `max_overlap_m`,
+//! `total_overlap_m` (sum over the contacts: the cumulated interpenetration of
+//! Saussine et al. 2006, Fig. 2).
+//!
+//! `cycles.csv`, one row per loading cycle (a cycle of frequency `f` lasts `1/f` from t = 0; the step that
+//! ends within half a step of `c/f` or past it closes cycle `c`, [`crate::clock::cycles_at`]):
+//! [`PlaneCycleRow`] (Saussine et al. 2006, §4: settlement of the sleeper,
 //! Figs. 6, 11, 12; mean grain velocity, Fig. 7), with `y` the vertical position
 //! of the followed body's centre of mass and `y0` its value at the start of the
 //! run: `cycle`, `time_s` (end of the cycle), `settlement_mean_m` (`y0 − ⟨y⟩`
@@ -18,30 +27,70 @@
 //! body, [`crate::plane::outputs::coordination`]). The last two were added on
 //! 2026-12-03; an older file reads them as NaN.
 //!
-//! MD ([`MdCycleRow`]; the residual displacements of Karrech et al. 2007 §3,
-//! taken at the end of each cycle, where the load is back to its base value):
-//! `cycle`, `time_s`, `mean_displacement_x_m`, `…_y_m`, `…_z_m` (mean over the
-//! spheres of the displacement since the start of the run), `max_displacement_m`
-//! (the largest norm), `max_overlap_m` (largest over the cycle), then
-//! `<wall>_position_m` for every servo wall.
-//!
-//! The per-cycle state is plain data, kept in checkpoints so that a resumed run
-//! writes the same rows.
+//! The per-cycle state is plain data, kept in checkpoints so that a resumed run writes the same rows.
 
 use crate::engine::CycleCheck;
 use crate::error::Result;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// What an NSCD run accumulates over the steps of a cycle.
+/// One row of a 2D engine's `series.csv`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PlaneSeriesRow {
+    /// Column `time_s`: time at the end of the step (s).
+    pub time_s: f64,
+    /// Column `kinetic_energy_J`: kinetic energy of the non-fixed bodies, translational plus
+    /// rotational, at the end of the step (J).
+    #[serde(rename = "kinetic_energy_J")]
+    pub kinetic_energy_j: f64,
+    /// Column `contacts`: contacts detected, open ones within the alert distance included.
+    pub contacts: usize,
+    /// Column `active_contacts`: contacts carrying an impulse or overlapping at the end of the step.
+    pub active_contacts: usize,
+    /// Column `iterations`: NLGS sweeps made in the step.
+    pub iterations: usize,
+    /// Column `criterion`: final value of the convergence norm of the policy
+    /// ([`crate::nscd::criterion::evaluate`]; dimensionless, converged below the tolerance).
+    pub criterion: f64,
+    /// Column `converged`: 1 if the iterations converged, 0 if they hit the iteration cap.
+    pub converged: u8,
+    /// Column `mean_overlap_m`: mean overlap over the active contacts at the end of the step (m).
+    pub mean_overlap_m: f64,
+    /// Column `max_overlap_m`: largest overlap at the end of the step (m).
+    pub max_overlap_m: f64,
+    /// Column `total_overlap_m`: sum of the overlaps of all contacts (m), the cumulated
+    /// interpenetration of Saussine et al. 2006, Fig. 2.
+    pub total_overlap_m: f64,
+}
+
+/// The columns of [`PlaneSeriesRow`].
+pub const PLANE_SERIES_COLUMNS: [&str; 10] = [
+    "time_s",
+    "kinetic_energy_J",
+    "contacts",
+    "active_contacts",
+    "iterations",
+    "criterion",
+    "converged",
+    "mean_overlap_m",
+    "max_overlap_m",
+    "total_overlap_m",
+];
+
+/// Reads a 2D engine's `series.csv`; the error names the file and the line.
+pub fn read_series(path: &Path) -> Result<Vec<PlaneSeriesRow>> {
+    Ok(crate::io::table::read(path)?.1)
+}
+
+/// What a run of a 2D engine accumulates over the steps of a cycle.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct NscdCycleState {
+pub struct PlaneCycleState {
     /// Index of the followed body.
     pub body: usize,
     /// Its initial vertical position (m).
     pub y0: f64,
     /// Steps accumulated so far in the cycle under way (the divisor of the
-    /// means of [`NscdCycleRow`]).
+    /// means of [`PlaneCycleRow`]).
     pub steps: u64,
     /// Sum over those steps of the followed body's vertical position `y` (m).
     pub sum_y: f64,
@@ -68,12 +117,7 @@ pub struct NscdCycleState {
     pub first_cycle_q: Option<Vec<[f64; 3]>>,
 }
 
-/// An `f64` that reads `null` (serde_json's form of a non-finite number) as +∞.
-fn null_is_infinite<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
-    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
-}
-
-impl NscdCycleState {
+impl PlaneCycleState {
     /// A cycle state following body `body` from the vertical position `y0` (m).
     pub fn new(body: usize, y0: f64) -> Self {
         Self {
@@ -100,7 +144,7 @@ impl NscdCycleState {
     }
 }
 
-impl CycleCheck for NscdCycleState {
+impl CycleCheck for PlaneCycleState {
     fn check(&self, start: &Self, bodies: usize, cycles: u64) -> std::result::Result<(), String> {
         if self.body != start.body || self.y0.to_bits() != start.y0.to_bits() {
             return Err(format!(
@@ -119,21 +163,9 @@ impl CycleCheck for NscdCycleState {
     }
 }
 
-impl CycleCheck for MdCycleState {
-    fn check(&self, start: &Self, _bodies: usize, _cycles: u64) -> std::result::Result<(), String> {
-        let same = self.x0.len() == start.x0.len()
-            && self.x0.iter().flatten().zip(start.x0.iter().flatten()).all(|(a, b)| a.to_bits() == b.to_bits());
-        if same {
-            Ok(())
-        } else {
-            Err(format!("{} sphere centres at the start, not those of the scene's {}", self.x0.len(), start.x0.len()))
-        }
-    }
-}
-
-/// One row of an NSCD `cycles.csv`.
+/// One row of a 2D engine's `cycles.csv`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct NscdCycleRow {
+pub struct PlaneCycleRow {
     /// Column `cycle`: number of the cycle ended (1 for the first).
     pub cycle: u64,
     /// Column `time_s`: time at the end of the cycle (s).
@@ -166,12 +198,8 @@ pub struct NscdCycleRow {
     pub coordination: f64,
 }
 
-fn nan() -> f64 {
-    f64::NAN
-}
-
-/// The columns of [`NscdCycleRow`].
-pub const NSCD_CYCLE_COLUMNS: [&str; 10] = [
+/// The columns of [`PlaneCycleRow`].
+pub const PLANE_CYCLE_COLUMNS: [&str; 10] = [
     "cycle",
     "time_s",
     "settlement_mean_m",
@@ -184,55 +212,16 @@ pub const NSCD_CYCLE_COLUMNS: [&str; 10] = [
     "coordination",
 ];
 
-/// What an MD run keeps for its cycles.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MdCycleState {
-    /// Sphere centres at the start of the run (m).
-    pub x0: Vec<[f64; 3]>,
-    /// Largest overlap over the cycle under way (m).
-    pub max_overlap: f64,
+/// Reads a 2D engine's `cycles.csv`; the error names the file and the line.
+pub fn read_cycles(path: &Path) -> Result<Vec<PlaneCycleRow>> {
+    Ok(crate::io::table::read(path)?.1)
 }
 
-/// One row of an MD `cycles.csv`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MdCycleRow {
-    /// Column `cycle`: number of the cycle ended (1 for the first).
-    pub cycle: u64,
-    /// Column `time_s`: time at the end of the cycle (s).
-    pub time_s: f64,
-    /// Column `mean_displacement_x_m`: x-component of the displacement since the
-    /// start of the run, mean over the spheres (m).
-    pub mean_displacement_x_m: f64,
-    /// Column `mean_displacement_y_m`: y-component of the mean displacement (m).
-    pub mean_displacement_y_m: f64,
-    /// Column `mean_displacement_z_m`: z-component of the mean displacement (m).
-    pub mean_displacement_z_m: f64,
-    /// Column `max_displacement_m`: largest norm of a sphere's displacement since the
-    /// start of the run (m).
-    pub max_displacement_m: f64,
-    /// Column `max_overlap_m`: largest contact overlap over the cycle (m).
-    pub max_overlap_m: f64,
-    /// `<wall>_position_m` for every servo wall.
-    pub walls: Vec<f64>,
+/// An `f64` that reads `null` (serde_json's form of a non-finite number) as +∞.
+fn null_is_infinite<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
 }
 
-/// The fixed columns of [`MdCycleRow`], before the servo walls.
-pub const MD_CYCLE_COLUMNS: [&str; 7] = [
-    "cycle",
-    "time_s",
-    "mean_displacement_x_m",
-    "mean_displacement_y_m",
-    "mean_displacement_z_m",
-    "max_displacement_m",
-    "max_overlap_m",
-];
-
-/// Reads an NSCD `cycles.csv`; the error names the file and the line.
-pub fn read_nscd(path: &Path) -> Result<Vec<NscdCycleRow>> {
-    Ok(super::table::read(path)?.1)
-}
-
-/// Reads an MD `cycles.csv`; the error names the file and the line.
-pub fn read_md(path: &Path) -> Result<Vec<MdCycleRow>> {
-    Ok(super::table::read(path)?.1)
+fn nan() -> f64 {
+    f64::NAN
 }
