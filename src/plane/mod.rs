@@ -9,6 +9,7 @@
 pub mod bodies;
 pub mod broad_phase;
 pub mod detection;
+pub mod engine;
 pub mod loads;
 pub mod narrow_phase;
 pub mod outputs;
