@@ -1,7 +1,8 @@
 //! The `ballast run` command: output files on a valid scene, exit code 2 and a
 //! one-line error on an invalid one.
 
-use std::path::PathBuf;
+mod scratch;
+
 use std::process::Command;
 
 const SCENE: &str = r#"
@@ -42,21 +43,13 @@ regular = { sides = 5, radius = 0.02 }
 position = [0.2, 0.1]
 "#;
 
-/// A fresh directory under the system temp dir, unique to this test and process.
-fn temp_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-cli-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 fn ballast() -> Command {
     Command::new(env!("CARGO_BIN_EXE_ballast"))
 }
 
 #[test]
 fn run_writes_the_outputs() {
-    let dir = temp_dir("valid");
+    let dir = scratch::dir("valid");
     let scene = dir.join("in.toml");
     std::fs::write(&scene, SCENE).unwrap();
     let out = dir.join("out");
@@ -128,7 +121,7 @@ fn run_writes_the_outputs() {
 }
 
 fn assert_scene_error(args: &[&str], scene: Option<&str>, test: &str, expected: &str) {
-    let dir = temp_dir(test);
+    let dir = scratch::dir(test);
     let path = dir.join("bad.toml");
     if let Some(text) = scene {
         std::fs::write(&path, text).unwrap();
@@ -196,7 +189,7 @@ imposed = { vx = 0.0, vy = -1.0, spin = 0.0 }
 
 #[test]
 fn diverging_run_exits_with_code_1_and_keeps_the_last_good_state() {
-    let dir = temp_dir("diverge");
+    let dir = scratch::dir("diverge");
     let path = dir.join("in.toml");
     std::fs::write(&path, SQUEEZE).unwrap();
     let out = dir.join("out");
@@ -224,7 +217,7 @@ fn diverging_run_exits_with_code_1_and_keeps_the_last_good_state() {
 /// for another scene.
 #[test]
 fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
-    let dir = temp_dir("resume");
+    let dir = scratch::dir("resume");
     let scene = dir.join("in.toml");
     // With per-cycle statistics (5 cycles of 10 ms over the 50 steps).
     let text = SCENE.replace("every = 7", "every = 7\ncycles = { frequency = 100.0, body = \"block\" }");
@@ -298,7 +291,7 @@ fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
 /// inside that window and resumed ends at the same step with the same numbers.
 #[test]
 fn run_stops_at_equilibrium_and_resumes_into_the_same_stop() {
-    let dir = temp_dir("equilibrium");
+    let dir = scratch::dir("equilibrium");
     let scene = dir.join("in.toml");
     // 2 s of simulated time; the block and pebble settle within a fraction of it.
     let text = SCENE

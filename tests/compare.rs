@@ -5,6 +5,8 @@
 //! stiffen, the MD ensemble settlement approaches the NSCD ensemble settlement,
 //! judged with the replicas' 95 % confidence intervals.
 
+mod scratch;
+
 use ballast::io::read_csv;
 use ballast::scenarios::saussine::SampleSpec;
 use ballast::studies::campaigns::StudyOptions;
@@ -14,13 +16,6 @@ use ballast::studies::saussine::{self, Loading};
 use ballast::studies::Quiet;
 use ballast::Error;
 use std::path::{Path, PathBuf};
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-compare-{}-{tag}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn spec(sample: &Path, overlaps: &[f64], cycles: u64, replicas: u64) -> CompareSpec {
     CompareSpec {
@@ -48,7 +43,7 @@ fn sleeper_scene() -> PathBuf {
 /// cycles, NSCD and MD at two overlap ratios, two replicas each.
 #[test]
 fn compare_writes_every_run_and_cycle_and_derives_the_md_settings_from_the_ratio() {
-    let out = temp_dir("files");
+    let out = scratch::dir("files");
     let report = run(&spec(&sleeper_scene(), &[1e-2, 1e-3], 2, 2), &out);
     let header = "engine,overlap_ratio,replica,normal_stiffness_N_m,dt_s,steps_per_cycle,cycle,settlement_m,\
                   wall_time_s,mean_overlap_m,max_overlap_m,coordination";
@@ -102,7 +97,7 @@ fn compare_writes_every_run_and_cycle_and_derives_the_md_settings_from_the_ratio
 
 #[test]
 fn bad_compare_options_are_input_errors_naming_the_option() {
-    let out = temp_dir("errors");
+    let out = scratch::dir("errors");
     let scene = sleeper_scene();
     let message = |s: CompareSpec| match compare(&s, &StudyOptions::new(&out), &Quiet) {
         Err(Error::Scene(m)) => m,
@@ -131,7 +126,7 @@ fn bad_compare_options_are_input_errors_naming_the_option() {
 /// that the trend and its judgement by the intervals hold.
 #[test]
 fn md_settlement_approaches_nscd_as_the_contacts_stiffen() {
-    let out = temp_dir("trend");
+    let out = scratch::dir("trend");
     let spec100 = SampleSpec::saussine(1).scaled(100);
     let sample = saussine::sample(&spec100, &out.join("sample"), false, 1, &Quiet).unwrap();
     let report = run(&spec(&sample.path, &[1e-2, 1e-3], 20, 3), &out.join("compare"));

@@ -1,17 +1,11 @@
 //! `ballast::io::figures`: each figure is written as a PNG of the right size and an
 //! SVG with the expected elements; bad values are skipped, never a panic.
 
+mod scratch;
+
 use ballast::io::figures::{displacement_field, force_chains, line_chart, Arrow, Axes, ForceLine, Series};
 use ballast::report::plane::{force_lines_of, polygons_of};
-use std::path::{Path, PathBuf};
-
-/// A fresh directory under the system's temp dir.
-fn temp_dir(name: &str) -> PathBuf {
-    let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().as_nanos();
-    let dir = std::env::temp_dir().join(format!("ballast_figures_{name}_{}_{nanos}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use std::path::Path;
 
 /// Width and height of a PNG, from its IHDR chunk, after checking the signature.
 fn png_size(path: &Path) -> (u32, u32) {
@@ -49,7 +43,7 @@ fn sample() -> (Vec<Vec<[f64; 2]>>, Vec<bool>) {
 
 #[test]
 fn line_chart_writes_png_and_svg_with_legend_and_band() {
-    let dir = temp_dir("line");
+    let dir = scratch::dir("line");
     let stem = dir.join("settlement");
     let series = [
         Series {
@@ -80,7 +74,7 @@ fn line_chart_writes_png_and_svg_with_legend_and_band() {
 
 #[test]
 fn log_axes_skip_non_positive_and_nan_values() {
-    let dir = temp_dir("log");
+    let dir = scratch::dir("log");
     let series = [Series {
         label: "NLGS".into(),
         points: vec![(1e-6, 900.0), (0.0, 50.0), (-1e-3, 10.0), (1e-4, f64::NAN), (1e-3, 40.0), (1e-2, 0.0)],
@@ -111,7 +105,7 @@ fn log_axes_skip_non_positive_and_nan_values() {
 
 #[test]
 fn empty_inputs_give_a_no_data_figure() {
-    let dir = temp_dir("empty");
+    let dir = scratch::dir("empty");
     line_chart(&dir.join("chart"), &axes("Empty", false, false), &[]).unwrap();
     assert_eq!(png_size(&dir.join("chart.png")), (1200, 800));
     assert!(svg(&dir.join("chart.svg")).contains("no data"));
@@ -125,7 +119,7 @@ fn empty_inputs_give_a_no_data_figure() {
 
 #[test]
 fn force_chains_draws_polygons_and_lines_above_one_percent() {
-    let dir = temp_dir("forces");
+    let dir = scratch::dir("forces");
     let (polygons, fixed) = sample();
     let lines = [
         ForceLine { from: [-0.05, 0.05], to: [0.0, -0.1], normal_force: 10.0 },
@@ -156,7 +150,7 @@ fn force_chains_draws_polygons_and_lines_above_one_percent() {
 
 #[test]
 fn displacement_field_draws_one_arrow_per_moving_grain() {
-    let dir = temp_dir("disp");
+    let dir = scratch::dir("disp");
     let (polygons, fixed) = sample();
     let arrows = [
         Arrow { from: [-0.05, 0.06], displacement: [0.0, -0.01] },
@@ -176,7 +170,7 @@ fn displacement_field_draws_one_arrow_per_moving_grain() {
 
 #[test]
 fn unwritable_path_is_an_io_error_naming_the_file() {
-    let dir = temp_dir("err");
+    let dir = scratch::dir("err");
     let stem = dir.join("missing").join("fig");
     let err = line_chart(&stem, &axes("t", false, false), &[]).unwrap_err();
     assert!(matches!(err, ballast::Error::Io(_)));
@@ -208,7 +202,7 @@ fn adapters_read_the_engine_state() {
     let weight = 2700.0 * 0.1 * 0.1 * 9.81;
     let total: f64 = lines.iter().map(|l| l.normal_force).sum();
     assert!((total - weight).abs() < 0.05 * weight, "{lines:?}");
-    let dir = temp_dir("adapters");
+    let dir = scratch::dir("adapters");
     force_chains(&dir.join("block"), "Block on floor", &polygons, &fixed, &lines).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -6,6 +6,8 @@
 //! `ballast::report::draw_run_figures`, by `ballast run --figures`'s
 //! path (`RunOptions::figures`) and by the `ballast figures DIR` command.
 
+mod scratch;
+
 use ballast::engine::contacts::{self, ContactKind};
 use ballast::engine::FinalState;
 use ballast::open::run_file;
@@ -13,14 +15,6 @@ use ballast::report::draw_run_figures;
 use ballast::run::RunOptions;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-/// A fresh directory under the system's temp dir.
-fn temp_dir(name: &str) -> PathBuf {
-    let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().as_nanos();
-    let dir = std::env::temp_dir().join(format!("ballast_figures_cli_{name}_{}_{nanos}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn options(figures: bool) -> RunOptions {
     RunOptions { checkpoint_every_s: 0.0, threads: 1, figures, ..RunOptions::default() }
@@ -56,7 +50,7 @@ fn stems(dir: &Path, written: &[PathBuf]) -> Vec<String> {
 /// is not a run with one line naming the missing file.
 #[test]
 fn nscd_block_contacts_and_figures() {
-    let dir = temp_dir("nscd");
+    let dir = scratch::dir("nscd");
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/block_on_floor.toml");
     run_file(&scene, &dir, &options(true), &mut |_| {}).unwrap();
     let rows = contacts::read(&dir.join("contacts.csv")).unwrap();
@@ -101,7 +95,7 @@ fn nscd_block_contacts_and_figures() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout} {}", String::from_utf8_lossy(&out.stderr));
     assert!(stdout.contains("force_chains.png") && stdout.contains("skipped settlement"), "{stdout}");
-    let empty = temp_dir("not_a_run");
+    let empty = scratch::dir("not_a_run");
     let out = Command::new(env!("CARGO_BIN_EXE_ballast")).arg("figures").arg(&empty).output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
@@ -190,7 +184,7 @@ servo = { mass = 0.05, viscosity = 2.0, force = 2.0, amplitude = 2.0, period = 0
 
 #[test]
 fn md_contacts_and_figures() {
-    let dir = temp_dir("md");
+    let dir = scratch::dir("md");
     let mut text = MD_SCENE.to_string();
     for k in 0..8 {
         let (i, j, l) = (k % 2, (k / 2) % 2, k / 4);

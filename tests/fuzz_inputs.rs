@@ -34,6 +34,8 @@
 //! `--nocapture`). Failures in code another session is changing are listed in
 //! [`KNOWN`] (with a TODO) and reported, not failed.
 
+mod scratch;
+
 use ballast::open::run_file;
 use ballast::run::checkpoint::crc32;
 use ballast::run::{Progress, RunOptions, RunOutcome, Status};
@@ -259,14 +261,6 @@ impl Tally {
             );
         }
     }
-}
-
-/// A scratch folder of this process, removed at the end of a test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bf-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 /// Options of a fuzzed run: one thread, no wall-clock checkpoints, at most
@@ -765,7 +759,7 @@ fn check_scene(t: &mut Tally, base: &str, mutation: &str, dir: &Path, text: &[u8
 fn scene_values(engine: &str, per_base: usize, seed: u64) -> Tally {
     let mut t = Tally::new(&format!("scene values ({engine})"));
     let started = Instant::now();
-    let dir = scratch(&format!("sv-{engine}"));
+    let dir = scratch::dir(&format!("sv-{engine}"));
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     for (base, text) in bases().into_iter().filter(|(n, _)| n.starts_with("md") == (engine == "md")) {
         let doc: Toml = toml::from_str(&text).unwrap();
@@ -818,7 +812,7 @@ fn scene_values(engine: &str, per_base: usize, seed: u64) -> Tally {
 fn scene_text(per_base: usize, seed: u64) -> Tally {
     let mut t = Tally::new("scene text");
     let started = Instant::now();
-    let dir = scratch("st");
+    let dir = scratch::dir("st");
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     const INSERTS: &[&str] = &[
         "[[body]]",
@@ -1560,7 +1554,7 @@ fn checkpoint_files(t: &mut Tally, s: &Stopped, base: &str, count: usize, rng: &
 fn fuzz_checkpoints(name: &str, engine: &str, seed: u64, counts: [usize; 3]) -> Tally {
     let mut t = Tally::new(&format!("checkpoints ({engine})"));
     let started = Instant::now();
-    let dir = scratch(&format!("ck-{engine}"));
+    let dir = scratch::dir(&format!("ck-{engine}"));
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let s = stopped(&mut t, name, &dir);
     let before = (t.mutations, t.failures.len());

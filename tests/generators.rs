@@ -3,6 +3,8 @@
 //! replaced, and refuse impossible parameters with a one-line error naming the
 //! parameter (no panic, endless loop or invalid scene).
 
+mod scratch;
+
 use ballast::md::V3;
 use ballast::scenarios::karrech::{self, KarrechSpec, Loading};
 use ballast::scenarios::luding::{self, LudingSpec};
@@ -11,7 +13,7 @@ use ballast::scenarios::saussine::{
 };
 use ballast::scenarios::{pentagon_deposit, DepositSpec};
 use ballast::scene::{MdScene, Scene};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 /// The error message of `r`, which must be an error.
@@ -62,13 +64,6 @@ fn same_md(name: &str, new: &MdScene) {
 
 fn small_karrech() -> KarrechSpec {
     KarrechSpec { young: 1e7, dt: 2e-6, duration: 0.6, ..KarrechSpec::table1(40, 1) }
-}
-
-fn temp_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-generators-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 fn ballast(args: &[&str]) -> std::process::Output {
@@ -205,7 +200,7 @@ fn deposit_with_a_bad_dt_or_width_is_a_clear_error() {
     );
     says(&message(pentagon_deposit(&DepositSpec { friction: f64::INFINITY, ..spec })), &["deposit: friction"]);
 
-    let dir = temp_dir("deposit");
+    let dir = scratch::dir("deposit");
     let out = dir.join("d.toml");
     let o = ballast(&["deposit", "--dt", "nan", "--out", out.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr);
@@ -249,7 +244,7 @@ fn small_samples_are_loaded_by_a_scaled_sleeper() {
     says(&message(saussine::loaded_scene(&sample, &narrow)), &["too narrow for 2 bars of 0.01 m", "use fewer bars"]);
 
     // Through the CLI, with the default options.
-    let dir = temp_dir("load");
+    let dir = scratch::dir("load");
     let (sample_path, out) = (dir.join("sample.toml"), dir.join("loaded.toml"));
     std::fs::write(&sample_path, sample.to_toml_string().unwrap()).unwrap();
     let o = ballast(&["saussine", "load", "--sample", sample_path.to_str().unwrap(), "--out", out.to_str().unwrap()]);
@@ -355,7 +350,7 @@ fn impossible_luding_boxes_are_errors() {
 /// `saussine sample --grains 1` is refused before any run, with the minimum.
 #[test]
 fn cli_refuses_a_sample_below_the_minimum() {
-    let dir = temp_dir("grains");
+    let dir = scratch::dir("grains");
     let out = dir.join("s");
     let o = ballast(&["saussine", "sample", "--grains", "1", "--quiet", "--out", out.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr);

@@ -2,21 +2,15 @@
 //! stop and resume with the same bytes, the equilibrium stop, VTK snapshots,
 //! servo-wall columns, and exit code 2 with one line on an invalid scene.
 
-use std::path::{Path, PathBuf};
+mod scratch;
+
+use std::path::Path;
 use std::process::{Command, Output};
 
 /// The example scene's text.
 fn example() -> String {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/md_two_spheres.toml");
     std::fs::read_to_string(path).unwrap()
-}
-
-/// A fresh directory under the system temp dir, unique to this test and process.
-fn temp_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-md-cli-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 /// `ballast run SCENE --out OUT --quiet EXTRA…`.
@@ -53,7 +47,7 @@ mean_overlap_m,coordination,packing_fraction";
 
 #[test]
 fn the_example_writes_every_output() {
-    let dir = temp_dir("example");
+    let dir = scratch::dir("example");
     let scene = dir.join("in.toml");
     let text = example();
     std::fs::write(&scene, &text).unwrap();
@@ -136,7 +130,7 @@ fn the_example_writes_every_output() {
 
 #[test]
 fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
-    let dir = temp_dir("resume");
+    let dir = scratch::dir("resume");
     let scene = dir.join("in.toml");
     std::fs::write(&scene, example()).unwrap();
     let (whole, parts) = (dir.join("whole"), dir.join("parts"));
@@ -187,7 +181,7 @@ fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
 
 #[test]
 fn vtk_snapshots_are_sphere_points_listed_in_the_pvd() {
-    let dir = temp_dir("vtk");
+    let dir = scratch::dir("vtk");
     let scene = dir.join("in.toml");
     std::fs::write(&scene, example().replace("duration = 0.2\n", "duration = 0.01\n")).unwrap();
     let out = dir.join("out");
@@ -213,7 +207,7 @@ fn vtk_snapshots_are_sphere_points_listed_in_the_pvd() {
 /// The legacy form of a spheres snapshot holds the same arrays as point data.
 #[test]
 fn legacy_spheres_snapshot() {
-    let dir = temp_dir("legacy");
+    let dir = scratch::dir("legacy");
     let sys = ballast::scene::MdScene::from_toml_str(&example()).unwrap().build().unwrap();
     let path = dir.join("spheres.vtk");
     ballast::md::vtk::write_spheres(&path, &sys).unwrap();
@@ -235,7 +229,7 @@ fn legacy_spheres_snapshot() {
 
 #[test]
 fn run_stops_at_equilibrium() {
-    let dir = temp_dir("equilibrium");
+    let dir = scratch::dir("equilibrium");
     let scene = dir.join("in.toml");
     // At most 0.4 s; the spheres have landed and roll slowly after about 0.2 s (a
     // window of 2000 steps, 4 ms, is longer than the top of a bounce).
@@ -276,7 +270,7 @@ fn run_stops_at_equilibrium() {
 /// and a 100-step window, a run that counted from the start stopped at step 100.
 #[test]
 fn equilibrium_is_not_declared_before_the_sample_has_moved() {
-    let dir = temp_dir("equilibrium_rest");
+    let dir = scratch::dir("equilibrium_rest");
     let scene = dir.join("in.toml");
     let text = example()
         .replace("seed = 1\n", "seed = 1\nequilibrium = { energy_ratio = 1e-2, steps = 100 }\n")
@@ -296,7 +290,7 @@ fn equilibrium_is_not_declared_before_the_sample_has_moved() {
 
 #[test]
 fn servo_walls_get_a_position_column() {
-    let dir = temp_dir("servo");
+    let dir = scratch::dir("servo");
     let scene = dir.join("in.toml");
     let lid = "[[wall]]\nname = \"lid\"\nmaterial = \"steel\"\n\
                disc = { point = [0.0, 0.0, 0.02], normal = [0.0, 0.0, -1.0], radius = 0.0075 }\n\
@@ -325,7 +319,7 @@ fn servo_walls_get_a_position_column() {
 /// the other are refused at load: tests/md_safety.rs.)
 #[test]
 fn diverging_run_exits_with_code_1() {
-    let dir = temp_dir("diverge");
+    let dir = scratch::dir("diverge");
     let scene = dir.join("in.toml");
     let lid = "[[wall]]\nname = \"lid\"\nmaterial = \"steel\"\n\
                disc = { point = [0.0, 0.0, 0.016], normal = [0.0, 0.0, -1.0], radius = 0.0075 }\n\
@@ -355,7 +349,7 @@ fn diverging_run_exits_with_code_1() {
 
 /// Runs an invalid scene: exit code 2, one line `error: …` containing `expected`, no outputs.
 fn assert_refused(text: &str, extra: &[&str], test: &str, expected: &str) {
-    let dir = temp_dir(test);
+    let dir = scratch::dir(test);
     let path = dir.join("bad.toml");
     std::fs::write(&path, text).unwrap();
     let r = run(&path, &dir.join("out"), extra);

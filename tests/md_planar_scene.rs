@@ -5,18 +5,14 @@
 //! the same bytes, the settlement driver runs on it, and bad `[soft]` tables or
 //! time steps are one-line errors naming the key and the numbers.
 
+mod scratch;
+
 use ballast::open::run_file;
 use ballast::run::RunOptions;
 use ballast::scene::Scene;
 use std::path::{Path, PathBuf};
 
 const BLOCK: &str = "examples/block_on_floor.toml";
-
-fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-planar-scene-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
 
 fn opts(engine: Option<&str>) -> RunOptions {
     RunOptions { checkpoint_every_s: 0.0, threads: 1, engine: engine.map(String::from), ..RunOptions::default() }
@@ -39,7 +35,7 @@ fn scene_file(dir: &Path, text: &str) -> PathBuf {
 /// 1e-3 × its inradius (50 µm): at rest the face sits exactly that deep.
 #[test]
 fn a_block_run_with_engine_md_rests_at_the_overlap_its_stiffness_was_derived_for() {
-    let out = out_dir("block");
+    let out = scratch::path("block");
     let outcome = run_file(BLOCK.as_ref(), &out, &opts(Some("md")), &mut |_| {}).unwrap();
     let run = json(&out.join("run.json"));
     assert_eq!(run["engine"], "md2d");
@@ -69,7 +65,7 @@ fn a_block_run_with_engine_md_rests_at_the_overlap_its_stiffness_was_derived_for
 /// One scene, both engines: the same files with the same columns.
 #[test]
 fn both_engines_write_the_same_files_from_one_scene() {
-    let (nscd, md) = (out_dir("both-nscd"), out_dir("both-md"));
+    let (nscd, md) = (scratch::path("both-nscd"), scratch::path("both-md"));
     run_file(BLOCK.as_ref(), &nscd, &opts(None), &mut |_| {}).unwrap();
     run_file(BLOCK.as_ref(), &md, &opts(Some("md")), &mut |_| {}).unwrap();
     for f in ["series.csv", "contacts.csv"] {
@@ -87,7 +83,7 @@ fn both_engines_write_the_same_files_from_one_scene() {
 /// A planar run stopped and resumed writes the bytes of the uninterrupted run.
 #[test]
 fn a_planar_run_stopped_and_resumed_writes_the_same_bytes() {
-    let (whole, cut) = (out_dir("whole"), out_dir("cut"));
+    let (whole, cut) = (scratch::path("whole"), scratch::path("cut"));
     run_file(BLOCK.as_ref(), &whole, &opts(Some("md")), &mut |_| {}).unwrap();
     let stop = RunOptions { stop_after: Some(3001), ..opts(Some("md")) };
     run_file(BLOCK.as_ref(), &cut, &stop, &mut |_| {}).unwrap();
@@ -105,7 +101,7 @@ fn a_planar_run_stopped_and_resumed_writes_the_same_bytes() {
 #[test]
 fn the_settlement_driver_runs_on_the_planar_md_engine() {
     let scene = "examples/settlement_sleeper.toml";
-    let out = out_dir("driver");
+    let out = scratch::path("driver");
     let s = ballast::open::settle_file(scene.as_ref(), &out, &opts(Some("md")), &mut |_| {}).unwrap().unwrap();
     assert_eq!((s.total_cycles, s.computed_cycles, s.jumps), (30, 18, 3));
     assert_eq!(json(&out.join("run.json"))["engine"], "md2d");
@@ -114,7 +110,7 @@ fn the_settlement_driver_runs_on_the_planar_md_engine() {
     for j in &jumps {
         assert!(j.relax_converged && j.max_overlap_after_relax_m <= j.relax_tolerance_m, "{j:?}");
     }
-    let cut = out_dir("driver-cut");
+    let cut = scratch::path("driver-cut");
     let stop = RunOptions { stop_after: Some(20_000), ..opts(Some("md")) };
     let s1 = ballast::open::settle_file(scene.as_ref(), &cut, &stop, &mut |_| {}).unwrap().unwrap();
     assert_eq!(s1.end, "stopped");
@@ -127,7 +123,7 @@ fn the_settlement_driver_runs_on_the_planar_md_engine() {
 #[test]
 fn bad_soft_tables_name_the_key() {
     let base = std::fs::read_to_string(BLOCK).unwrap();
-    let dir = out_dir("errors");
+    let dir = scratch::path("errors");
     let cases: [(&str, &str); 6] = [
         ("[soft]\ndt = 1.0e-2\n", "stability limit"),
         ("[soft]\nmodel = \"soft\"\n", "soft.model: unknown model 'soft'"),

@@ -4,15 +4,10 @@
 //! servo walls hold their prescribed stress, and the cyclic stress reaches
 //! `p₀ + Δσ` at mid-cycle.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod scratch;
 
-fn temp_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-md-ready-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use std::path::Path;
+use std::process::Command;
 
 fn ballast(args: &[&str]) -> String {
     let out = Command::new(env!("CARGO_BIN_EXE_ballast")).args(args).output().unwrap();
@@ -35,7 +30,7 @@ fn col(header: &[String], name: &str) -> usize {
 
 #[test]
 fn karrech_deposit_then_cyclic_load() {
-    let dir = temp_dir("karrech");
+    let dir = scratch::dir("karrech");
     let (dep, load) = (dir.join("deposit"), dir.join("load"));
     // 40 spheres of Table 1 sizes, softened (E = 10 MPa) so that a 2 µs step resolves contacts.
     ballast(
@@ -143,7 +138,7 @@ fn karrech_deposit_then_cyclic_load() {
 
 #[test]
 fn luding_compression_then_one_cycle() {
-    let dir = temp_dir("luding");
+    let dir = scratch::dir("luding");
     let (comp, cyc) = (dir.join("compress"), dir.join("cycle"));
     ballast(
         &[

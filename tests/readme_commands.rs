@@ -10,7 +10,9 @@
 //! commands: the examples and benches are built by `cargo clippy
 //! --all-targets` in CI, the tests by this very run.
 
-use std::path::{Path, PathBuf};
+mod scratch;
+
+use std::path::Path;
 use std::process::Command;
 
 /// Reduced options per subcommand: `(subcommand words, [(option, value)])`;
@@ -137,13 +139,6 @@ fn reduced(args: &[String]) -> Vec<String> {
     out
 }
 
-fn temp_dir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-readme-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 #[test]
 fn every_readme_command_runs() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -153,7 +148,7 @@ fn every_readme_command_runs() {
     for sub in ["run", "saussine sample", "karrech deposit", "luding compare", "figures"] {
         assert!(cmds.iter().any(|c| c.join(" ").starts_with(sub)), "no `ballast {sub}` found in README.md");
     }
-    let dir = temp_dir();
+    let dir = scratch::dir("readme");
     std::os::unix::fs::symlink(root.join("examples"), dir.join("examples")).unwrap();
     for args in &cmds {
         let args = reduced(args);

@@ -3,18 +3,13 @@
 //! a 50-grain sample (flat sleeper, 2 cycles at dt = 1 ms), whose ensemble
 //! tables must be the statistics of the replicas' own `cycles.csv`.
 
+mod scratch;
+
 use ballast::scene::{MdScene, Scene};
 use ballast::studies::replicas::{ball_point, perturb_md_scene, perturb_scene, t_quantile_975, Perturbation};
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-replicas-{}-{tag}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn run(args: &[&str]) -> String {
     let r = Command::new(env!("CARGO_BIN_EXE_ballast")).args(args).arg("--quiet").output().unwrap();
@@ -143,7 +138,7 @@ const SHORT: [&str; 6] = ["--cycles", "2", "--dt", "1e-3", "--bars", "0"];
 /// the same run: identical settlements, sd exactly 0.
 #[test]
 fn settle_replicas_ensemble_is_that_of_the_replicas() {
-    let dir = temp_dir("settle");
+    let dir = scratch::dir("settle");
     let sample = sample(&dir);
     let out = dir.join("settle");
     let out_s = out.to_str().unwrap();
@@ -288,7 +283,7 @@ fn settle_replicas_ensemble_is_that_of_the_replicas() {
 /// tightest tolerance when no strict run is there) with Welch's interval.
 #[test]
 fn convergence_replicas_compare_with_the_reference() {
-    let dir = temp_dir("conv");
+    let dir = scratch::dir("conv");
     let sample = sample(&dir);
     let out = dir.join("conv");
     let args = [
@@ -351,7 +346,7 @@ fn convergence_replicas_compare_with_the_reference() {
 ///   that under- or over-predicts the accrual further fails here.
 #[test]
 fn the_default_setting_settles_like_the_reference_within_its_stated_error() {
-    let dir = temp_dir("default");
+    let dir = scratch::dir("default");
     let sample = sample(&dir);
     let out = dir.join("conv");
     let spec = ballast::scenarios::saussine::LoadingSpec::saussine(1);

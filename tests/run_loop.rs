@@ -5,6 +5,8 @@
 //! leaves the last good state and its row; every CSV it writes reads back
 //! through the library's row types.
 
+mod scratch;
+
 use ballast::engine::Engine;
 use ballast::engine::FinalState;
 use ballast::run::RunEnd;
@@ -12,14 +14,6 @@ use ballast::run::{RunOptions, RunPlan, Runner, Status};
 use ballast::scene::{MdScene, Scene};
 use ballast::Error;
 use std::path::{Path, PathBuf};
-
-/// A fresh directory under the system temp dir, unique to this test and process.
-fn temp_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-run-loop-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// NSCD: a block dropped on a floor and a pentagon beside it, 5 cycles of 10 ms
 /// followed on the block, with the positions of the mobile bodies per cycle.
@@ -110,7 +104,7 @@ fn summary_without_wall_time(dir: &Path) -> serde_json::Value {
 /// a snapshot every `vtk` steps: the same bytes; a checkpoint left after the
 /// first stop is refused by a runner of another scene.
 fn resume_is_bit_identical<E: Engine>(runner: &Runner<E>, other: &Runner<E>, stop: u64, vtk: u64, test: &str) {
-    let dir = temp_dir(test);
+    let dir = scratch::dir(test);
     let (whole, parts) = (dir.join("whole"), dir.join("parts"));
     let opts = RunOptions { vtk_every: vtk, ..quiet() };
     // Nothing to resume yet: an input error, nothing written.
@@ -167,7 +161,7 @@ fn md_resume_is_bit_identical() {
 /// Runs to equilibrium; the last row is the stop step; stopped 10 steps before
 /// the stop and resumed, the same stop and bytes.
 fn equilibrium_stop_survives_a_resume<E: Engine>(runner: &Runner<E>, test: &str) -> u64 {
-    let dir = temp_dir(test);
+    let dir = scratch::dir(test);
     let (whole, parts) = (dir.join("whole"), dir.join("parts"));
     let done = runner.run(&whole, &quiet(), &mut |_| {}).unwrap();
     assert_eq!(done.status, Status::Ended(RunEnd::Equilibrium));
@@ -218,7 +212,7 @@ fn md_equilibrium_stop() {
 /// run folder holds the state of step `k` (`final.json`), whose row ends
 /// `series.csv`, and `summary.json` says it diverged.
 fn divergence_keeps_the_last_good_state<E: Engine>(runner: &Runner<E>, body: &str, test: &str) {
-    let dir = temp_dir(test);
+    let dir = scratch::dir(test);
     let err = runner.run(&dir, &quiet(), &mut |_| {}).unwrap_err();
     let Error::Diverged { step, name, .. } = &err else { panic!("{err}") };
     assert_eq!(name, body, "{err}");
@@ -262,7 +256,7 @@ fn md_divergence_keeps_the_last_good_state() {
          [[body]]\nname = \"right\"\nmaterial = \"soft\"\nsphere = 0.005\nposition = [0.035, 0.0, 0.1]\nvelocity = [-20.0, 0.0, 0.0]\n";
     let scene = MdScene::from_toml_str(text).unwrap();
     let runner = Runner::from_system(scene.build().unwrap(), RunPlan::new(1000, 7)).unwrap();
-    let dir = temp_dir("md_diverge_probe");
+    let dir = scratch::dir("md_diverge_probe");
     let err = runner.run(&dir, &quiet(), &mut |_| {}).unwrap_err();
     let _ = std::fs::remove_dir_all(&dir);
     let Error::Diverged { name, .. } = &err else { panic!("{err}") };
@@ -273,7 +267,7 @@ fn md_divergence_keeps_the_last_good_state() {
 #[test]
 fn outputs_read_back_through_the_row_types() {
     use ballast::run::positions;
-    let dir = temp_dir("read_back");
+    let dir = scratch::dir("read_back");
     let scene = Scene::from_toml_str(NSCD).unwrap();
     let nscd = dir.join("nscd");
     Runner::from_system(scene.build().unwrap(), scene.plan().unwrap())
@@ -328,7 +322,7 @@ fn outputs_read_back_through_the_row_types() {
 fn a_run_length_replaces_the_scene_duration() {
     use ballast::open::run_file;
     use ballast::run::RunLength;
-    let dir = temp_dir("length");
+    let dir = scratch::dir("length");
     let md = dir.join("md.toml");
     std::fs::write(&md, md_scene(0.01, false)).unwrap();
     let nscd = dir.join("nscd.toml");

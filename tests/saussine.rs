@@ -5,20 +5,14 @@
 //! measured by `ballast saussine sample` (data/saussine2006/README.md); the
 //! reduced one keeps the tests within seconds.
 
+mod scratch;
+
 use ballast::run::{RunOptions, Runner, Status};
 use ballast::scenarios::saussine::{loaded_scene, measure_sample, sample_scene, LoadingSpec, SampleSpec};
 use ballast::scene::Scene;
-use std::path::PathBuf;
 use std::sync::OnceLock;
 
 const GRAINS: usize = 121;
-
-/// A fresh output folder for this test process.
-fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-saussine-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
 
 /// Deposits the reduced sample of `seed` with the library's run loop, which stops
 /// once the kinetic energy has stayed below the scene's equilibrium threshold for
@@ -27,7 +21,7 @@ fn deposit(seed: u64) -> (Scene, f64) {
     let spec = SampleSpec::saussine(seed).scaled(GRAINS);
     let scene = sample_scene(&spec).unwrap();
     let sys = scene.build().unwrap();
-    let dir = out_dir(&format!("deposit{seed}"));
+    let dir = scratch::path(&format!("deposit{seed}"));
     let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
     let run = Runner::from_system(sys.clone(), scene.plan().unwrap()).unwrap().run(&dir, &opts, &mut |_| {}).unwrap();
     assert_eq!(
@@ -69,7 +63,7 @@ fn settle(scene: &Scene, cycles: u64, stiffness_factor: f64) -> Vec<(f64, f64)> 
         ..LoadingSpec::saussine(cycles).scaled(sample().1)
     };
     let loaded = loaded_scene(scene, &spec).unwrap();
-    let dir = out_dir(&format!("settle{cycles}_{stiffness_factor}"));
+    let dir = scratch::path(&format!("settle{cycles}_{stiffness_factor}"));
     let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
     let runner = Runner::from_system(loaded.build().unwrap(), loaded.plan().unwrap()).unwrap();
     runner.run(&dir, &opts, &mut |_| {}).unwrap();

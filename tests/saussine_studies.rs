@@ -3,18 +3,13 @@
 //! dt = 1 ms): what each study must show, and that its summary agrees with the
 //! runs it summarises.
 
-use std::path::{Path, PathBuf};
+mod scratch;
+
+use std::path::Path;
 use std::process::Command;
 
 fn ballast() -> Command {
     Command::new(env!("CARGO_BIN_EXE_ballast"))
-}
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-studies-{}-{tag}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 fn run(args: &[&str]) -> String {
@@ -57,7 +52,7 @@ fn sample(dir: &Path) -> String {
 /// nothing finished. Then §3.3: a longer step leaves more interpenetration at 0° and 5°.
 #[test]
 fn convergence_and_step_studies() {
-    let dir = temp_dir("conv");
+    let dir = scratch::dir("conv");
     let sample = sample(&dir);
     let conv = dir.join("conv");
     let conv_s = conv.to_str().unwrap();
@@ -194,7 +189,7 @@ fn convergence_and_step_studies() {
 /// ensemble's mean and spread are those of the runs' own cycles.
 #[test]
 fn ensemble_mean_and_spread_are_those_of_its_runs() {
-    let dir = temp_dir("ensemble");
+    let dir = scratch::dir("ensemble");
     let out = dir.join("ens");
     run(&[
         "saussine",
@@ -250,7 +245,7 @@ fn ensemble_mean_and_spread_are_those_of_its_runs() {
 /// Bad study arguments are refused with a one-line error before any run.
 #[test]
 fn study_arguments_are_checked() {
-    let dir = temp_dir("bad");
+    let dir = scratch::dir("bad");
     let out = dir.join("x");
     for (args, needle) in [
         (vec!["saussine", "convergence", "--sample", "nowhere.toml", "--policies", "quad"], "POLICY:TOLERANCE"),

@@ -4,6 +4,8 @@
 //! with 1.8× fewer computed cycles, within the spread of full runs whose start
 //! differs by 1e-9 m; its outputs, its checkpoint and its resume.
 
+mod scratch;
+
 use ballast::run::positions::CyclePositions;
 use ballast::run::{RunOptions, Runner, Status};
 use ballast::scenarios::saussine::{loaded_scene, sample_scene, LoadingSpec, SampleSpec};
@@ -11,17 +13,10 @@ use ballast::scene::Scene;
 use ballast::settlement::estimate::configuration_error;
 use ballast::settlement::{Accelerated, Acceleration, Law, SettlementRow};
 use ballast::studies::replicas::{perturb_scene, Perturbation};
-use std::path::PathBuf;
 use std::sync::OnceLock;
 
 const GRAINS: usize = 121;
 const CYCLES: u64 = 90;
-
-fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-driver-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
 
 /// The deposited reduced sample of seed 1, loaded for `CYCLES` cycles (dt 1e-3 s,
 /// 50 steps per cycle; quad_max 1e-4), as in tests/saussine.rs.
@@ -31,7 +26,7 @@ fn loaded() -> &'static Scene {
         let spec = SampleSpec::saussine(1).scaled(GRAINS);
         let scene = sample_scene(&spec).unwrap();
         let sys = scene.build().unwrap();
-        let dir = out_dir("deposit");
+        let dir = scratch::path("deposit");
         let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
         let run = Runner::from_system(sys, scene.plan().unwrap()).unwrap();
         let out = run.run(&dir, &opts, &mut |_| {}).unwrap();
@@ -64,7 +59,7 @@ fn accelerate(
     let cycles = plan.cycles.unwrap();
     let spec = Acceleration { settlement_body: cycles.body, positions: true, ..spec.clone() };
     let run = Accelerated::from_system(scene.build().unwrap(), spec, cycles.frequency, CYCLES).unwrap();
-    let dir = out_dir(name);
+    let dir = scratch::path(name);
     let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
     let out = run.run(&dir, &opts, &mut |_| {}).unwrap();
     let rows: Vec<SettlementRow> = ballast::io::read_csv(&dir.join("settlement.csv")).unwrap();

@@ -7,11 +7,12 @@
 //! The load is a tenth of the paper's amplitude (at the full one the soft
 //! contacts are pressed by 5 % of a radius and the sample flows).
 
+mod scratch;
+
 use ballast::engine::Engine;
 use ballast::run::{RunOptions, Runner};
 use ballast::scenarios::karrech::{deposit_scene, loading_scene, KarrechSpec, Loading};
 use ballast::settlement::{Accelerated, Acceleration, SettlementRow};
-use std::path::PathBuf;
 
 const CYCLES: u64 = 90;
 
@@ -20,12 +21,6 @@ const CYCLES: u64 = 90;
 /// contacts by 5 % of a radius and the sample flows.
 const LOAD: Loading = Loading { amplitude: 1.415e3, ..Loading::FULL };
 
-fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-driver-md-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
-
 fn spec() -> KarrechSpec {
     KarrechSpec { young: 1e7, dt: 2e-6, duration: 0.6, container_radius: 0.02, ..KarrechSpec::table1(40, 1) }
 }
@@ -33,7 +28,7 @@ fn spec() -> KarrechSpec {
 /// The spheres of `spec` deposited, `(radius, centre)`.
 fn deposit(spec: &KarrechSpec, name: &str) -> Vec<(f64, ballast::md::V3)> {
     let scene = deposit_scene(spec, 1000).unwrap();
-    let dir = out_dir(name);
+    let dir = scratch::path(name);
     let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
     let run = Runner::from_system(scene.build().unwrap(), scene.plan().unwrap()).unwrap();
     run.run(&dir, &opts, &mut |_| {}).unwrap();
@@ -64,7 +59,7 @@ fn accelerate(
     name: &str,
 ) -> (Vec<SettlementRow>, ballast::settlement::AccelerationSummary) {
     let run = Accelerated::from_system(sys, spec.clone(), Loading::FULL.frequency, CYCLES).unwrap();
-    let dir = out_dir(name);
+    let dir = scratch::path(name);
     let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
     let out = run.run(&dir, &opts, &mut |_| {}).unwrap();
     let rows: Vec<SettlementRow> = ballast::io::read_csv(&dir.join("settlement.csv")).unwrap();
@@ -185,7 +180,7 @@ fn md_landing_relaxed_to_the_computed_overlap_starts_no_reseating() {
         .into_par_iter()
         .map(|(name, sys, spec)| {
             let run = Accelerated::from_system(sys, spec, Loading::FULL.frequency, N).unwrap();
-            let dir = out_dir(name);
+            let dir = scratch::path(name);
             let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
             run.run(&dir, &opts, &mut |_| {}).unwrap();
             let rows: Vec<SettlementRow> = ballast::io::read_csv(&dir.join("settlement.csv")).unwrap();

@@ -5,18 +5,14 @@
 //! for bit; a landing rolled back after its window (`rollback_rate`) from a
 //! checkpoint taken on probation resumes to the uninterrupted run's numbers.
 
+mod scratch;
+
 use ballast::open::settle_file;
 use ballast::run::RunOptions;
 use ballast::settlement::{AccelerationSummary, JumpRow, SettlementRow};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 const SCENE: &str = "examples/settlement_sleeper.toml";
-
-fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-rollback-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
 
 fn tables(dir: &Path) -> (Vec<SettlementRow>, Vec<JumpRow>) {
     let mut rows: Vec<SettlementRow> = ballast::io::read_csv(&dir.join("settlement.csv")).unwrap();
@@ -62,11 +58,11 @@ fn opts() -> RunOptions {
 #[test]
 fn jumps_whose_relaxation_fails_are_rolled_back_to_computed_cycles() {
     // A window longer than the run: never a jump, every cycle computed.
-    let full_dir = out_dir("full");
+    let full_dir = scratch::path("full");
     let full = run(&full_dir, &scene_with(&[("computed_cycles", "31")]), &opts());
     assert_eq!((full.computed_cycles, full.jumps, full.rollbacks), (30, 0, 0));
     // A relaxation that cannot reach 1e-14 m in one iteration: every landing fails.
-    let failing_dir = out_dir("failing");
+    let failing_dir = scratch::path("failing");
     let text = scene_with(&[("relax_tolerance", "1e-14"), ("relax_max_iterations", "1")]);
     let s = run(&failing_dir, &text, &opts());
     assert_eq!(s.end, "finished");
@@ -96,7 +92,7 @@ fn jumps_whose_relaxation_fails_are_rolled_back_to_computed_cycles() {
 fn a_landing_rolled_back_after_its_window_resumes_to_the_same_numbers() {
     // Every window after a landing that moves at all is "off" its predicted rate.
     let text = scene_with(&[("rollback_rate", "1e-9")]);
-    let whole_dir = out_dir("whole");
+    let whole_dir = scratch::path("whole");
     let s = run(&whole_dir, &text, &opts());
     assert_eq!(s.end, "finished");
     let (rows, jumps) = tables(&whole_dir.join("out"));
@@ -113,7 +109,7 @@ fn a_landing_rolled_back_after_its_window_resumes_to_the_same_numbers() {
     // Stopped on probation (1800 steps: cycle 12, two cycles after the first
     // landing), the checkpoint holds the state before the jump; resumed, the run
     // rolls the landing back as the uninterrupted one did.
-    let cut_dir = out_dir("cut");
+    let cut_dir = scratch::path("cut");
     let stop = RunOptions { stop_after: Some(1800), ..opts() };
     let s1 = run(&cut_dir, &text, &stop);
     assert_eq!(s1.end, "stopped");

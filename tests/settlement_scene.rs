@@ -2,18 +2,14 @@
 //! runs the procedure; a stopped run resumes to the same numbers; bad tables are
 //! one-line errors naming the key.
 
+mod scratch;
+
 use ballast::open::settle_file;
 use ballast::run::RunOptions;
 use ballast::settlement::{AccelerationSummary, JumpRow, SettlementRow};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 const SCENE: &str = "examples/settlement_sleeper.toml";
-
-fn out_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-settlement-scene-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
 
 fn tables(dir: &Path) -> (Vec<SettlementRow>, Vec<JumpRow>) {
     let mut rows: Vec<SettlementRow> = ballast::io::read_csv(&dir.join("settlement.csv")).unwrap();
@@ -28,7 +24,7 @@ fn tables(dir: &Path) -> (Vec<SettlementRow>, Vec<JumpRow>) {
 /// folder named after `name`: its summary and tables, the folder removed.
 fn run_text(name: &str, text: &str) -> (AccelerationSummary, (Vec<SettlementRow>, Vec<JumpRow>)) {
     let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
-    let dir = out_dir(name);
+    let dir = scratch::path(name);
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("scene.toml");
     std::fs::write(&scene, text).unwrap();
@@ -41,7 +37,7 @@ fn run_text(name: &str, text: &str) -> (AccelerationSummary, (Vec<SettlementRow>
 #[test]
 fn the_example_runs_through_the_procedure_and_resumes_to_the_same_numbers() {
     let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
-    let whole = out_dir("whole");
+    let whole = scratch::path("whole");
     let s = settle_file(SCENE.as_ref(), &whole, &opts, &mut |_| {}).unwrap().expect("the example has [settlement]");
     // 30 cycles: 2 initial, then 4 computed + 4 extrapolated, three times, and 4 computed.
     assert_eq!((s.total_cycles, s.computed_cycles, s.jumps), (30, 18, 3));
@@ -55,7 +51,7 @@ fn the_example_runs_through_the_procedure_and_resumes_to_the_same_numbers() {
     }
     assert!(!whole.join("checkpoint.json").exists());
     // Stopped after 1000 steps (cycle 14, inside the second window), resumed.
-    let cut = out_dir("cut");
+    let cut = scratch::path("cut");
     let stop = RunOptions { stop_after: Some(1000), ..opts.clone() };
     let s1 = settle_file(SCENE.as_ref(), &cut, &stop, &mut |_| {}).unwrap().unwrap();
     assert_eq!(s1.end, "stopped");
@@ -104,7 +100,7 @@ fn the_example_runs_through_the_procedure_and_resumes_to_the_same_numbers() {
     );
     // A scene without [settlement] is not run by it, and its folder has no
     // accelerated run to measure: one line naming the file, exit code 2.
-    let none = out_dir("none");
+    let none = scratch::path("none");
     assert!(settle_file("examples/sleeper_load.toml".as_ref(), &none, &opts, &mut |_| {}).unwrap().is_none());
     std::fs::create_dir_all(&none).unwrap();
     let out = figures(&none);
@@ -347,7 +343,7 @@ fn a_body_that_leaves_the_domain_stops_the_run_naming_it() {
     let text = std::fs::read_to_string(SCENE).unwrap().replace("duration = 1.5 ", "duration = 0.5 ")
         + "\n[[body]]\nname = \"stray\"\nmaterial = \"grain\"\nregular = { sides = 5, radius = 0.03 }\n\
            position = [0.0, 0.5]\nvelocity = [30.0, 0.0]\n";
-    let dir = out_dir("stray");
+    let dir = scratch::path("stray");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("stray.toml");
     std::fs::write(&scene, text).unwrap();
@@ -393,7 +389,7 @@ fn hold_anchored_keeps_the_sprung_bodies_where_the_computed_cycle_left_them() {
     let with = |hold: &str| text.replace("law = \"shenton\"", &format!("law = \"shenton\"\nhold_anchored = {hold}"));
     let positions = |name: &str, t: &str| {
         let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
-        let dir = out_dir(name);
+        let dir = scratch::path(name);
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("scene.toml"), t).unwrap();
         settle_file(&dir.join("scene.toml"), &dir.join("out"), &opts, &mut |_| {}).unwrap().unwrap();

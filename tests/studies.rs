@@ -2,6 +2,8 @@
 //! binary), at small sizes: what each writes, what it returns, what its
 //! [`RunDisplay`] is told, and which errors are input errors.
 
+mod scratch;
+
 use ballast::io::table::write_all;
 use ballast::run::{Progress, RunOptions, RunOutcome};
 use ballast::scenarios::karrech::Loading as Plate;
@@ -16,13 +18,6 @@ use ballast::studies::{karrech, Quiet, RunDisplay};
 use ballast::Error;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ballast-studies-lib-{}-{tag}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn figures_exist(dir: &Path, stems: &[impl AsRef<str>]) {
     for stem in stems {
@@ -68,7 +63,7 @@ impl RunDisplay for Record {
 /// runs the display was told of, and a resume that reruns nothing.
 #[test]
 fn saussine_sample_load_and_convergence_study() {
-    let dir = temp_dir("saussine");
+    let dir = scratch::dir("saussine");
     let spec = SampleSpec { dt: 5e-4, ..SampleSpec::saussine(1) }.scaled(60);
     let sample = saussine::sample(&spec, &dir.join("sample"), false, 1, &Quiet).unwrap();
     assert_eq!(sample.path, dir.join("sample/sample.toml"));
@@ -144,7 +139,7 @@ fn saussine_sample_load_and_convergence_study() {
 /// mean of the two runs. A loading without cycles is refused before any deposit.
 #[test]
 fn saussine_ensemble_of_two_samples() {
-    let dir = temp_dir("ensemble");
+    let dir = scratch::dir("ensemble");
     let loading = Loading { cycles: 1, dt: 1e-3, bars: 0, ..Loading::default() };
     let spec = EnsembleSpec {
         samples: 2,
@@ -187,7 +182,7 @@ fn saussine_ensemble_of_two_samples() {
 /// the stages' scenes, `spec.json`, tables and figures.
 #[test]
 fn karrech_deposit_then_one_cycle() {
-    let dir = temp_dir("karrech");
+    let dir = scratch::dir("karrech");
     let stage = |name: &str| Stage {
         out: dir.join(name),
         every: 1000,
@@ -225,7 +220,7 @@ fn karrech_deposit_then_one_cycle() {
 /// tabulates ε_N per run and cycle, and refuses a folder that is not a cycled run.
 #[test]
 fn luding_compression_and_compare_of_two_runs() {
-    let dir = temp_dir("luding");
+    let dir = scratch::dir("luding");
     let stage = Stage {
         every: 500,
         run: RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() },
