@@ -159,34 +159,24 @@ struct Tail {
     bad_force: Option<usize>,
 }
 
-/// A copy of the whole dynamic state (spheres, integrator, contact memory,
-/// neighbour list, images, walls), for going back to the last good step when a
-/// step fails. Buffers are reused from one copy to the next.
+/// A copy of the whole dynamic state, for going back to the last good step when a step fails: the spheres,
+/// the walls, the neighbour list with its contact memory, the images, the integrator's derivatives, the
+/// virial, the last statistics and the clock, each field of [`MdSystem`] copied whole (`clone_from` reuses
+/// the buffers of the previous copy), so that a field added to one of these structures is backed up without
+/// a line here. What a step only reads (settings, laws, the origins of the clock and of the energy check)
+/// is not copied.
 #[derive(Debug, Clone, Default)]
 struct Backup {
-    x: Vec<V3>,
-    v: Vec<V3>,
-    w: Vec<V3>,
-    f: Vec<V3>,
-    t: Vec<V3>,
-    q: Vec<UnitQuaternion<f64>>,
-    /// Gear derivatives (empty with Verlet).
+    /// Whether a copy has been taken.
+    taken: bool,
+    particles: Particles,
+    walls: Vec<Wall>,
+    wall_hist: Vec<History>,
+    neighbours: Neighbours,
+    ghosts: Ghosts,
     gear_x: Vec<[V3; 6]>,
     gear_w: Vec<[V3; 6]>,
-    /// Per wall: s, ṡ, s at the last build, force, contacts.
-    walls: Vec<(f64, f64, f64, V3, usize)>,
-    candidates: Vec<Vec<u32>>,
-    wall_hist: Vec<History>,
-    start: Vec<u32>,
-    j: Vec<u32>,
-    key: Vec<u64>,
-    hist: Vec<History>,
-    x_build: Vec<V3>,
-    builds: u64,
     force_x: Vec<V3>,
-    ghost_origin: Vec<u32>,
-    ghost_mask: Vec<u32>,
-    ghost_key: Vec<u64>,
     virial: Matrix3<f64>,
     last: MdStepStats,
     time: f64,
@@ -822,32 +812,16 @@ impl MdSystem {
     }
 
     fn save_backup(&mut self) {
-        let (p, nb, g, b) = (&self.particles, &self.neighbours, &self.ghosts, &mut self.backup);
-        b.x.clone_from(&p.x);
-        b.v.clone_from(&p.v);
-        b.w.clone_from(&p.w);
-        b.f.clone_from(&p.f);
-        b.t.clone_from(&p.t);
-        b.q.clone_from(&p.q);
+        let b = &mut self.backup;
+        b.taken = true;
+        b.particles.clone_from(&self.particles);
+        b.walls.clone_from(&self.walls);
+        b.wall_hist.clone_from(&self.wall_hist);
+        b.neighbours.clone_from(&self.neighbours);
+        b.ghosts.clone_from(&self.ghosts);
         b.gear_x.clone_from(&self.gear_x);
         b.gear_w.clone_from(&self.gear_w);
-        b.walls.clear();
-        b.walls.extend(self.walls.iter().map(|w| (w.s, w.s_dot, w.s_build, w.force, w.contacts)));
-        b.candidates.resize_with(self.walls.len(), Vec::new);
-        for (c, w) in b.candidates.iter_mut().zip(&self.walls) {
-            c.clone_from(&w.candidates);
-        }
-        b.wall_hist.clone_from(&self.wall_hist);
-        b.start.clone_from(&nb.start);
-        b.j.clone_from(&nb.j);
-        b.key.clone_from(&nb.key);
-        b.hist.clone_from(&nb.hist);
-        b.x_build.clone_from(&nb.x_build);
-        b.builds = nb.builds;
         b.force_x.clone_from(&self.force_x);
-        b.ghost_origin.clone_from(&g.origin);
-        b.ghost_mask.clone_from(&g.mask);
-        b.ghost_key.clone_from(&g.key);
         b.virial = self.virial;
         b.last = self.last;
         b.time = self.time;
@@ -857,36 +831,18 @@ impl MdSystem {
 
     fn restore_backup(&mut self) {
         let b = &self.backup;
-        if b.x.len() != self.particles.len() {
+        if !b.taken || b.particles.len() != self.particles.len() {
             return;
         }
-        let p = &mut self.particles;
-        p.x.clone_from(&b.x);
-        p.v.clone_from(&b.v);
-        p.w.clone_from(&b.w);
-        p.f.clone_from(&b.f);
-        p.t.clone_from(&b.t);
-        p.q.clone_from(&b.q);
+        self.particles.clone_from(&b.particles);
+        self.walls.clone_from(&b.walls);
+        self.wall_hist.clone_from(&b.wall_hist);
+        self.neighbours.clone_from(&b.neighbours);
+        self.ghosts.clone_from(&b.ghosts);
+        self.ghosts.update(&self.particles);
         self.gear_x.clone_from(&b.gear_x);
         self.gear_w.clone_from(&b.gear_w);
-        for ((w, &(s, s_dot, s_build, force, contacts)), c) in self.walls.iter_mut().zip(&b.walls).zip(&b.candidates) {
-            (w.s, w.s_dot, w.s_build, w.force, w.contacts) = (s, s_dot, s_build, force, contacts);
-            w.candidates.clone_from(c);
-        }
-        self.wall_hist.clone_from(&b.wall_hist);
-        let nb = &mut self.neighbours;
-        nb.start.clone_from(&b.start);
-        nb.j.clone_from(&b.j);
-        nb.key.clone_from(&b.key);
-        nb.hist.clone_from(&b.hist);
-        nb.x_build.clone_from(&b.x_build);
-        nb.builds = b.builds;
         self.force_x.clone_from(&b.force_x);
-        let g = &mut self.ghosts;
-        g.origin.clone_from(&b.ghost_origin);
-        g.mask.clone_from(&b.ghost_mask);
-        g.key.clone_from(&b.ghost_key);
-        g.update(&self.particles);
         self.virial = b.virial;
         self.last = b.last;
         self.time = b.time;
