@@ -32,9 +32,14 @@ done
 run run "examples/block_on_floor.toml" --engine md --out "$out/run-block-md" --steps 300 --vtk-every 100 --figures
 run run "examples/sleeper_load.toml" --out "$out/resume" --steps 300 --stop-after 150 --checkpoint-every 0
 run run "examples/sleeper_load.toml" --out "$out/resume" --steps 300 --resume --checkpoint-every 0
-# A checkpoint left as it is: copied next to a later state of the code and resumed there, it must end as ./resume
-# does (cp -r OLD/stopped X && ballast run examples/sleeper_load.toml --out X --steps 300 --resume).
+# Checkpoints left as they are, one per engine: copied next to a later state of the code and resumed there, each
+# must end as an uninterrupted run does (cp -r OLD/stopped X && ballast run examples/sleeper_load.toml --out X
+# --steps 300 --resume ends as ./resume; likewise md_two_spheres.toml for 3000 steps, block_on_floor.toml with
+# --engine md for 300).
 run run "examples/sleeper_load.toml" --out "$out/stopped" --steps 300 --stop-after 150 --checkpoint-every 0
+run run "examples/md_two_spheres.toml" --out "$out/stopped-md" --steps 3000 --stop-after 1500 --checkpoint-every 0
+run run "examples/block_on_floor.toml" --engine md --out "$out/stopped-md2d" --steps 300 --stop-after 100 \
+    --checkpoint-every 0
 run saussine sample --grains 60 --dt 1e-4 --seed 3 --out "$out/sample"
 run saussine settle --sample "$out/sample/sample.toml" --cycles 2 --dt 1e-3 --bars 0 --out "$out/settle"
 run saussine settle --sample "$out/sample/sample.toml" --cycles 12 --dt 1e-3 --bars 0 --accelerate 2,4,4 \

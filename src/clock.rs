@@ -9,6 +9,57 @@
 //! ends at `t = c / f`; the step that ends within half a step of it, or past it,
 //! closes it ([`cycles_at`]).
 
+use serde::{Deserialize, Serialize};
+
+/// The origin `(t_0, k_0)` of an engine's exact clock: the time and step at which its time step last changed.
+/// Every engine holds one, flattened into its serde form (the keys `time_origin` and `step_origin`, 0 when
+/// absent, as in states written before they existed).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Origin {
+    /// Time (s) at which the time step last changed.
+    #[serde(default)]
+    pub time_origin: f64,
+    /// Step count at which the time step last changed.
+    #[serde(default)]
+    pub step_origin: u64,
+}
+
+impl Origin {
+    /// Time (s) after `step` steps of `dt` (s) from this origin ([`time_at`]).
+    #[inline]
+    pub fn time_at(&self, step: u64, dt: f64) -> f64 {
+        time_at(self.time_origin, self.step_origin, step, dt)
+    }
+
+    /// Moves the origin to `(time, step)`: what changing the time step at that step does, so that the clock
+    /// stays exact.
+    pub fn rebase(&mut self, time: f64, step: u64) {
+        (self.time_origin, self.step_origin) = (time, step);
+    }
+
+    /// Checks that a state read back is on this clock: `step` not before the origin and, if the state keeps
+    /// its time, `time` the clock's time at `step` with `dt`, bit for bit. The message starts with `clock:`.
+    ///
+    /// # Errors
+    /// The message saying what does not follow.
+    pub fn check(&self, step: u64, time: Option<f64>, dt: f64) -> Result<(), String> {
+        match time {
+            None if step < self.step_origin => {
+                Err(format!("clock: step {step} before its origin {}", self.step_origin))
+            }
+            Some(t) if step < self.step_origin || self.time_at(step, dt).to_bits() != t.to_bits() => {
+                Err(format!("clock: time {t} s at step {step} does not follow from its origin"))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Whether `other` is the same origin, bit for bit (a state and the scene it claims to come from).
+    pub fn same(&self, other: &Origin) -> bool {
+        self.time_origin.to_bits() == other.time_origin.to_bits() && self.step_origin == other.step_origin
+    }
+}
+
 /// Time (s) after `step` steps of `dt` (s) counted from the origin
 /// `(time_origin, step_origin)`: `t_0 + (k − k_0) h`.
 #[inline]

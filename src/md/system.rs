@@ -239,17 +239,14 @@ pub struct MdSystem {
     pub ghosts: Ghosts,
     /// Verlet neighbour list (with its skin) and the pairs' tangential memory.
     pub neighbours: Neighbours,
-    /// Time (s) at the end of the last step: `time_origin + (step − step_origin) dt`
+    /// Time (s) at the end of the last step: `t_0 + (step − k_0) dt` from [`MdSystem::origin`]
     /// ([`crate::clock`]), never accumulated.
     pub time: f64,
     /// Steps made.
     pub step: u64,
-    /// Time (s) and step at which the time step last changed ([`MdSystem::set_dt`]).
-    #[serde(default)]
-    pub time_origin: f64,
-    /// Step count at which the time step last changed.
-    #[serde(default)]
-    pub step_origin: u64,
+    /// The clock's origin: the time and step at which the time step last changed.
+    #[serde(flatten)]
+    pub origin: crate::clock::Origin,
     /// Mechanical energy `E_k + E_g + E_el` (J) when the system was built or its
     /// configuration last written ([`MdSystem::set_configuration`]): with the work
     /// of the servo drives, the budget of the energy-growth check. Read from a
@@ -343,8 +340,7 @@ impl MdSystem {
             ghosts,
             time: 0.0,
             step: 0,
-            time_origin: 0.0,
-            step_origin: 0,
+            origin: crate::clock::Origin::default(),
             energy_start: 0.0,
             drive_work: 0.0,
             gear_x: Vec::new(),
@@ -458,8 +454,7 @@ impl MdSystem {
 
     /// Changes the time step (s) from now on, keeping the clock exact.
     pub fn set_dt(&mut self, dt: f64) {
-        self.time_origin = self.time;
-        self.step_origin = self.step;
+        self.origin.rebase(self.time, self.step);
         self.settings.dt = dt;
     }
 
@@ -542,7 +537,7 @@ impl MdSystem {
             };
             return Err(self.diverged(i, what));
         }
-        let t_next = crate::clock::time_at(self.time_origin, self.step_origin, self.step + 1, dt);
+        let t_next = self.origin.time_at(self.step + 1, dt);
         self.drive_work += walls::advance(&mut self.walls, t_next, dt);
         self.check_energy(kinetic, height)?;
         self.time = t_next;
@@ -741,10 +736,7 @@ impl MdSystem {
         if again.wall_hist != self.wall_hist {
             return bad("wall contact memory: held for spheres that are not candidates".into());
         }
-        let t = crate::clock::time_at(self.time_origin, self.step_origin, self.step, self.settings.dt);
-        if self.step < self.step_origin || t.to_bits() != self.time.to_bits() {
-            return bad(format!("clock: time {} s at step {} does not follow from its origin", self.time, self.step));
-        }
+        self.origin.check(self.step, Some(self.time), self.settings.dt).or_else(bad)?;
         Ok(())
     }
 
@@ -789,7 +781,7 @@ impl MdSystem {
             return bad("the [md] settings, time step or measurement period".into());
         }
         // The run loop never changes the time step: the clock keeps its origin.
-        if self.time_origin.to_bits() != fresh.time_origin.to_bits() || self.step_origin != fresh.step_origin {
+        if !self.origin.same(&fresh.origin) {
             return bad("the clock's origin".into());
         }
         // Set when the system is built: the zero of the gravitational energy. (The

@@ -30,7 +30,7 @@ impl System {
         let h = self.params.dt;
         let theta = self.params.theta;
         let n = self.bodies.len();
-        let t_f = crate::clock::time_at(self.time_origin, self.step_origin, self.step + 1, h);
+        let t_f = self.origin.time_at(self.step + 1, h);
         let t_m = t_f - theta * h;
         let mut ws = std::mem::take(&mut self.ws);
         ws.q_i.clone_from(&self.bodies.q);

@@ -146,17 +146,14 @@ pub struct System {
     /// Number of materials.
     pub materials: usize,
     /// Time (s) and number of steps done. The time is recomputed each step as
-    /// `time_origin + (step − step_origin) · dt`, never accumulated, so it does not
+    /// `t_0 + (step − k_0) · dt` from [`System::origin`], never accumulated, so it does not
     /// drift over millions of steps; [`System::set_dt`] rebases the origin.
     pub time: f64,
     /// Steps done.
     pub step: u64,
-    /// Time (s) at which the time step last changed.
-    #[serde(default)]
-    pub time_origin: f64,
-    /// Step count at which the time step last changed.
-    #[serde(default)]
-    pub step_origin: u64,
+    /// The clock's origin: the time and step at which the time step last changed.
+    #[serde(flatten)]
+    pub origin: crate::clock::Origin,
     /// Contacts of the last step and their impulses `(P_N, P_T)` (N·s), sorted by
     /// key: the warm start of the next step.
     pub contacts: Vec<ContactGeom>,
@@ -188,8 +185,7 @@ impl System {
             materials,
             time: 0.0,
             step: 0,
-            time_origin: 0.0,
-            step_origin: 0,
+            origin: crate::clock::Origin::default(),
             contacts: Vec::new(),
             impulses: Vec::new(),
             gravity_reference: None,
@@ -199,8 +195,7 @@ impl System {
 
     /// Changes the time step (s) from now on, keeping the clock exact.
     pub fn set_dt(&mut self, dt: f64) {
-        self.time_origin = self.time;
-        self.step_origin = self.step;
+        self.origin.rebase(self.time, self.step);
         self.params.dt = dt;
     }
 
@@ -350,10 +345,7 @@ impl System {
             return bad("warm-start contacts: bodies out of range or keys not sorted".into());
         }
         self.params.check()?;
-        let t = crate::clock::time_at(self.time_origin, self.step_origin, self.step, self.params.dt);
-        if self.step < self.step_origin || t.to_bits() != self.time.to_bits() {
-            return bad(format!("clock: time {} s at step {} does not follow from its origin", self.time, self.step));
-        }
+        self.origin.check(self.step, Some(self.time), self.params.dt).or_else(bad)?;
         Ok(())
     }
 
@@ -372,7 +364,7 @@ impl System {
             return bad("the [nscd] parameters or time step".into());
         }
         // The run loop never changes the time step: the clock keeps its origin.
-        if self.time_origin.to_bits() != fresh.time_origin.to_bits() || self.step_origin != fresh.step_origin {
+        if !self.origin.same(&fresh.origin) {
             return bad("the clock's origin".into());
         }
         // The zero of the gravitational energy is set by the first step, from

@@ -95,8 +95,9 @@ pub struct PlanarSystem {
     laws: Vec<Option<SoftLaw>>,
     /// Per pair: the law of a point with the whole stiffness and with half.
     point_laws: Vec<Option<[PairLaw; 2]>>,
-    time_origin: f64,
-    step_origin: u64,
+    /// The clock's origin: the time and step at which the time step last changed.
+    #[serde(flatten)]
+    origin: clock::Origin,
     step: u64,
     /// Height (m, along −g) of the zero of the gravitational energy: the lowest
     /// point of the mobile bodies at the first step.
@@ -134,8 +135,7 @@ impl PlanarSystem {
             materials,
             laws: vec![None; materials * materials],
             point_laws: vec![None; materials * materials],
-            time_origin: 0.0,
-            step_origin: 0,
+            origin: clock::Origin::default(),
             step: 0,
             gravity_reference: None,
             points: Vec::new(),
@@ -173,7 +173,7 @@ impl PlanarSystem {
 
     /// Time (s), from the exact clock.
     pub fn time(&self) -> f64 {
-        clock::time_at(self.time_origin, self.step_origin, self.step, self.params.dt)
+        self.origin.time_at(self.step, self.params.dt)
     }
 
     /// Steps made.
@@ -183,8 +183,7 @@ impl PlanarSystem {
 
     /// Sets the time step `dt` (s) from now on (the clock keeps the time reached).
     pub fn set_dt(&mut self, dt: f64) {
-        self.time_origin = self.time();
-        self.step_origin = self.step;
+        self.origin.rebase(self.time(), self.step);
         self.params.dt = dt;
     }
 
@@ -285,9 +284,7 @@ impl PlanarSystem {
             return bad(format!("forces: {} entries for {n} bodies, or not finite", self.f.len()));
         }
         check_params(&self.params)?;
-        if self.step < self.step_origin {
-            return bad(format!("clock: step {} before its origin {}", self.step, self.step_origin));
-        }
+        self.origin.check(self.step, None, self.params.dt).or_else(bad)?;
         Ok(())
     }
 
@@ -306,7 +303,7 @@ impl PlanarSystem {
         if self.params != fresh.params {
             return bad("the [soft] parameters or time step");
         }
-        if self.time_origin.to_bits() != fresh.time_origin.to_bits() || self.step_origin != fresh.step_origin {
+        if !self.origin.same(&fresh.origin) {
             return bad("the clock's origin");
         }
         let up = crate::plane::bodies::up(fresh.params.gravity);
