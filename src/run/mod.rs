@@ -15,6 +15,7 @@
 
 pub mod checkpoint;
 mod equilibrium;
+pub mod folder;
 pub mod positions;
 mod runner;
 pub mod summary;

@@ -15,15 +15,16 @@
 //! error is returned.
 
 use super::equilibrium::Equilibrium;
+use super::folder::{self, Source};
 use crate::clock::cycles_at;
 use crate::engine::CycleCheck;
 use crate::engine::Engine;
 use crate::error::{Error, Result};
-use crate::io::layout::{self, CHECKPOINT};
+use crate::io::layout;
 use crate::io::table::TableWriter;
 use crate::io::vtk::PvdCollection;
 use crate::io::{self, RunInfo};
-use crate::run::checkpoint::{crc32, Checkpoint};
+use crate::run::checkpoint::Checkpoint;
 use crate::run::positions::PositionsWriter;
 use crate::run::summary::{RunEnd, RunReport, RunSummary};
 use std::path::{Path, PathBuf};
@@ -186,19 +187,14 @@ pub type Restart<E> = Box<dyn Fn(&E) -> Result<String> + Send + Sync>;
 /// loop only calls it when [`RunOptions::figures`] asks.
 pub type Figures<E> = Box<dyn Fn(&Path, Option<&<E as Engine>::CycleState>) -> Result<()> + Send + Sync>;
 
-/// Where the system of a run comes from.
-enum Origin {
-    /// A scene file: its path (for the copy and the header) and text.
-    Scene { path: PathBuf, text: String },
-    /// Built in code: the serde form of the initial system and of the plan.
-    Code { json: String },
-}
-
 /// A run of an engine: its initial system, its plan and where it came from.
 pub struct Runner<E: Engine> {
     system: E,
     plan: RunPlan,
-    origin: Origin,
+    /// The scene's text or the system's serde form ([`Source`]).
+    source: Source,
+    /// The scene file's path, for the header of `final_scene.toml`.
+    scene_path: Option<PathBuf>,
     restart: Option<Restart<E>>,
     /// What the scene resolved to that the system does not say, for `run.json`.
     model: Option<serde_json::Value>,
@@ -226,7 +222,8 @@ impl<E: Engine> Runner<E> {
         Self {
             system,
             plan,
-            origin: Origin::Scene { path: path.to_path_buf(), text },
+            source: Source::Scene { text },
+            scene_path: Some(path.to_path_buf()),
             restart,
             model: None,
             figures: None,
@@ -257,7 +254,15 @@ impl<E: Engine> Runner<E> {
         }
         let json = serde_json::to_string(&Input { plan: &plan, system: &system })
             .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-        Ok(Self { system, plan, origin: Origin::Code { json }, restart: None, model: None, figures: None })
+        Ok(Self {
+            system,
+            plan,
+            source: Source::Code { json },
+            scene_path: None,
+            restart: None,
+            model: None,
+            figures: None,
+        })
     }
 
     /// The plan of the run.
@@ -266,10 +271,7 @@ impl<E: Engine> Runner<E> {
     }
 
     fn source_crc32(&self) -> u32 {
-        match &self.origin {
-            Origin::Scene { text, .. } => crc32(text.as_bytes()),
-            Origin::Code { json } => crc32(json.as_bytes()),
-        }
+        self.source.crc32()
     }
 
     /// Runs into the folder `out` (created if needed; existing output files of an
@@ -421,7 +423,7 @@ impl<E: Engine> Runner<E> {
             return Err(e);
         }
         io::remove_stale(out, layout::CHECKPOINT)?;
-        if let (Some(restart), Origin::Scene { path, .. }) = (&self.restart, &self.origin) {
+        if let (Some(restart), Some(path)) = (&self.restart, &self.scene_path) {
             let text = format!(
                 "# Written by ballast {}: the state of {} at t = {} s (step {}).\n\
                  # Rerun it with `ballast run`; time restarts at 0.\n\n{}",
@@ -439,22 +441,21 @@ impl<E: Engine> Runner<E> {
     /// A fresh run: the output folder prepared, the first rows and snapshot written.
     fn start(&self, out: &Path, opts: &RunOptions) -> Result<Live<E>> {
         let sys = self.system.clone();
-        io::create_output_dir(out)?;
-        // Files left by an earlier run would pass for this run's.
-        for stale in [
-            layout::FINAL_SCENE,
-            layout::CHECKPOINT,
-            layout::CYCLES,
-            layout::FINAL,
-            layout::CONTACTS,
-            layout::SUMMARY,
-            layout::CYCLE_BODIES,
-            layout::CYCLE_DISPLACEMENTS,
-            layout::SCENE,
-            layout::INITIAL_STATE,
-        ] {
-            io::remove_stale(out, stale)?;
-        }
+        folder::prepare(
+            out,
+            &[
+                layout::FINAL_SCENE,
+                layout::CHECKPOINT,
+                layout::CYCLES,
+                layout::FINAL,
+                layout::CONTACTS,
+                layout::SUMMARY,
+                layout::CYCLE_BODIES,
+                layout::CYCLE_DISPLACEMENTS,
+                layout::SCENE,
+                layout::INITIAL_STATE,
+            ],
+        )?;
         self.write_records(out)?;
         let series = TableWriter::create(&out.join(layout::SERIES), &sys.series_header())?;
         let mut snapshots = PvdCollection::new();
@@ -492,14 +493,6 @@ impl<E: Engine> Runner<E> {
     /// Writes the record of the run's input: the copy of the scene (or the
     /// initial state of a system built in code) and `run.json`.
     fn write_records(&self, out: &Path) -> Result<()> {
-        match &self.origin {
-            Origin::Scene { text, .. } => {
-                io::write_text(out, layout::SCENE, text)?;
-            }
-            Origin::Code { json } => {
-                io::write_text(out, layout::INITIAL_STATE, json)?;
-            }
-        }
         let info = RunInfo {
             seed: self.plan.seed,
             engine: E::NAME.to_string(),
@@ -508,25 +501,17 @@ impl<E: Engine> Runner<E> {
             dt: self.system.dt(),
             model: self.model.clone(),
         };
-        info.write(out)?;
-        Ok(())
+        self.source.write_records(out, &info)
     }
 
     /// The run continued from the checkpoint in `out`, checked against the plan,
     /// the initial system and the files. The record of the input is written
     /// again (the checkpoint holds the CRC-32 of the scene text: it is the same).
     fn resume(&self, out: &Path) -> Result<Live<E>> {
-        let path = out.join(layout::CHECKPOINT);
-        if !path.is_file() {
-            return Err(Error::Scene(format!(
-                "--resume: no {CHECKPOINT} in '{}' (nothing to continue: run without --resume)",
-                out.display()
-            )));
-        }
+        let path = folder::checkpoint_to_resume(out)?;
         let cp = Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source_crc32())?;
-        let bad = |msg: String| Error::Scene(format!("{}: not a valid checkpoint: {msg}", path.display()));
-        cp.system.check_state().map_err(|e| bad(e.to_string()))?;
-        cp.system.check_same_model(&self.system).map_err(|e| bad(e.to_string()))?;
+        let bad = |msg: String| folder::invalid_checkpoint(&path, msg);
+        folder::check_resumed(&path, "", &cp.system, &self.system)?;
         let plan = &self.plan;
         let first = self.system.steps_done();
         let end = first.saturating_add(plan.steps);

@@ -51,10 +51,11 @@ use crate::clock::cycles_at;
 use crate::engine::{Boundary, Configuration, Engine};
 use crate::engine::{RelaxReport, RelaxSettings};
 use crate::error::{Error, Result};
-use crate::io::layout::{self, CHECKPOINT, JUMPS, SETTLEMENT};
+use crate::io::layout::{self, JUMPS, SETTLEMENT};
 use crate::io::table::TableWriter;
 use crate::io::{self, RunInfo};
-use crate::run::checkpoint::{check_origin, crc32, read_checked, write_checked};
+use crate::run::checkpoint::{check_origin, read_checked, write_checked};
+use crate::run::folder::{self, Source};
 use crate::run::positions::PositionsWriter;
 use crate::run::{body_names, RunOptions};
 use rollback::Landing;
@@ -378,12 +379,6 @@ fn no_state<E>() -> Option<Box<State<E>>> {
     None
 }
 
-/// Where the system of a run comes from (for its record and `--resume`).
-enum Origin {
-    Scene { text: String },
-    Code { json: String },
-}
-
 /// An accelerated run of an engine: its start state, the procedure's settings,
 /// the loading frequency and the target number of cycles.
 pub struct Accelerated<E: Engine> {
@@ -392,7 +387,8 @@ pub struct Accelerated<E: Engine> {
     frequency: f64,
     target: u64,
     seed: u64,
-    origin: Origin,
+    /// The scene's text or the system's serde form.
+    source: Source,
     /// What the scene resolved to, for `run.json` ([`Accelerated::with_model`]).
     model: Option<serde_json::Value>,
     /// The figures drawn at the end when [`RunOptions::figures`] asks ([`Accelerated::with_figures`]).
@@ -407,7 +403,7 @@ impl<E: Engine> Accelerated<E> {
     /// A run of `system` loaded at `frequency` (Hz) to `target` cycles, from the
     /// scene whose text is `text` (recorded as `scene.toml`, its CRC-32 checked on `--resume`).
     pub fn from_scene(system: E, spec: Acceleration, frequency: f64, target: u64, seed: u64, text: String) -> Self {
-        Self { system, spec, frequency, target, seed, origin: Origin::Scene { text }, model: None, figures: None }
+        Self { system, spec, frequency, target, seed, source: Source::Scene { text }, model: None, figures: None }
     }
 
     /// The same run, with `model` (what the scene resolved to: the planar MD
@@ -430,14 +426,11 @@ impl<E: Engine> Accelerated<E> {
     pub fn from_system(system: E, spec: Acceleration, frequency: f64, target: u64) -> Result<Self> {
         let json = serde_json::to_string(&(&spec, frequency, target, &system))
             .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-        Ok(Self { system, spec, frequency, target, seed: 0, origin: Origin::Code { json }, model: None, figures: None })
+        Ok(Self { system, spec, frequency, target, seed: 0, source: Source::Code { json }, model: None, figures: None })
     }
 
     fn source_crc32(&self) -> u32 {
-        match &self.origin {
-            Origin::Scene { text } => crc32(text.as_bytes()),
-            Origin::Code { json } => crc32(json.as_bytes()),
-        }
+        self.source.crc32()
     }
 
     fn check(&self) -> Result<()> {
@@ -867,24 +860,20 @@ impl<E: Engine> Accelerated<E> {
 
     /// A fresh run: the folder prepared, the records and table headers written.
     fn start(&self, out: &Path) -> Result<(State<E>, Files)> {
-        io::create_output_dir(out)?;
-        for stale in [layout::CHECKPOINT, layout::SUMMARY, layout::FINAL, layout::SCENE, layout::INITIAL_STATE] {
-            io::remove_stale(out, stale)?;
-        }
-        match &self.origin {
-            Origin::Scene { text } => io::write_text(out, layout::SCENE, text)?,
-            Origin::Code { json } => io::write_text(out, layout::INITIAL_STATE, json)?,
-        };
+        folder::prepare(
+            out,
+            &[layout::CHECKPOINT, layout::SUMMARY, layout::FINAL, layout::SCENE, layout::INITIAL_STATE],
+        )?;
         let steps = (self.target as f64 / (self.frequency * self.system.dt())).round() as u64;
-        RunInfo {
+        let info = RunInfo {
             seed: self.seed,
             engine: E::NAME.into(),
             version: env!("CARGO_PKG_VERSION").into(),
             steps,
             dt: self.system.dt(),
             model: self.model.clone(),
-        }
-        .write(out)?;
+        };
+        self.source.write_records(out, &info)?;
         let origin = self.system.configuration();
         let slot = match self.spec.settlement_body {
             Some(b) => Some(origin.bodies.iter().position(|&i| i == b).ok_or_else(|| {
@@ -949,20 +938,13 @@ impl<E: Engine> Accelerated<E> {
 
     /// The run continued from `OUT/checkpoint.json`.
     fn resume(&self, out: &Path) -> Result<(State<E>, Files)> {
-        if !out.join(layout::CHECKPOINT).is_file() {
-            return Err(Error::Scene(format!(
-                "--resume: no {CHECKPOINT} in '{}' (nothing to continue: run without --resume)",
-                out.display()
-            )));
-        }
+        folder::checkpoint_to_resume(out)?;
         let (path, st): (PathBuf, State<E>) = read_checked(out)?;
         check_origin(&path, (&st.engine, &st.version, st.source_crc32), (E::NAME, self.source_crc32()))?;
-        let bad = |msg: String| Error::Scene(format!("{}: not a valid checkpoint: {msg}", path.display()));
-        st.sys.check_state().map_err(|e| bad(e.to_string()))?;
-        st.sys.check_same_model(&self.system).map_err(|e| bad(e.to_string()))?;
+        let bad = |msg: String| folder::invalid_checkpoint(&path, msg);
+        folder::check_resumed(&path, "", &st.sys, &self.system)?;
         if let Some(b) = &st.before_jump {
-            b.sys.check_state().map_err(|e| bad(format!("before_jump: {e}")))?;
-            b.sys.check_same_model(&self.system).map_err(|e| bad(format!("before_jump: {e}")))?;
+            folder::check_resumed(&path, "before_jump: ", &b.sys, &self.system)?;
             if b.before_jump.is_some()
                 || b.cycle > st.cycle
                 || b.jumps > st.jumps
