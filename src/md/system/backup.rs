@@ -28,7 +28,6 @@ pub(super) struct Backup {
     drive_work: f64,
 }
 
-
 impl MdSystem {
     pub(super) fn save_backup(&mut self) {
         let b = &mut self.backup;

@@ -44,7 +44,14 @@ pub(super) fn run_chunks(
 
 /// Forces of the pairs of rows `lo..hi` into `w` (cleared first).
 #[inline(never)]
-pub(super) fn pair_rows(ctx: &PairContext, lo: usize, hi: usize, hist: &mut [History], offset: usize, w: &mut Workspace) {
+pub(super) fn pair_rows(
+    ctx: &PairContext,
+    lo: usize,
+    hi: usize,
+    hist: &mut [History],
+    offset: usize,
+    w: &mut Workspace,
+) {
     let p = ctx.p;
     let n = p.len();
     let dt = ctx.dt;

@@ -520,6 +520,4 @@ impl MdSystem {
             w.s_build = w.s;
         }
     }
-
 }
-

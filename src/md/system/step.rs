@@ -17,9 +17,8 @@
 //! the same whatever the number of threads, so are the sums: a run gives the same
 //! numbers on one thread or two.
 
-
-use super::*;
 use super::kernels::*;
+use super::*;
 
 impl MdSystem {
     /// Makes one time step.
