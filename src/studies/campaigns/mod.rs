@@ -1,0 +1,454 @@
+//! The studies of Saussine et al. (2006) §3.2, §3.3 and §4.2, each one call
+//! (`ballast saussine convergence | steps | ensemble`): many loaded runs of the
+//! same sample, run side by side on a thread pool (one run per core,
+//! [`StudyOptions::jobs`]), each in its own folder with the outputs of
+//! `ballast run` (series, cycles, summary, checkpoints, figures), then read back
+//! through the row types into one summary CSV and the study's figures.
+//!
+//! - [`convergence`] (§3.2): one run per policy × tolerance of the paper's table
+//!   (energy 1.66e-3/-4/-5, strict 1e-3 and 1e-4, non-strict "quad" 1e-5/-6/-7);
+//!   `convergence.csv` (mean NLGS iterations, wall time, interpenetration),
+//!   `cumulated_interpenetration` (Fig. 2), `iterations_vs_tolerance`.
+//!   The first strict tolerance is illegible in the paper's table ("1 ×"): 1e-3 is
+//!   taken, a decade above its other strict value as for the other policies.
+//! - [`steps`] (§3.3): one run per time step (1e-4 … 1e-3 s, ten values) × inclination
+//!   (0°, 5°); `steps.csv`, `max_interpenetration_<a>deg` (Fig. 3),
+//!   `mean_interpenetration_<a>deg` (Fig. 4), `interpenetration_vs_dt`.
+//! - [`ensemble`] (§4.2): samples that differ only by their seed, deposited, then
+//!   loaded on sublayers of stiffness k_N × 1, × 100, × 1000; `ensemble.csv` (mean,
+//!   standard deviation, min and max of the settlement over the samples, per
+//!   stiffness and cycle) and `settlement_ensemble` (mean ± one standard deviation).
+//!
+//! With `R` replicas per setting ([`super::replicas::Replicas`]; convergence
+//! and steps), each setting runs from `R` starts, replica 0 the sample as it is,
+//! the others perturbed; the summary CSV has one row per run (column
+//! `replica`) followed by the ensemble columns of its setting (settlement after
+//! the last cycle, seating, accrued: mean, sd, 95 % interval), and for §3.2 the
+//! difference of its setting's mean from the reference setting's with Welch's
+//! 95 % interval; the figures show the replicas' means with their 95 % bands,
+//! and `settlement_ensemble` the mean settlement per cycle of each setting.
+//!
+//! Layout: `DIR/scenes/<run>.toml` and `DIR/runs/<run>/` (`<run>` is
+//! `<setting>/replica-<r>` with several replicas), each run folder with its
+//! `replica.json`. A run that diverges is
+//! reported in the summary (`status`) and in [`StudyReport::failed`], the others
+//! go on. [`StudyOptions::resume`] skips the finished runs and resumes the
+//! checkpointed ones.
+
+mod convergence;
+mod ensemble;
+mod steps;
+
+pub use convergence::{convergence, ConvergenceSpec};
+pub use ensemble::{ensemble, EnsembleRow, EnsembleSpec, Spread};
+pub use steps::{steps, StepsSpec};
+
+use super::replicas::{
+    perturb_scene, settlement_ensemble, EnsembleColumns, Estimate, Perturbation, ReferenceColumns, Replicas,
+    SettlementSummary, ENSEMBLE_COLUMNS, REFERENCE_COLUMNS, REPLICA_FILE,
+};
+use super::saussine::{sample, Loading};
+use super::{axes, output_error, run_scene, RunDisplay, SummaryTable};
+use crate::error::{Error, Result};
+use crate::io;
+use crate::io::figures::{self, Series};
+use crate::io::layout;
+use crate::io::table::TableWriter;
+use crate::plane::rows::PlaneCycleRow as CycleRow;
+use crate::plane::rows::PlaneSeriesRow as SeriesRow;
+use crate::run::RunReport;
+use crate::run::{cores, default_threads, Prior, RunOptions};
+use crate::scenarios::saussine::{loaded_scene, LoadingSpec, SampleSpec};
+use crate::scene::Scene;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Settings shared by the studies.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudyOptions {
+    /// Output directory of the study.
+    pub out: PathBuf,
+    /// Runs at once, each on one core (`None`: the number of cores).
+    pub jobs: Option<usize>,
+    /// Skip the finished runs and resume the checkpointed ones of an interrupted study.
+    pub resume: bool,
+    /// Wall-clock seconds between checkpoints of each run.
+    pub checkpoint_every_s: f64,
+}
+
+impl StudyOptions {
+    /// A fresh study in `out`: one run per core, checkpoints every 5 minutes.
+    pub fn new(out: impl Into<PathBuf>) -> Self {
+        Self { out: out.into(), jobs: None, resume: false, checkpoint_every_s: 300.0 }
+    }
+
+    /// The runs at once (the pool's threads).
+    fn threads(&self) -> Result<usize> {
+        if !(self.checkpoint_every_s.is_finite() && self.checkpoint_every_s >= 0.0) {
+            return Err(Error::Scene(format!(
+                "--checkpoint-every: must be non-negative, got {}",
+                self.checkpoint_every_s
+            )));
+        }
+        match self.jobs.unwrap_or_else(cores) {
+            0 => Err(Error::Scene("--jobs: must be at least 1".into())),
+            n => Ok(n),
+        }
+    }
+}
+
+/// What a study wrote: its summary table (read back), where its runs are, and
+/// the runs that failed (reported in the table's `status`; the others went on).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudyReport {
+    /// The summary CSV: `convergence.csv`, `steps.csv` or `runs.csv`.
+    pub table: SummaryTable,
+    /// The folder of the runs, `DIR/runs`.
+    pub runs: PathBuf,
+    /// `(label, error)` of each run that failed in this invocation.
+    pub failed: Vec<(String, String)>,
+}
+
+/// The convergence policies and tolerances of the table of §3.2.
+pub const PAPER_POLICIES: [(&str, f64); 8] = [
+    ("energy", 1.66e-3),
+    ("energy", 1.66e-4),
+    ("energy", 1.66e-5),
+    ("strict", 1e-3),
+    ("strict", 1e-4),
+    ("quad", 1e-5),
+    ("quad", 1e-6),
+    ("quad", 1e-7),
+];
+
+/// Where the scene of a study's run comes from.
+#[derive(Clone)]
+pub(super) enum Source {
+    /// The deposited sample at `sample`, loaded by [`loaded_scene`] with `spec`.
+    Loaded {
+        /// The loading.
+        spec: Box<LoadingSpec>,
+        /// The sample's scene file.
+        sample: PathBuf,
+    },
+    /// A scene made by the study (the unperturbed start of its setting).
+    Ready(Box<Scene>),
+}
+
+/// One run of a study: its label, its scene and which replica of its setting it is.
+pub(super) struct Job {
+    pub(super) label: String,
+    pub(super) source: Source,
+    pub(super) replica: u64,
+    pub(super) perturbation: Perturbation,
+}
+
+impl Job {
+    /// Replica 0 of the sample at `sample` loaded with `spec`.
+    fn loaded(label: String, spec: LoadingSpec, sample: &Path, perturbation: Perturbation) -> Self {
+        Self {
+            label,
+            source: Source::Loaded { spec: Box::new(spec), sample: sample.to_path_buf() },
+            replica: 0,
+            perturbation,
+        }
+    }
+}
+
+/// The runs of `settings` (replica 0 each): unchanged for one replica, else
+/// `replicas.count` runs per setting labelled `<setting>/replica-<r>`, setting
+/// after setting.
+pub(super) fn replicate(settings: Vec<Job>, replicas: &Replicas) -> Vec<Job> {
+    if replicas.count == 1 {
+        return settings;
+    }
+    settings
+        .into_iter()
+        .flat_map(|job| {
+            (0..replicas.count).map(move |r| Job {
+                label: format!("{}/replica-{r}", job.label),
+                source: job.source.clone(),
+                replica: r,
+                perturbation: replicas.perturbation,
+            })
+        })
+        .collect()
+}
+
+impl Job {
+    pub(super) fn scene(&self, study: &Path) -> PathBuf {
+        study.join("scenes").join(format!("{}.toml", self.label))
+    }
+    pub(super) fn dir(&self, study: &Path) -> PathBuf {
+        study.join("runs").join(&self.label)
+    }
+}
+
+/// What a finished (or diverged) run left: its report, series and cycles.
+pub(super) struct Outcome {
+    pub(super) status: String,
+    pub(super) report: Option<RunReport>,
+    pub(super) series: Vec<SeriesRow>,
+    pub(super) cycles: Vec<CycleRow>,
+}
+
+/// The cycles of the runs `outcomes`.
+pub(super) fn cycles_of<'a>(outcomes: &[&'a Outcome]) -> Vec<&'a [CycleRow]> {
+    outcomes.iter().map(|o| o.cycles.as_slice()).collect()
+}
+
+/// The ensemble columns of the replicas `outcomes` of one setting.
+fn ensemble_columns(outcomes: &[&Outcome], seating: u64) -> EnsembleColumns {
+    SettlementSummary::of(&cycles_of(outcomes), seating)
+        .map_or(EnsembleColumns { replicas: outcomes.len(), ..EnsembleColumns::default() }, |s| s.columns())
+}
+
+/// Mean over the runs `outcomes` of `f` of their series rows (row by row, up to
+/// the shortest run), against time, and its 95 % band (none for one run).
+fn mean_curve(outcomes: &[&Outcome], label: String, f: fn(&SeriesRow) -> f64, scale: f64) -> Series {
+    let n = outcomes.iter().map(|o| o.series.len()).min().unwrap_or(0);
+    let mut series = Series { label, ..Series::default() };
+    for k in 0..n {
+        let values: Vec<f64> = outcomes.iter().map(|o| scale * f(&o.series[k])).collect();
+        let Some(e) = Estimate::of(&values) else { continue };
+        let t = outcomes[0].series[k].time_s;
+        series.points.push((t, e.mean));
+        if let Some((lo, hi)) = e.ci95 {
+            series.band.push((t, lo, hi));
+        }
+    }
+    series
+}
+
+/// The mean settlement per cycle of each setting (`(label, its runs)`), each
+/// with its 95 % band, in `DIR/<name>` (PNG and SVG), behind them the curves
+/// `behind` (e.g. every replica, thin).
+pub(super) fn settlement_figure(
+    out: &Path,
+    name: &str,
+    title: &str,
+    settings: &[(String, Vec<&Outcome>)],
+    seating: u64,
+    behind: &[Series],
+) -> Result<()> {
+    let curves: Vec<Series> = settings
+        .iter()
+        .map(|(label, runs)| {
+            let rows = settlement_ensemble(&cycles_of(runs), seating);
+            Series {
+                label: if runs.len() > 1 {
+                    format!("{label} (mean of {}, 95 % CI)", runs.len())
+                } else {
+                    label.clone()
+                },
+                points: rows.iter().map(|r| (r.cycle as f64, 1e3 * r.settlement_mean_m)).collect(),
+                band: rows
+                    .iter()
+                    .filter_map(|r| {
+                        Some((r.cycle as f64, 1e3 * r.settlement_ci95_low_m?, 1e3 * r.settlement_ci95_high_m?))
+                    })
+                    .collect(),
+                thin: false,
+                points_only: false,
+            }
+        })
+        .collect();
+    let all: Vec<Series> = behind.iter().cloned().chain(curves).collect();
+    figures::line_chart(
+        &out.join(name),
+        &axes(title, "cycles", "settlement at the load minimum (mm)", false, false),
+        &all,
+    )
+}
+
+pub(super) fn label_number(x: f64) -> String {
+    format!("{x:e}").replace('.', "p")
+}
+
+/// A pool of `threads` threads for runs side by side.
+pub(crate) fn pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| Error::Io(std::io::Error::other(e)))
+}
+
+/// Threads of each run on a pool of `pool` threads: one sweep thread each when
+/// several go side by side, else those of a single run.
+pub(crate) fn run_threads(pool: usize) -> usize {
+    if pool == 1 {
+        default_threads()
+    } else {
+        1
+    }
+}
+
+/// Writes the scenes of `jobs`, runs them `study.jobs` at a time and reads
+/// back their outcomes; the failed runs are added to `failed`.
+pub(super) fn run_jobs(
+    jobs: &[Job],
+    study: &StudyOptions,
+    display: &dyn RunDisplay,
+    failed: &mut Vec<(String, String)>,
+) -> Result<Vec<Outcome>> {
+    let out = &study.out;
+    let threads = study.threads()?;
+    for dir in ["scenes", "runs"] {
+        io::create_output_dir(&out.join(dir))?;
+    }
+    // All scenes first, so that an invalid one stops the study before any run.
+    let mut samples: Vec<(PathBuf, Scene)> = Vec::new();
+    for job in jobs {
+        let (mut loaded, from) = match &job.source {
+            Source::Loaded { spec, sample: path } => {
+                let sample = match samples.iter().find(|(p, _)| p == path) {
+                    Some((_, s)) => s.clone(),
+                    None => {
+                        let s = Scene::load(path)?;
+                        samples.push((path.clone(), s.clone()));
+                        s
+                    }
+                };
+                (loaded_scene(&sample, spec)?, format!(", from {}", path.display()))
+            }
+            Source::Ready(scene) => ((**scene).clone(), String::new()),
+        };
+        let record = perturb_scene(&mut loaded, &job.perturbation, job.replica)?;
+        let what = format!("{} of the study in {}{from}", job.label, out.display());
+        let scene = job.scene(out);
+        if let Some(parent) = scene.parent() {
+            io::create_output_dir(parent)?;
+        }
+        super::saussine::write_scene(&scene, &loaded, &what)?;
+        io::create_output_dir(&job.dir(out))?;
+        io::write_json(&job.dir(out).join(REPLICA_FILE), &record)?;
+    }
+    let pool = pool(threads)?;
+    let results: Vec<Result<()>> = pool.install(|| {
+        jobs.par_iter()
+            .map(|job| {
+                let dir = job.dir(out);
+                // summary.json: a diverged run is finished too (and reported as such).
+                let prior = Prior::of(&dir, layout::SUMMARY, study.resume);
+                if prior == Prior::Finished {
+                    return Ok(());
+                }
+                let opts = RunOptions {
+                    checkpoint_every_s: study.checkpoint_every_s,
+                    resume: prior == Prior::Checkpointed,
+                    figures: true,
+                    threads: run_threads(threads),
+                    ..RunOptions::default()
+                };
+                run_scene(&job.scene(out), &dir, &opts, display, &job.label).map(|_| ())
+            })
+            .collect()
+    });
+    let mut outcomes = Vec::with_capacity(jobs.len());
+    for (job, result) in jobs.iter().zip(results) {
+        let dir = job.dir(out);
+        let status = match result {
+            // Skipped on --resume, but diverged in an earlier invocation (no final scene).
+            Ok(()) if !dir.join(layout::FINAL_SCENE).exists() => "failed in an earlier invocation".to_string(),
+            Ok(()) => "ok".to_string(),
+            Err(e @ Error::Scene(_)) => return Err(e),
+            // A diverged run still wrote its series and summary: keep it in the study.
+            Err(e) => {
+                failed.push((job.label.clone(), e.to_string()));
+                format!("failed: {}", e.one_line())
+            }
+        };
+        let report = std::fs::read_to_string(dir.join(layout::SUMMARY))
+            .ok()
+            .and_then(|t| serde_json::from_str::<RunReport>(&t).ok());
+        let series = crate::plane::rows::read_series(&dir.join(layout::SERIES)).unwrap_or_default();
+        let cycles_path = dir.join(layout::CYCLES);
+        let cycles = if cycles_path.exists() { crate::plane::rows::read_cycles(&cycles_path)? } else { vec![] };
+        outcomes.push(Outcome { status, report, series, cycles });
+    }
+    Ok(outcomes)
+}
+
+/// The columns of a study's summary CSVs that describe one run, from its report
+/// and cycles (NaN where the run left nothing).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunColumns {
+    /// Column `mean_iterations`: NLGS sweeps per step, mean over the run.
+    pub mean_iterations: f64,
+    /// Column `mean_contacts`: contacts detected per step, mean over the run.
+    pub mean_contacts: f64,
+    /// Column `wall_time_s`: wall-clock time spent stepping, over all invocations (s).
+    pub wall_time_s: f64,
+    /// Column `wall_time_per_cycle_s`: wall-clock time per loading cycle (s).
+    pub wall_time_per_cycle_s: f64,
+    /// Column `unconverged_steps`: steps whose NLGS hit `max_iterations` before the tolerance.
+    pub unconverged_steps: u64,
+    /// Column `mean_overlap_m`: mean over the steps of the mean overlap of the active
+    /// contacts (m; Saussine et al. 2006, Fig. 4).
+    pub mean_overlap_m: f64,
+    /// Column `max_overlap_m`: largest overlap of the run (m; Saussine et al. 2006, Fig. 3).
+    pub max_overlap_m: f64,
+    /// Column `final_total_overlap_m`: sum of the overlaps of all contacts at the last
+    /// row of `series.csv` (m), the end of the cumulated interpenetration curve (Fig. 2).
+    pub final_total_overlap_m: f64,
+    /// Column `cycles`: loading cycles completed (the last row of `cycles.csv`; 0 if none).
+    pub cycles: u64,
+    /// Column `settlement_mean_m`: the sleeper's settlement averaged over the last
+    /// completed cycle (m, positive downwards; see
+    /// [`crate::plane::rows::PlaneCycleRow::settlement_mean_m`]).
+    pub settlement_mean_m: f64,
+    /// Column `settlement_at_min_load_m`: the sleeper's settlement at the smallest load of
+    /// the last completed cycle (m, positive downwards).
+    pub settlement_at_min_load_m: f64,
+    /// Column `status`: `ok`, `failed: <error>`, or `failed in an earlier invocation`.
+    pub status: String,
+}
+
+/// The names of the [`RunColumns`].
+const RUN_COLUMNS: [&str; 12] = [
+    "mean_iterations",
+    "mean_contacts",
+    "wall_time_s",
+    "wall_time_per_cycle_s",
+    "unconverged_steps",
+    "mean_overlap_m",
+    "max_overlap_m",
+    "final_total_overlap_m",
+    "cycles",
+    "settlement_mean_m",
+    "settlement_at_min_load_m",
+    "status",
+];
+
+fn run_columns(o: &Outcome) -> RunColumns {
+    let nan = f64::NAN;
+    let r = o.report.as_ref();
+    let last = o.cycles.last();
+    RunColumns {
+        mean_iterations: r.and_then(|r| r.mean_iterations).unwrap_or(nan),
+        mean_contacts: r.map_or(nan, |r| r.mean_contacts),
+        wall_time_s: r.map_or(nan, |r| r.wall_time_s),
+        wall_time_per_cycle_s: r.and_then(|r| r.wall_time_per_cycle_s).unwrap_or(nan),
+        unconverged_steps: r.and_then(|r| r.unconverged_steps).unwrap_or(0),
+        mean_overlap_m: r.map_or(nan, |r| r.mean_overlap_m),
+        max_overlap_m: r.map_or(nan, |r| r.max_overlap_m),
+        final_total_overlap_m: o.series.last().map_or(nan, |s| s.total_overlap_m),
+        cycles: last.map_or(0, |c| c.cycle),
+        settlement_mean_m: last.map_or(nan, |c| c.settlement_mean_m),
+        settlement_at_min_load_m: last.map_or(nan, |c| c.settlement_at_min_load_m),
+        status: o.status.clone(),
+    }
+}
+
+/// Writes a study table: the columns `key` then `rest`, one row per item.
+pub(super) fn write_table<R: Serialize>(path: &Path, key: &[&str], rest: &[&str], rows: &[R]) -> Result<()> {
+    let header: Vec<&str> = key.iter().chain(rest).copied().collect();
+    let mut t = TableWriter::create(path, &header)?;
+    for r in rows {
+        t.write(r)?;
+    }
+    t.finish()
+}
+
+/// The report of a study whose summary table is `DIR/name`.
+pub(super) fn report(out: &Path, name: &str, failed: Vec<(String, String)>) -> Result<StudyReport> {
+    Ok(StudyReport { table: SummaryTable::read(&out.join(name))?, runs: out.join("runs"), failed })
+}
