@@ -16,15 +16,14 @@
 pub mod checkpoint;
 mod equilibrium;
 pub mod folder;
+pub mod plan;
 pub mod positions;
 mod runner;
 pub mod summary;
 
 pub use checkpoint::Checkpoint;
 pub use equilibrium::{Equilibrium, EquilibriumWatch, DEFAULT_EQUILIBRIUM_STEPS};
+pub use plan::{check_built, check_options, cores, default_threads, CyclePlan, Prior, RunLength, RunOptions, RunPlan};
 pub(crate) use runner::body_names;
-pub use runner::{
-    check_built, check_options, cores, default_threads, CyclePlan, Figures, Prior, Progress, Restart, RunLength,
-    RunOptions, RunOutcome, RunPlan, Runner, Status,
-};
+pub use runner::{Figures, Progress, Restart, RunOutcome, Runner, Status};
 pub use summary::{RunEnd, RunReport, RunSummary};
