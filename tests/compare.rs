@@ -103,12 +103,12 @@ fn bad_compare_options_are_input_errors_naming_the_option() {
         Err(Error::Scene(m)) => m,
         other => panic!("expected an input error, got {:?}", other.map(|r| r.settings.len())),
     };
-    assert!(message(spec(&scene, &[], 1, 1)).contains("--overlaps"));
-    assert!(message(spec(&scene, &[0.5], 1, 1)).contains("--overlaps"));
+    assert!(message(spec(&scene, &[], 1, 1)).contains("overlaps:"));
+    assert!(message(spec(&scene, &[0.5], 1, 1)).contains("overlaps:"));
     assert!(message(spec(&scene, &[1e-3, 1e-3], 1, 1)).contains("twice"));
-    assert!(message(spec(&scene, &[1e-3], 0, 1)).contains("--cycles"));
-    assert!(message(spec(&scene, &[1e-3], 1, 0)).contains("--replicas"));
-    assert!(message(CompareSpec { model: "soft".into(), ..spec(&scene, &[1e-3], 1, 1) }).contains("--model"));
+    assert!(message(spec(&scene, &[1e-3], 0, 1)).contains("cycles:"));
+    assert!(message(spec(&scene, &[1e-3], 1, 0)).contains("replicas:"));
+    assert!(message(CompareSpec { model: "soft".into(), ..spec(&scene, &[1e-3], 1, 1) }).contains("model:"));
     // Nothing ran.
     assert!(!out.join("runs").exists());
 }

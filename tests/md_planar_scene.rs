@@ -146,5 +146,5 @@ fn bad_soft_tables_name_the_key() {
     let e = run_file("examples/md_two_spheres.toml".as_ref(), &dir.join("out-3d"), &opts(Some("nscd")), &mut |_| {})
         .unwrap_err()
         .to_string();
-    assert!(e.contains("--engine nscd: this is a 3D MD scene"), "{e}");
+    assert!(e.contains("engine: nscd runs 2D scenes, and this is a 3D MD scene"), "{e}");
 }

@@ -70,7 +70,7 @@ fn perturbation_moves_mobile_bodies_within_the_disc() {
     assert_ne!(other, one);
     // Invalid distances are refused, naming the option.
     let e = perturb_scene(&mut scene.clone(), &Perturbation { distance_m: -1.0, seed: 0 }, 1).unwrap_err();
-    assert!(e.to_string().contains("--perturb"), "{e}");
+    assert!(e.to_string().contains("perturbation.distance_m"), "{e}");
 }
 
 /// MD replicas: every sphere moves within the ball, walls stay; the ball's draws
@@ -98,7 +98,7 @@ fn md_perturbation_moves_every_sphere_within_the_ball() {
     assert_eq!(perturbed(1).0, one);
     assert_ne!(perturbed(2).0, one);
     let e = perturb_md_scene(&mut scene.clone(), &Perturbation { distance_m: f64::NAN, seed: 0 }, 1).unwrap_err();
-    assert!(e.to_string().contains("--perturb"), "{e}");
+    assert!(e.to_string().contains("perturbation.distance_m"), "{e}");
 
     // Uniform in the ball of radius R: E|d| = 3R/4 (the density of |d| is 3r²/R³),
     // P(|d| < R/2) = 1/8, E d = 0. With n = 20 000 draws the standard errors are

@@ -109,7 +109,7 @@ fn resume_is_bit_identical<E: Engine>(runner: &Runner<E>, other: &Runner<E>, sto
     let opts = RunOptions { vtk_every: vtk, ..quiet() };
     // Nothing to resume yet: an input error, nothing written.
     let err = runner.run(&parts, &RunOptions { resume: true, ..opts.clone() }, &mut |_| {}).unwrap_err();
-    assert!(matches!(err, Error::Scene(_)) && err.to_string().contains("--resume: no checkpoint.json"), "{err}");
+    assert!(matches!(err, Error::Scene(_)) && err.to_string().contains("resume: no checkpoint.json"), "{err}");
     assert!(!parts.join("series.csv").exists());
     let done = runner.run(&whole, &opts, &mut |_| {}).unwrap();
     assert_eq!(done.status, Status::Ended(RunEnd::Finished));
@@ -349,7 +349,7 @@ fn a_run_length_replaces_the_scene_duration() {
             };
             assert_eq!(planned, steps);
         }
-        for (length, option) in [(RunLength::Steps(0), "--steps"), (RunLength::Duration(-1.0), "--duration")] {
+        for (length, option) in [(RunLength::Steps(0), "length.steps"), (RunLength::Duration(-1.0), "length.duration")] {
             let opts = RunOptions { length: Some(length), ..quiet() };
             let e = run_file(scene, &out, &opts, &mut |_| {}).unwrap_err().to_string();
             assert!(e.starts_with(option) && !e.contains('\n'), "{e}");

@@ -70,11 +70,11 @@ fn saussine_sample_load_and_convergence_study() {
     assert_eq!(sample.report.grains, 60);
     assert!(dir.join("sample/sample.json").is_file() && dir.join("sample/deposit/final_scene.toml").is_file());
 
-    // The loading is checked, naming the options.
+    // The loading is checked, naming the fields.
     for (bad, needle) in [
-        (Loading { stiffness_factor: 0.0, ..Loading::default() }, "--stiffness-factor"),
-        (Loading { inclination_deg: 90.0, ..Loading::default() }, "--inclination"),
-        (Loading { cycles: 0, ..Loading::default() }, "--cycles"),
+        (Loading { stiffness_factor: 0.0, ..Loading::default() }, "stiffness_factor:"),
+        (Loading { inclination_deg: 90.0, ..Loading::default() }, "inclination_deg:"),
+        (Loading { cycles: 0, ..Loading::default() }, "cycles:"),
     ] {
         assert!(input_error(bad.spec()).contains(needle), "{needle}");
     }
@@ -129,7 +129,7 @@ fn saussine_sample_load_and_convergence_study() {
 
     // Invalid study options are input errors, before any run.
     let bad = StudyOptions { jobs: Some(0), ..StudyOptions::new(dir.join("bad")) };
-    assert!(input_error(campaigns::convergence(&conv, &bad, &Quiet)).contains("--jobs"));
+    assert!(input_error(campaigns::convergence(&conv, &bad, &Quiet)).contains("jobs:"));
     assert!(!dir.join("bad/runs").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -151,7 +151,7 @@ fn saussine_ensemble_of_two_samples() {
     };
     let study = StudyOptions { jobs: Some(2), ..StudyOptions::new(dir.join("ens")) };
     let no_cycle = EnsembleSpec { loading: Loading { cycles: 0, ..loading }, ..spec.clone() };
-    assert!(input_error(campaigns::ensemble(&no_cycle, &study, &Quiet)).contains("--cycles"));
+    assert!(input_error(campaigns::ensemble(&no_cycle, &study, &Quiet)).contains("cycles:"));
     assert!(!dir.join("ens/samples").exists());
 
     let record = Record::default();
@@ -204,7 +204,7 @@ fn karrech_deposit_then_one_cycle() {
 
     // The load needs a finished deposit: an input error naming the option.
     assert!(input_error(karrech::load(&dir.join("bad"), Plate::FULL, 1, &Default::default(), &stage("x"), &Quiet))
-        .contains("--from"));
+        .contains("from:"));
     let load =
         karrech::load(&dir.join("deposit"), Plate::FULL, 1, &Default::default(), &stage("load"), &Quiet).unwrap();
     assert!(dir.join("load/load.toml").is_file());

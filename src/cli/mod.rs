@@ -13,6 +13,7 @@
 mod compare;
 mod deposit;
 mod figures;
+mod flags;
 mod md_tests;
 mod run;
 mod saussine;
@@ -95,7 +96,7 @@ pub fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(e)) => {
-            eprintln!("error: {}", e.one_line());
+            eprintln!("error: {}", flags::as_flags(&e.one_line()));
             ExitCode::from(2)
         }
         Err(Failure::Run(e)) => {

@@ -55,14 +55,14 @@ pub fn reference_settlement(dir: &Path) -> Result<Vec<(f64, Option<f64>)>> {
     if c.is_file() {
         let cols = crate::io::table::read_columns(&c, &["settlement_at_min_load_m"]).map_err(|e| {
             Error::Scene(format!(
-                "--reference: {e} (an MD run's cycles.csv has no settlement: give the folder of a full run made \
+                "reference: {e} (an MD run's cycles.csv has no settlement: give the folder of a full run made \
                  through the driver, --accelerate K_I,N+1,1)"
             ))
         })?;
         return Ok(cols[0].iter().map(|&v| (v, None)).collect());
     }
     Err(Error::Scene(format!(
-        "--reference: '{}' has neither {SETTLEMENT} nor cycles.csv (the folder of a full run of the same scene)",
+        "reference: '{}' has neither {SETTLEMENT} nor cycles.csv (the folder of a full run of the same scene)",
         dir.display()
     )))
 }
@@ -104,7 +104,7 @@ pub fn add_configuration_errors(rows: &mut [ErrorRow], run: &CyclePositions, ref
     let same = a.bodies == b.bodies && a.dof == b.dof && a.q.iter().zip(&b.q).all(|(x, y)| (x - y).abs() <= 1e-12);
     if !same {
         return Err(Error::Scene(
-            "--reference: the two runs' cycle positions do not follow the same bodies from the same start".into(),
+            "reference: the two runs' cycle positions do not follow the same bodies from the same start".into(),
         ));
     }
     // The translations: 2 of (x, y, θ) in 2D, 3 of (x, y, z, r) in 3D.

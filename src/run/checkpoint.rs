@@ -147,14 +147,14 @@ pub fn check_origin(path: &Path, (engine, version, source_crc32): (&str, &str, u
         return Err(invalid(
             path,
             format!(
-                "written by ballast {}, this is {this}; run without --resume to start again",
+                "written by ballast {}, this is {this}; start a fresh run instead of resuming",
                 crate::error::clip(version)
             ),
         ));
     }
     if source_crc32 != want.1 {
         return Err(Error::Scene(format!(
-            "{}: the checkpoint was written for another scene; run without --resume to start again",
+            "{}: the checkpoint was written for another scene; start a fresh run instead of resuming",
             path.display()
         )));
     }

@@ -72,7 +72,7 @@ pub fn checkpoint_to_resume(out: &Path) -> Result<PathBuf> {
         Ok(path)
     } else {
         Err(Error::Scene(format!(
-            "--resume: no {CHECKPOINT} in '{}' (nothing to continue: run without --resume)",
+            "resume: no {CHECKPOINT} in '{}' (nothing to continue: start a fresh run)",
             out.display()
         )))
     }

@@ -110,7 +110,7 @@ pub fn default_threads() -> usize {
 pub fn check_options(opts: &RunOptions) -> Result<()> {
     if !(opts.checkpoint_every_s.is_finite() && opts.checkpoint_every_s >= 0.0) {
         return Err(Error::Scene(format!(
-            "--checkpoint-every: must be a non-negative number of seconds, got {}",
+            "checkpoint_every_s: must be a non-negative number of seconds, got {}",
             opts.checkpoint_every_s
         )));
     }
@@ -118,7 +118,7 @@ pub fn check_options(opts: &RunOptions) -> Result<()> {
         crate::io::figures::require()?;
     }
     if opts.threads == 0 {
-        return Err(Error::Scene("--threads: must be at least 1, got 0".into()));
+        return Err(Error::Scene("threads: must be at least 1, got 0".into()));
     }
     Ok(())
 }

@@ -60,12 +60,12 @@ impl Simulation {
         use crate::run::RunLength;
         let duration = match length {
             RunLength::Duration(d) => d,
-            RunLength::Steps(0) => return Err(crate::Error::Scene("--steps: must be at least 1".into())),
+            RunLength::Steps(0) => return Err(crate::Error::Scene("length.steps: must be at least 1".into())),
             RunLength::Steps(n) => n as f64 * self.dt,
         };
         super::validate::check_time(self.dt, duration).map_err(|e| match (length, e) {
-            (RunLength::Duration(_), crate::Error::Scene(m)) => crate::Error::Scene(format!("--duration: {m}")),
-            (RunLength::Steps(_), crate::Error::Scene(m)) => crate::Error::Scene(format!("--steps: {m}")),
+            (RunLength::Duration(_), crate::Error::Scene(m)) => crate::Error::Scene(format!("length.duration: {m}")),
+            (RunLength::Steps(_), crate::Error::Scene(m)) => crate::Error::Scene(format!("length.steps: {m}")),
             (_, e) => e,
         })?;
         self.duration = duration;

@@ -172,10 +172,7 @@ impl Scene {
                 out.simulation.dimension = Some(2);
             }
             other => {
-                return err(format!(
-                    "--engine: unknown engine '{}', expected 'nscd' or 'md'",
-                    crate::error::clip(other)
-                ))
+                return err(format!("engine: unknown engine '{}', expected 'nscd' or 'md'", crate::error::clip(other)))
             }
         }
         out.validate()?;
@@ -313,12 +310,10 @@ impl SceneKind {
             None => Ok(SceneKind::Nscd),
             Some("md") if spheres => Ok(SceneKind::Md),
             Some("md") => Ok(SceneKind::PlanarMd),
-            Some("nscd") if spheres => {
-                err("--engine nscd: this is a 3D MD scene (spheres); the NSCD engine runs 2D scenes".into())
-            }
+            Some("nscd") if spheres => err("engine: nscd runs 2D scenes, and this is a 3D MD scene (spheres)".into()),
             Some("nscd") => Ok(SceneKind::Nscd),
             Some(other) => {
-                err(format!("--engine: unknown engine '{}', expected 'nscd' or 'md'", crate::error::clip(other)))
+                err(format!("engine: unknown engine '{}', expected 'nscd' or 'md'", crate::error::clip(other)))
             }
         }
     }

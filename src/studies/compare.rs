@@ -159,11 +159,11 @@ struct Setting {
 /// or the deposited sample loaded with `spec.loading`.
 fn loaded(spec: &CompareSpec) -> Result<(Scene, f64)> {
     if spec.loading.cycles == 0 {
-        return Err(Error::Scene("--cycles: must be at least 1".into()));
+        return Err(Error::Scene("cycles: must be at least 1".into()));
     }
     let scene = Scene::load(&spec.sample)?;
     if scene.simulation.dimension == Some(3) || (scene.simulation.engine == "md" && !scene.is_planar_md()) {
-        return Err(Error::Scene(format!("--sample: {} is not a 2D scene", spec.sample.display())));
+        return Err(Error::Scene(format!("sample: {} is not a 2D scene", spec.sample.display())));
     }
     let followed = scene.output.as_ref().and_then(|o| o.cycles.as_ref()).filter(|c| c.body.is_some()).cloned();
     let mut scene = match followed {
@@ -176,16 +176,17 @@ fn loaded(spec: &CompareSpec) -> Result<(Scene, f64)> {
         None => loaded_scene(&scene, &spec.loading.for_sample(&scene)?)?,
     };
     scene = scene.on_engine("nscd")?;
-    let frequency = scene.output.as_ref().and_then(|o| o.cycles.as_ref()).map(|c| c.frequency).ok_or_else(|| {
-        Error::Scene(format!("--sample: {} has no [output.cycles] once loaded", spec.sample.display()))
-    })?;
+    let frequency =
+        scene.output.as_ref().and_then(|o| o.cycles.as_ref()).map(|c| c.frequency).ok_or_else(|| {
+            Error::Scene(format!("sample: {} has no [output.cycles] once loaded", spec.sample.display()))
+        })?;
     Ok((scene, 1.0 / frequency))
 }
 
 /// The settings of `spec`: NSCD, then MD at each overlap ratio.
 fn settings(spec: &CompareSpec) -> Result<Vec<Setting>> {
     if spec.overlaps.is_empty() {
-        return Err(Error::Scene("--overlaps: give at least one overlap ratio".into()));
+        return Err(Error::Scene("overlaps: give at least one overlap ratio".into()));
     }
     let (nscd, period) = loaded(spec)?;
     let dt = nscd.simulation.dt;
@@ -201,7 +202,7 @@ fn settings(spec: &CompareSpec) -> Result<Vec<Setting>> {
     }];
     for &ratio in &spec.overlaps {
         if out.iter().any(|s| s.ratio == Some(ratio)) {
-            return Err(Error::Scene(format!("--overlaps: {ratio:e} is given twice")));
+            return Err(Error::Scene(format!("overlaps: {ratio:e} is given twice")));
         }
         let mut md = nscd.clone();
         md.soft = Some(SoftSection {
@@ -214,11 +215,11 @@ fn settings(spec: &CompareSpec) -> Result<Vec<Setting>> {
         });
         let mut md = md.on_engine("md").map_err(|e| match e {
             Error::Scene(m) if m.starts_with("soft.max_overlap_ratio") => {
-                Error::Scene(format!("--overlaps: {ratio:e}: {m}"))
+                Error::Scene(format!("overlaps: {ratio:e}: {m}"))
             }
-            Error::Scene(m) if m.starts_with("soft.model") => Error::Scene(m.replacen("soft.model", "--model", 1)),
+            Error::Scene(m) if m.starts_with("soft.model") => Error::Scene(m.replacen("soft.model", "model", 1)),
             Error::Scene(m) if m.starts_with("soft.dt_fraction") => {
-                Error::Scene(m.replacen("soft.dt_fraction", "--dt-fraction", 1))
+                Error::Scene(m.replacen("soft.dt_fraction", "dt_fraction", 1))
             }
             e => e,
         })?;

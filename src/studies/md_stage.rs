@@ -115,7 +115,7 @@ impl TestSpec {
 pub(crate) fn final_state(dir: &Path) -> Result<MdSystem> {
     let path = dir.join(layout::FINAL_SCENE);
     if !path.exists() {
-        return Err(Error::Scene(format!("--from: no finished run in '{}' (no final_scene.toml)", dir.display())));
+        return Err(Error::Scene(format!("from: no finished run in '{}' (no final_scene.toml)", dir.display())));
     }
     MdScene::load(&path).and_then(|s| s.build())
 }

@@ -25,8 +25,9 @@
 //!
 //! Progress goes through a [`RunDisplay`]: one callback per run, and a word
 //! when each run ends ([`Quiet`] shows nothing). Invalid inputs are
-//! [`Error::Scene`] with a one-line message naming the option (as the command
-//! line spells it); a failed run or an unwritable output is another error.
+//! [`Error::Scene`] with a one-line message naming the spec's field (`cycles`,
+//! `jobs`, `perturbation.distance_m`, …; the command line maps them to its
+//! flags); a failed run or an unwritable output is another error.
 //!
 //! A 60-grain sample, deposited quietly:
 //! ```no_run

@@ -97,16 +97,16 @@ impl Loading {
             None => Guide::Level,
         };
         if !(self.stiffness_factor.is_finite() && self.stiffness_factor > 0.0) {
-            return Err(Error::Scene(format!("--stiffness-factor: must be positive, got {}", self.stiffness_factor)));
+            return Err(Error::Scene(format!("stiffness_factor: must be positive, got {}", self.stiffness_factor)));
         }
         if !(self.inclination_deg.is_finite() && self.inclination_deg.abs() < 90.0) {
             return Err(Error::Scene(format!(
-                "--inclination: must be in (-90, 90) degrees, got {}",
+                "inclination_deg: must be in (-90, 90) degrees, got {}",
                 self.inclination_deg
             )));
         }
         if self.cycles == 0 {
-            return Err(Error::Scene("--cycles: must be at least 1".into()));
+            return Err(Error::Scene("cycles: must be at least 1".into()));
         }
         let base = LoadingSpec::saussine(self.cycles);
         Ok(LoadingSpec {
@@ -474,7 +474,7 @@ pub fn settle_replicas(
 /// [`Error::Scene`] for `jobs` = 0.
 pub(crate) fn replica_jobs(jobs: Option<usize>, count: u64) -> Result<usize> {
     match jobs.unwrap_or_else(crate::run::cores) {
-        0 => Err(Error::Scene("--jobs: must be at least 1".into())),
+        0 => Err(Error::Scene("jobs: must be at least 1".into())),
         n => Ok(n.min(count as usize)),
     }
 }

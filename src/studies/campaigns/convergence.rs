@@ -23,10 +23,9 @@ pub struct ConvergenceSpec {
 /// The reference setting of [`ConvergenceSpec::reference`] among `runs`: its index.
 fn reference_of(runs: &[(String, f64)], given: Option<&(String, f64)>) -> Result<usize> {
     if let Some((p, t)) = given {
-        return runs
-            .iter()
-            .position(|(q, u)| q == p && u == t)
-            .ok_or_else(|| Error::Scene(format!("--reference: {p}:{t:e} is not among the runs (--policies)")));
+        return runs.iter().position(|(q, u)| q == p && u == t).ok_or_else(|| {
+            Error::Scene(format!("reference: {p}:{t:e} is not among the runs of the policies asked for"))
+        });
     }
     let tightest = |strict: bool| {
         runs.iter()
@@ -35,7 +34,7 @@ fn reference_of(runs: &[(String, f64)], given: Option<&(String, f64)>) -> Result
             .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1).then(a.0.cmp(&b.0)))
             .map(|(i, _)| i)
     };
-    tightest(true).or_else(|| tightest(false)).ok_or_else(|| Error::Scene("--policies: no run".into()))
+    tightest(true).or_else(|| tightest(false)).ok_or_else(|| Error::Scene("policies: no run".into()))
 }
 
 /// §3.2 (`ballast saussine convergence`): one run per policy and tolerance,

@@ -61,10 +61,10 @@ pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisp
     crate::io::figures::require()?; // the stage ends with its figures
     let factors = &spec.factors;
     if spec.samples == 0 {
-        return Err(Error::Scene("--samples: must be at least 1".into()));
+        return Err(Error::Scene("samples: must be at least 1".into()));
     }
     if let Some(f) = factors.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
-        return Err(Error::Scene(format!("--factors: every stiffness factor must be positive, got {f}")));
+        return Err(Error::Scene(format!("factors: every stiffness factor must be positive, got {f}")));
     }
     // The loading and the options are checked before the deposits.
     let loadings: Vec<Loading> =

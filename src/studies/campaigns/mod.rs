@@ -87,12 +87,12 @@ impl StudyOptions {
     fn threads(&self) -> Result<usize> {
         if !(self.checkpoint_every_s.is_finite() && self.checkpoint_every_s >= 0.0) {
             return Err(Error::Scene(format!(
-                "--checkpoint-every: must be non-negative, got {}",
+                "checkpoint_every_s: must be non-negative, got {}",
                 self.checkpoint_every_s
             )));
         }
         match self.jobs.unwrap_or_else(cores) {
-            0 => Err(Error::Scene("--jobs: must be at least 1".into())),
+            0 => Err(Error::Scene("jobs: must be at least 1".into())),
             n => Ok(n),
         }
     }

@@ -34,7 +34,7 @@ pub fn steps(spec: &StepsSpec, study: &StudyOptions, display: &dyn RunDisplay) -
     spec.replicas.check()?;
     let (dts, inclinations) = (&spec.dts, &spec.inclinations);
     if let Some(dt) = dts.iter().find(|dt| !(dt.is_finite() && **dt > 0.0)) {
-        return Err(Error::Scene(format!("--dts: every time step must be positive, got {dt}")));
+        return Err(Error::Scene(format!("dts: every time step must be positive, got {dt}")));
     }
     let sample_path = &spec.sample;
     let sample_scene = Scene::load(sample_path)?;

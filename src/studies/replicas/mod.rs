@@ -111,12 +111,12 @@ impl Perturbation {
     /// Checks the distance.
     ///
     /// # Errors
-    /// [`Error::Scene`] naming `--perturb` if the distance is negative or not finite.
+    /// [`Error::Scene`] naming `perturbation.distance_m` if the distance is negative or not finite.
     pub fn check(&self) -> Result<()> {
         if self.distance_m.is_finite() && self.distance_m >= 0.0 {
             Ok(())
         } else {
-            Err(Error::Scene(format!("--perturb: must be a distance ≥ 0 m, got {}", self.distance_m)))
+            Err(Error::Scene(format!("perturbation.distance_m: must be a distance ≥ 0 m, got {}", self.distance_m)))
         }
     }
 
@@ -256,10 +256,10 @@ impl Replicas {
     /// Checks the count and the perturbation.
     ///
     /// # Errors
-    /// [`Error::Scene`] naming `--replicas` or `--perturb`.
+    /// [`Error::Scene`] naming `replicas` or `perturbation.distance_m`.
     pub fn check(&self) -> Result<()> {
         if self.count == 0 {
-            return Err(Error::Scene("--replicas: must be at least 1".into()));
+            return Err(Error::Scene("replicas: must be at least 1".into()));
         }
         self.perturbation.check()
     }
