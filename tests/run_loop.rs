@@ -349,7 +349,8 @@ fn a_run_length_replaces_the_scene_duration() {
             };
             assert_eq!(planned, steps);
         }
-        for (length, option) in [(RunLength::Steps(0), "length.steps"), (RunLength::Duration(-1.0), "length.duration")] {
+        for (length, option) in [(RunLength::Steps(0), "length.steps"), (RunLength::Duration(-1.0), "length.duration")]
+        {
             let opts = RunOptions { length: Some(length), ..quiet() };
             let e = run_file(scene, &out, &opts, &mut |_| {}).unwrap_err().to_string();
             assert!(e.starts_with(option) && !e.contains('\n'), "{e}");
