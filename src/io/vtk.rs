@@ -123,7 +123,8 @@ fn bodies_and_contacts(bodies: PathBuf, contacts: PathBuf) -> Vec<PvdPart> {
 /// for k in 1..=scene.steps() {
 ///     sys.step()?;
 ///     if k % 10 == 0 {
-///         pvd.write_snapshot(dir, &sys)?; // out/bodies_000000010.vtp, out/contacts_000000010.vtp
+///         // out/bodies_000000010.vtp, out/contacts_000000010.vtp
+///         ballast::plane::vtk::write_snapshot(&mut pvd, dir, &sys)?;
 ///         pvd.write(&dir.join("run.pvd"))?; // rewritten each time: valid even if the run stops
 ///     }
 /// }
