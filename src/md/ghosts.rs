@@ -66,6 +66,20 @@ pub struct Ghosts {
 }
 
 impl Ghosts {
+    /// Copies `src` into `self`, reusing `self`'s buffers (no allocation once the sizes match): the backup of
+    /// an MD step ([`crate::md::MdSystem`]). The destructuring names every field, so a field added to the
+    /// struct does not compile until it is copied here too (a field forgotten would be a silent replay bug).
+    pub(crate) fn copy_from(&mut self, src: &Ghosts) {
+        let Ghosts { planes, origin, mask, key, x, v, w } = src;
+        self.planes.clone_from(planes);
+        self.origin.clone_from(origin);
+        self.mask.clone_from(mask);
+        self.key.clone_from(key);
+        self.x.clone_from(x);
+        self.v.clone_from(v);
+        self.w.clone_from(w);
+    }
+
     /// No image yet.
     pub fn new(planes: Vec<SymmetryPlane>) -> Self {
         Ghosts { planes, ..Default::default() }

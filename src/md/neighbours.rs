@@ -76,6 +76,21 @@ struct Scratch {
 }
 
 impl Neighbours {
+    /// Copies `src` into `self`, reusing `self`'s buffers (no allocation once the sizes match): the backup of
+    /// an MD step ([`crate::md::MdSystem`]). The destructuring names every field, so a field added to the
+    /// struct does not compile until it is copied here too (a field forgotten would be a silent replay bug).
+    /// The scratch buffers are not state (each build fills them before it reads them).
+    pub(crate) fn copy_from(&mut self, src: &Neighbours) {
+        let Neighbours { skin, start, j, key, hist, x_build, builds, scratch: _ } = src;
+        self.skin = *skin;
+        self.start.clone_from(start);
+        self.j.clone_from(j);
+        self.key.clone_from(key);
+        self.hist.clone_from(hist);
+        self.x_build.clone_from(x_build);
+        self.builds = *builds;
+    }
+
     /// An empty list with skin `skin` (m); call [`Neighbours::build`] before use.
     pub fn new(skin: f64) -> Self {
         Neighbours { skin, ..Default::default() }

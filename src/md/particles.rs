@@ -42,6 +42,25 @@ pub struct Particles {
 }
 
 impl Particles {
+    /// Copies `src` into `self`, reusing `self`'s buffers (no allocation once the sizes match): the backup of
+    /// an MD step ([`crate::md::MdSystem`]). The destructuring names every field, so a field added to the
+    /// struct does not compile until it is copied here too (a field forgotten would be a silent replay bug).
+    pub(crate) fn copy_from(&mut self, src: &Particles) {
+        let Particles { x, v, w, f, t, r, m, inv_m, inv_i, material, q, name } = src;
+        self.x.clone_from(x);
+        self.v.clone_from(v);
+        self.w.clone_from(w);
+        self.f.clone_from(f);
+        self.t.clone_from(t);
+        self.r.clone_from(r);
+        self.m.clone_from(m);
+        self.inv_m.clone_from(inv_m);
+        self.inv_i.clone_from(inv_i);
+        self.material.clone_from(material);
+        self.q.clone_from(q);
+        self.name.clone_from(name);
+    }
+
     /// Number of spheres.
     pub fn len(&self) -> usize {
         self.x.len()

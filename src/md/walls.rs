@@ -124,6 +124,23 @@ pub struct Wall {
 }
 
 impl Wall {
+    /// Copies `src` into `self`, reusing `self`'s buffers (no allocation once the sizes match): the backup of
+    /// an MD step ([`crate::md::MdSystem`]). The destructuring names every field, so a field added to the
+    /// struct does not compile until it is copied here too (a field forgotten would be a silent replay bug).
+    pub(crate) fn copy_from(&mut self, src: &Wall) {
+        let Wall { name, material, shape, motion, s, s_dot, force, contacts, s_build, candidates } = src;
+        self.name.clone_from(name);
+        self.material = *material;
+        self.shape.clone_from(shape);
+        self.motion.clone_from(motion);
+        self.s = *s;
+        self.s_dot = *s_dot;
+        self.force = *force;
+        self.contacts = *contacts;
+        self.s_build = *s_build;
+        self.candidates.clone_from(candidates);
+    }
+
     /// A wall at rest.
     pub fn new(name: &str, material: u32, shape: Shape, motion: Motion) -> Self {
         Wall {

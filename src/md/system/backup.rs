@@ -5,9 +5,9 @@ use super::*;
 
 /// A copy of the whole dynamic state, for going back to the last good step when a step fails: the spheres,
 /// the walls, the neighbour list with its contact memory, the images, the integrator's derivatives, the
-/// virial, the last statistics and the clock, each field of [`MdSystem`] copied whole (`clone_from` reuses
-/// the buffers of the previous copy), so that a field added to one of these structures is backed up without
-/// a line here. What a step only reads (settings, laws, the origins of the clock and of the energy check)
+/// virial, the last statistics and the clock, each field of [`MdSystem`] copied whole into the buffers of
+/// the previous copy (no allocation once the sizes match): the structures copy themselves with a destructuring
+/// of all their fields (`copy_from`), so a field added to one of them does not compile until it is copied. What a step only reads (settings, laws, the origins of the clock and of the energy check)
 /// is not copied.
 #[derive(Debug, Clone, Default)]
 pub(super) struct Backup {
@@ -32,11 +32,11 @@ impl MdSystem {
     pub(super) fn save_backup(&mut self) {
         let b = &mut self.backup;
         b.taken = true;
-        b.particles.clone_from(&self.particles);
-        b.walls.clone_from(&self.walls);
+        b.particles.copy_from(&self.particles);
+        copy_walls(&mut b.walls, &self.walls);
         b.wall_hist.clone_from(&self.wall_hist);
-        b.neighbours.clone_from(&self.neighbours);
-        b.ghosts.clone_from(&self.ghosts);
+        b.neighbours.copy_from(&self.neighbours);
+        b.ghosts.copy_from(&self.ghosts);
         b.gear_x.clone_from(&self.gear_x);
         b.gear_w.clone_from(&self.gear_w);
         b.force_x.clone_from(&self.force_x);
@@ -52,11 +52,11 @@ impl MdSystem {
         if !b.taken || b.particles.len() != self.particles.len() {
             return;
         }
-        self.particles.clone_from(&b.particles);
-        self.walls.clone_from(&b.walls);
+        self.particles.copy_from(&b.particles);
+        copy_walls(&mut self.walls, &b.walls);
         self.wall_hist.clone_from(&b.wall_hist);
-        self.neighbours.clone_from(&b.neighbours);
-        self.ghosts.clone_from(&b.ghosts);
+        self.neighbours.copy_from(&b.neighbours);
+        self.ghosts.copy_from(&b.ghosts);
         self.ghosts.update(&self.particles);
         self.gear_x.clone_from(&b.gear_x);
         self.gear_w.clone_from(&b.gear_w);
@@ -67,4 +67,14 @@ impl MdSystem {
         self.step = b.step;
         self.drive_work = b.drive_work;
     }
+}
+
+/// Copies the walls `src` into `dst`, reusing `dst`'s walls and their buffers.
+fn copy_walls(dst: &mut Vec<Wall>, src: &[Wall]) {
+    dst.truncate(src.len());
+    for (d, w) in dst.iter_mut().zip(src) {
+        d.copy_from(w);
+    }
+    let have = dst.len();
+    dst.extend_from_slice(&src[have..]);
 }
