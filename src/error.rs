@@ -10,6 +10,11 @@ pub enum Error {
     /// section.
     #[error("{0}")]
     Scene(String),
+    /// A checkpoint to resume from was refused, or there is none: truncated or edited (checksum), of another
+    /// engine, version or scene, a state that does not hold together or is not the scene's model, or counters
+    /// that do not match the run's files. The message names the file; nothing was run.
+    #[error("{0}")]
+    Checkpoint(String),
     /// A shape was refused ([`GeometryError`]), e.g. a polygon given clockwise to
     /// a constructor in code; converts with `?`. (Scenes report their shapes'
     /// errors as [`Error::Scene`], with the body named.)

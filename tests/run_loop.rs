@@ -109,7 +109,7 @@ fn resume_is_bit_identical<E: Engine>(runner: &Runner<E>, other: &Runner<E>, sto
     let opts = RunOptions { vtk_every: vtk, ..quiet() };
     // Nothing to resume yet: an input error, nothing written.
     let err = runner.run(&parts, &RunOptions { resume: true, ..opts.clone() }, &mut |_| {}).unwrap_err();
-    assert!(matches!(err, Error::Scene(_)) && err.to_string().contains("resume: no checkpoint.json"), "{err}");
+    assert!(matches!(err, Error::Checkpoint(_)) && err.to_string().contains("resume: no checkpoint.json"), "{err}");
     assert!(!parts.join("series.csv").exists());
     let done = runner.run(&whole, &opts, &mut |_| {}).unwrap();
     assert_eq!(done.status, Status::Ended(RunEnd::Finished));
@@ -117,7 +117,7 @@ fn resume_is_bit_identical<E: Engine>(runner: &Runner<E>, other: &Runner<E>, sto
     assert_eq!((first.status, first.step), (Status::Stopped, stop));
     assert!(parts.join("checkpoint.json").is_file() && !parts.join("final.json").exists());
     let err = other.run(&parts, &RunOptions { resume: true, ..opts.clone() }, &mut |_| {}).unwrap_err();
-    assert!(err.to_string().contains("another scene"), "{err}");
+    assert!(matches!(err, Error::Checkpoint(_)) && err.to_string().contains("another scene"), "{err}");
     let resume = RunOptions { resume: true, ..opts.clone() };
     let second = runner.run(&parts, &RunOptions { stop_after: Some(stop), ..resume.clone() }, &mut |_| {}).unwrap();
     assert_eq!((second.status, second.step), (Status::Stopped, 2 * stop));

@@ -66,11 +66,11 @@ pub(crate) enum Failure {
 }
 
 impl From<Error> for Failure {
-    /// An invalid scene, option, checkpoint or shape is an input error; a
+    /// An invalid scene, option, checkpoint or shape is an input error (exit code 2); a
     /// divergence or an I/O error a run error.
     fn from(e: Error) -> Self {
         match e {
-            Error::Scene(_) | Error::Geometry(_) => Failure::Input(e),
+            Error::Scene(_) | Error::Checkpoint(_) | Error::Geometry(_) => Failure::Input(e),
             _ => Failure::Run(e),
         }
     }

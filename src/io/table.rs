@@ -125,7 +125,7 @@ impl TableWriter {
 /// Checks that the first `bytes` bytes of the table at `path` are its header and
 /// `rows` complete lines, with the CRC-32 `crc`.
 pub fn check_length(path: &Path, bytes: u64, rows: u64, crc: u32) -> Result<()> {
-    let bad = |msg: String| Err(Error::Scene(format!("not a valid checkpoint: '{}' {msg}", path.display())));
+    let bad = |msg: String| Err(Error::Checkpoint(format!("not a valid checkpoint: '{}' {msg}", path.display())));
     let text = match std::fs::read(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return bad("is missing".into()),

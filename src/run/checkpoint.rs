@@ -89,7 +89,7 @@ fn invalid(path: &Path, msg: impl std::fmt::Display) -> Error {
     if msg.chars().count() > MAX {
         short.push('…');
     }
-    Error::Scene(format!("{}: not a valid checkpoint: {short}", path.display()))
+    Error::Checkpoint(format!("{}: not a valid checkpoint: {short}", path.display()))
 }
 
 /// Writes `value` as `DIR/checkpoint.json`, atomically: a first line
@@ -109,7 +109,7 @@ pub fn write_checked<T: Serialize>(dir: &Path, value: &T) -> Result<PathBuf> {
 /// line and checksum; returns its path and value.
 ///
 /// # Errors
-/// [`Error::Io`] if it cannot be read; [`Error::Scene`] `PATH: not a valid
+/// [`Error::Io`] if it cannot be read; [`Error::Checkpoint`] `PATH: not a valid
 /// checkpoint: …` if it is not one.
 pub fn read_checked<T: DeserializeOwned>(dir: &Path) -> Result<(PathBuf, T)> {
     let path = dir.join(layout::CHECKPOINT);
@@ -134,7 +134,7 @@ pub fn read_checked<T: DeserializeOwned>(dir: &Path) -> Result<(PathBuf, T)> {
 /// the CRC-32 of the scene it belongs to.
 ///
 /// # Errors
-/// [`Error::Scene`] naming what differs.
+/// [`Error::Checkpoint`] naming what differs.
 pub fn check_origin(path: &Path, (engine, version, source_crc32): (&str, &str, u32), want: (&str, u32)) -> Result<()> {
     if engine != want.0 {
         return Err(invalid(
@@ -153,7 +153,7 @@ pub fn check_origin(path: &Path, (engine, version, source_crc32): (&str, &str, u
         ));
     }
     if source_crc32 != want.1 {
-        return Err(Error::Scene(format!(
+        return Err(Error::Checkpoint(format!(
             "{}: the checkpoint was written for another scene; start a fresh run instead of resuming",
             path.display()
         )));

@@ -71,7 +71,7 @@ pub fn checkpoint_to_resume(out: &Path) -> Result<PathBuf> {
     if path.is_file() {
         Ok(path)
     } else {
-        Err(Error::Scene(format!(
+        Err(Error::Checkpoint(format!(
             "resume: no {CHECKPOINT} in '{}' (nothing to continue: start a fresh run)",
             out.display()
         )))
@@ -80,7 +80,7 @@ pub fn checkpoint_to_resume(out: &Path) -> Result<PathBuf> {
 
 /// `PATH: not a valid checkpoint: MSG`, the one-line refusal of a checkpoint at `path`.
 pub fn invalid_checkpoint(path: &Path, msg: impl std::fmt::Display) -> Error {
-    Error::Scene(format!("{}: not a valid checkpoint: {msg}", path.display()))
+    Error::Checkpoint(format!("{}: not a valid checkpoint: {msg}", path.display()))
 }
 
 /// Checks an engine state read from the checkpoint at `path` ([`Engine::check_state`]) and that it is a

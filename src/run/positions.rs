@@ -113,12 +113,12 @@ impl PositionsWriter {
     /// shorter than `cycles` records or their CRC-32 is not `crc` (edited).
     pub fn resume(dir: &Path, reference: Configuration, names: &[String], cycles: u64, crc: u32) -> Result<Self> {
         let invalid =
-            |path: &Path, msg: &str| Error::Scene(format!("not a valid checkpoint: '{}' {msg}", path.display()));
+            |path: &Path, msg: &str| Error::Checkpoint(format!("not a valid checkpoint: '{}' {msg}", path.display()));
         let bodies = dir.join(layout::CYCLE_BODIES);
         let (header, rows): (Vec<String>, Vec<BodyRow>) = match crate::io::table::read(&bodies) {
             Ok(table) => table,
             Err(_) if !bodies.is_file() => return Err(invalid(&bodies, "is missing")),
-            Err(e) => return Err(Error::Scene(format!("not a valid checkpoint: {e}"))),
+            Err(e) => return Err(Error::Checkpoint(format!("not a valid checkpoint: {e}"))),
         };
         let same = header == columns(reference.dof)
             && rows.len() == reference.len()

@@ -180,8 +180,8 @@ impl<E: Engine> Runner<E> {
     /// earlier run are replaced), calling `progress` after every step.
     ///
     /// # Errors
-    /// [`Error::Scene`] for invalid options or an invalid checkpoint
-    /// (`--resume`); [`Error::Io`] naming the file if an output cannot be
+    /// [`Error::Scene`] for invalid options; [`Error::Checkpoint`] for a checkpoint to resume from that is
+    /// refused or missing; [`Error::Io`] naming the file if an output cannot be
     /// written; [`Error::Diverged`] if a step diverges, after the last good
     /// state has been written (`series.csv` row, `final.json`, `summary.json`).
     pub fn run(&self, out: &Path, opts: &RunOptions, progress: &mut dyn FnMut(&Progress)) -> Result<RunOutcome> {

@@ -217,7 +217,8 @@ impl<E: Engine> Accelerated<E> {
     /// stops (with a checkpoint) at the first cycle's end after that many steps.
     ///
     /// # Errors
-    /// [`Error::Scene`] for invalid settings or checkpoint; [`Error::Io`] naming a
+    /// [`Error::Scene`] for invalid settings; [`Error::Checkpoint`] for a refused or missing checkpoint;
+    /// [`Error::Io`] naming a
     /// file; the engine's error if a step or a relaxation fails, after the tables
     /// and `summary.json` (`end: "diverged"`) are written.
     pub fn run(
