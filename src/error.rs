@@ -10,6 +10,17 @@ pub enum Error {
     /// section.
     #[error("{0}")]
     Scene(String),
+    /// An input file (a scene) could not be read: missing, unreadable or not UTF-8. `source` keeps the
+    /// operating system's kind (`NotFound`, `PermissionDenied`, …).
+    #[error("cannot read {what} '{}': {source}", path.display())]
+    File {
+        /// What the file was to be (`scene file`).
+        what: &'static str,
+        /// The path as given.
+        path: std::path::PathBuf,
+        /// Why it could not be read.
+        source: std::io::Error,
+    },
     /// A checkpoint to resume from was refused, or there is none: truncated or edited (checksum), of another
     /// engine, version or scene, a state that does not hold together or is not the scene's model, or counters
     /// that do not match the run's files. The message names the file; nothing was run.

@@ -50,8 +50,8 @@ pub enum Loaded {
 /// recorded text, its system and its `[settlement]` plan, if any.
 ///
 /// # Errors
-/// [`Error::Scene`]: one line naming the file if it cannot be read, or the key of an invalid scene or
-/// override.
+/// [`Error::File`] naming the file if it cannot be read; [`Error::Scene`] (one line naming the key) for an
+/// invalid scene or override.
 pub fn open(path: &Path, opts: &RunOptions) -> Result<Loaded> {
     let text = Scene::read_text(path)?;
     let name = path.display().to_string();

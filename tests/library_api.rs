@@ -485,3 +485,28 @@ fn engines_count_the_force_carrying_contacts_and_size_the_bodies() {
     assert_eq!(sys.contact_counts(&mobile), vec![2, 1]);
     assert_eq!(sys.body_sizes(&mobile), vec![r, 0.5 * r]);
 }
+
+/// The kinds of error a caller can tell apart: a missing scene file is `Error::File` with the operating
+/// system's kind, a refused option names the argument (`Error::Scene`), a missing checkpoint to resume from is
+/// `Error::Checkpoint`.
+#[test]
+fn error_kinds_tell_a_file_an_argument_and_a_checkpoint_apart() {
+    use ballast::run::RunOptions;
+    let missing = std::path::Path::new("examples/no_such_scene.toml");
+    let out = std::env::temp_dir().join(format!("ballast-library-api-{}-kinds", std::process::id()));
+    match ballast::open::run_file(missing, &out, &RunOptions::default(), &mut |_| {}) {
+        Err(Error::File { path, source, .. }) => {
+            assert_eq!((path.as_path(), source.kind()), (missing, std::io::ErrorKind::NotFound));
+        }
+        other => panic!("expected Error::File, got {:?}", other.map(|o| o.step)),
+    }
+    let scene = std::path::Path::new("examples/block_on_floor.toml");
+    let e = ballast::open::run_file(scene, &out, &RunOptions { threads: 0, ..RunOptions::default() }, &mut |_| {})
+        .unwrap_err();
+    assert!(matches!(&e, Error::Scene(m) if m.starts_with("threads:")), "{e}");
+    let _ = std::fs::remove_dir_all(&out);
+    let e = ballast::open::run_file(scene, &out, &RunOptions { resume: true, ..RunOptions::default() }, &mut |_| {})
+        .unwrap_err();
+    assert!(matches!(&e, Error::Checkpoint(m) if m.starts_with("resume: no checkpoint.json")), "{e}");
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -70,7 +70,7 @@ impl From<Error> for Failure {
     /// divergence or an I/O error a run error.
     fn from(e: Error) -> Self {
         match e {
-            Error::Scene(_) | Error::Checkpoint(_) | Error::Geometry(_) => Failure::Input(e),
+            Error::Scene(_) | Error::File { .. } | Error::Checkpoint(_) | Error::Geometry(_) => Failure::Input(e),
             _ => Failure::Run(e),
         }
     }

@@ -110,17 +110,20 @@ impl Scene {
     }
 
     /// Reads, parses and validates the scene file at `path`; syntax errors name
-    /// the file as given. A file that cannot be read is an [`Error::Scene`] too.
+    /// the file as given. A file that cannot be read is an [`Error::File`].
     pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
         let path = path.as_ref();
         Self::from_toml_str_named(&Self::read_text(path)?, &path.display().to_string())
     }
 
-    /// The text of a scene file, with a one-line error naming the file if it cannot be read.
+    /// The text of a scene file, or [`Error::File`] naming it if it cannot be read.
     pub fn read_text(path: impl AsRef<Path>) -> Result<String> {
         let path = path.as_ref();
-        std::fs::read_to_string(path)
-            .map_err(|e| Error::Scene(format!("cannot read scene file '{}': {e}", path.display())))
+        std::fs::read_to_string(path).map_err(|source| Error::File {
+            what: "scene file",
+            path: path.to_path_buf(),
+            source,
+        })
     }
 
     /// Validates a scene built as a value (e.g. by a generator of

@@ -74,7 +74,7 @@ impl MdScene {
     }
 
     /// Reads, parses and validates the MD scene file at `path`; syntax errors name
-    /// the file as given. A file that cannot be read is an [`Error::Scene`] too.
+    /// the file as given. A file that cannot be read is an [`Error::File`].
     pub fn load(path: impl AsRef<Path>) -> Result<MdScene> {
         let path = path.as_ref();
         Self::from_toml_str_named(&Scene::read_text(path)?, &path.display().to_string())
