@@ -72,6 +72,13 @@ impl Error {
     pub fn one_line(&self) -> String {
         self.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
     }
+
+    /// Whether the error is the caller's input (a scene, an argument, a file to read, a checkpoint to resume
+    /// from, a shape) rather than a run that failed: the command line exits with code 2 on it, and a study
+    /// stops on it instead of recording a failed run.
+    pub fn is_input(&self) -> bool {
+        matches!(self, Error::Scene(_) | Error::File { .. } | Error::Checkpoint(_) | Error::Geometry(_))
+    }
 }
 
 /// The crate's result type.

@@ -495,7 +495,9 @@ fn error_kinds_tell_a_file_an_argument_and_a_checkpoint_apart() {
     let missing = std::path::Path::new("examples/no_such_scene.toml");
     let out = std::env::temp_dir().join(format!("ballast-library-api-{}-kinds", std::process::id()));
     match ballast::open::run_file(missing, &out, &RunOptions::default(), &mut |_| {}) {
-        Err(Error::File { path, source, .. }) => {
+        Err(e @ Error::File { .. }) => {
+            assert!(e.is_input());
+            let Error::File { path, source, .. } = e else { unreachable!() };
             assert_eq!((path.as_path(), source.kind()), (missing, std::io::ErrorKind::NotFound));
         }
         other => panic!("expected Error::File, got {:?}", other.map(|o| o.step)),
@@ -503,10 +505,10 @@ fn error_kinds_tell_a_file_an_argument_and_a_checkpoint_apart() {
     let scene = std::path::Path::new("examples/block_on_floor.toml");
     let e = ballast::open::run_file(scene, &out, &RunOptions { threads: 0, ..RunOptions::default() }, &mut |_| {})
         .unwrap_err();
-    assert!(matches!(&e, Error::Scene(m) if m.starts_with("threads:")), "{e}");
+    assert!(matches!(&e, Error::Scene(m) if m.starts_with("threads:")) && e.is_input(), "{e}");
     let _ = std::fs::remove_dir_all(&out);
     let e = ballast::open::run_file(scene, &out, &RunOptions { resume: true, ..RunOptions::default() }, &mut |_| {})
         .unwrap_err();
-    assert!(matches!(&e, Error::Checkpoint(m) if m.starts_with("resume: no checkpoint.json")), "{e}");
+    assert!(matches!(&e, Error::Checkpoint(m) if m.starts_with("resume: no checkpoint.json")) && e.is_input(), "{e}");
     let _ = std::fs::remove_dir_all(&out);
 }

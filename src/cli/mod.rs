@@ -69,9 +69,10 @@ impl From<Error> for Failure {
     /// An invalid scene, option, checkpoint or shape is an input error (exit code 2); a
     /// divergence or an I/O error a run error.
     fn from(e: Error) -> Self {
-        match e {
-            Error::Scene(_) | Error::File { .. } | Error::Checkpoint(_) | Error::Geometry(_) => Failure::Input(e),
-            _ => Failure::Run(e),
+        if e.is_input() {
+            Failure::Input(e)
+        } else {
+            Failure::Run(e)
         }
     }
 }

@@ -172,10 +172,6 @@ impl<E: Engine> Runner<E> {
         &self.plan
     }
 
-    fn source_crc32(&self) -> u32 {
-        self.source.crc32()
-    }
-
     /// Runs into the folder `out` (created if needed; existing output files of an
     /// earlier run are replaced), calling `progress` after every step.
     ///
@@ -411,7 +407,7 @@ impl<E: Engine> Runner<E> {
     /// again (the checkpoint holds the CRC-32 of the scene text: it is the same).
     fn resume(&self, out: &Path) -> Result<Live<E>> {
         let path = folder::checkpoint_to_resume(out)?;
-        let cp = Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source_crc32())?;
+        let cp = Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source.crc32())?;
         let bad = |msg: String| folder::invalid_checkpoint(&path, msg);
         folder::check_resumed(&path, "", &cp.system, &self.system)?;
         let plan = &self.plan;
@@ -506,7 +502,7 @@ impl<E: Engine> Runner<E> {
         Checkpoint {
             version: env!("CARGO_PKG_VERSION").to_string(),
             engine: E::NAME.to_string(),
-            source_crc32: self.source_crc32(),
+            source_crc32: self.source.crc32(),
             first_step: live.first_step,
             step: live.sys.steps_done(),
             series_bytes,

@@ -192,10 +192,6 @@ impl<E: Engine> Accelerated<E> {
         Ok(Self { system, spec, frequency, target, seed: 0, source: Source::Code { json }, model: None, figures: None })
     }
 
-    fn source_crc32(&self) -> u32 {
-        self.source.crc32()
-    }
-
     fn check(&self) -> Result<()> {
         self.spec.check()?;
         if !(self.frequency > 0.0 && self.frequency.is_finite()) {

@@ -480,12 +480,12 @@ pub(crate) fn replica_jobs(jobs: Option<usize>, count: u64) -> Result<usize> {
 }
 
 /// The end of a replica study in `out`: the failed replicas of `results` (one
-/// per replica; a [`Error::Scene`] is returned as it is), each replica's table
+/// per replica; an input error, [`Error::is_input`], is returned as it is), each replica's table
 /// `file` read by `read` (empty when absent), `OUT/settlement_ensemble.csv`
 /// with the seating cycle `seating` and its figure titled `title`.
 ///
 /// # Errors
-/// A replica's [`Error::Scene`]; a table that cannot be read or written.
+/// A replica's input error ([`Error::is_input`]); a table that cannot be read or written.
 pub(crate) fn finish_replicas<T: CycleSettlement>(
     out: &Path,
     results: Vec<Result<()>>,
@@ -499,7 +499,7 @@ pub(crate) fn finish_replicas<T: CycleSettlement>(
     for (r, result) in results.into_iter().enumerate() {
         match result {
             Ok(()) => {}
-            Err(e @ Error::Scene(_)) => return Err(e),
+            Err(e) if e.is_input() => return Err(e),
             Err(e) => failed.push((format!("replica-{r}"), e.one_line())),
         }
         let path = replica_dir(out, r as u64).join(file);

@@ -56,7 +56,7 @@ impl<E: Engine> Accelerated<E> {
         let st = State {
             version: env!("CARGO_PKG_VERSION").into(),
             engine: E::NAME.into(),
-            source_crc32: self.source_crc32(),
+            source_crc32: self.source.crc32(),
             sys: self.system.clone(),
             slot,
             cycle: 0,
@@ -101,7 +101,7 @@ impl<E: Engine> Accelerated<E> {
     pub(super) fn resume(&self, out: &Path) -> Result<(State<E>, Files)> {
         run_folder::checkpoint_to_resume(out)?;
         let (path, st): (PathBuf, State<E>) = read_checked(out)?;
-        check_origin(&path, (&st.engine, &st.version, st.source_crc32), (E::NAME, self.source_crc32()))?;
+        check_origin(&path, (&st.engine, &st.version, st.source_crc32), (E::NAME, self.source.crc32()))?;
         let bad = |msg: String| run_folder::invalid_checkpoint(&path, msg);
         run_folder::check_resumed(&path, "", &st.sys, &self.system)?;
         if let Some(b) = &st.before_jump {

@@ -349,7 +349,7 @@ pub(super) fn run_jobs(
             // Skipped on --resume, but diverged in an earlier invocation (no final scene).
             Ok(()) if !dir.join(layout::FINAL_SCENE).exists() => "failed in an earlier invocation".to_string(),
             Ok(()) => "ok".to_string(),
-            Err(e @ Error::Scene(_)) => return Err(e),
+            Err(e) if e.is_input() => return Err(e),
             // A diverged run still wrote its series and summary: keep it in the study.
             Err(e) => {
                 failed.push((job.label.clone(), e.to_string()));
