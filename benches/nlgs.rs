@@ -11,8 +11,7 @@
 //! and by NLGS to the default `energy` 1.66e-5 (the time a converged solve is to match).
 
 use ballast::nscd::interior::{solve_interior, InteriorOptions, InteriorWorkspace};
-use ballast::nscd::nlgs::{solve_nlgs, solve_nlgs_split, sweep, NlgsSettings};
-use ballast::nscd::split::SplitWorkspace;
+use ballast::nscd::nlgs::{solve_nlgs, solve_nlgs_split, sweep, NlgsSettings, SplitWorkspace};
 use ballast::nscd::{Measure, Policy};
 use ballast::scenarios::saussine::{loaded_scene, LoadingSpec};
 use ballast::scene::Scene;
@@ -57,7 +56,7 @@ fn bench(c: &mut Criterion) {
                 || problem.clone(),
                 |p| {
                     let (u, m, r, s) = (&mut p.u, &p.inv_m, &mut p.rows, &mut p.springs);
-                    black_box(solve_nlgs_split(&settings, &mut ws, threads, &q, u, m, r, s))
+                    black_box(solve_nlgs_split(&settings, &mut ws, threads, |i| q[i][0], u, m, r, s))
                 },
                 BatchSize::LargeInput,
             )

@@ -25,7 +25,8 @@
 //! leaves with `U_N⁺ = −e_n U_N⁻`. Tangentially the Coulomb law acts on
 //! `U_T⁺ + e_t U_T⁻`.
 
-use super::coulomb::Delassus;
+use super::coulomb::{solve, Delassus};
+use super::method::{Row, SweepNorms};
 use crate::geometry::{perp, Vec2};
 use serde::{Deserialize, Serialize};
 
@@ -146,5 +147,95 @@ impl ContactRow {
             shift_t: law.restitution_t * ut_minus,
             mu: law.friction,
         }
+    }
+}
+
+/// Adds `sign · M⁻¹ (h_n ΔP_N + h_t ΔP_T)` to one body's velocity `u` (`im`: its inverse mass).
+#[inline(always)]
+pub(crate) fn apply(u: &mut [f64; 3], im: &[f64; 3], hn: &[f64; 3], dn: f64, ht: &[f64; 3], dt: f64, sign: f64) {
+    for d in 0..3 {
+        u[d] += sign * im[d] * (hn[d] * dn + ht[d] * dt);
+    }
+}
+
+/// The norms of one contact row whose impulse goes from `p` to `q` (N·s) under its local Delassus block `w`
+/// ([`SweepNorms::add`]): `ΔU = W (q − p)`, `P̄ = ½ (p + q)`, and the midpoint averages of `P·WP` and `|WP|²`.
+#[inline(always)]
+pub fn add_contact_norms(norms: &mut SweepNorms, w: Delassus, p: [f64; 2], q: [f64; 2], changed: bool) {
+    let ([pn, pt], [qn, qt]) = (p, q);
+    let (dn, dt) = (qn - pn, qt - pt);
+    let (dun, dut) = (w.nn * dn + w.nt * dt, w.nt * dn + w.tt * dt);
+    let (wpn, wpt) = (w.nn * pn + w.nt * pt, w.nt * pn + w.tt * pt);
+    let (wqn, wqt) = (w.nn * qn + w.nt * qt, w.nt * qn + w.tt * qt);
+    let (mn, mt) = (0.5 * (pn + qn), 0.5 * (pt + qt));
+    let wqq = qn * wqn + qt * wqt;
+    norms.add(
+        dun * dun + dut * dut,
+        mn * mn + mt * mt,
+        mn * dun + mt * dut,
+        0.5 * (pn * wpn + pt * wpt + wqq),
+        0.5 * (wpn * wpn + wpt * wpt + wqn * wqn + wqt * wqt),
+        wqq,
+        changed,
+    );
+}
+
+/// The 2D contact as a row of the NSCD method: Signorini with the gap prediction and restitution thresholds,
+/// and exact Coulomb friction ([`super::coulomb::solve`]), over the 2×2 Delassus block.
+impl Row for ContactRow {
+    type Dofs = [f64; 3];
+
+    #[inline(always)]
+    fn bodies(&self) -> (u32, u32) {
+        (self.a, self.b)
+    }
+
+    #[inline(always)]
+    fn set_bodies(&mut self, a: u32, b: u32) {
+        (self.a, self.b) = (a, b);
+    }
+
+    #[inline(always)]
+    fn take_impulse(&mut self, other: &Self) {
+        self.p = other.p;
+    }
+
+    #[inline(always)]
+    fn add_impulse(&self, u: &mut [[f64; 3]], inv_m: &[[f64; 3]], sign: f64) {
+        let (a, b) = (self.a as usize, self.b as usize);
+        apply(&mut u[a], &inv_m[a], &self.hn_a, self.p[0], &self.ht_a, self.p[1], sign);
+        apply(&mut u[b], &inv_m[b], &self.hn_b, self.p[0], &self.ht_b, self.p[1], -sign);
+    }
+
+    #[inline(always)]
+    fn visit<const UPDATE: bool>(
+        &mut self,
+        u: &mut [[f64; 3]],
+        inv_m: &[[f64; 3]],
+        omega: f64,
+        norms: &mut SweepNorms,
+    ) {
+        let r = self;
+        let (a, b) = (r.a as usize, r.b as usize);
+        let (ua, ub) = (u[a], u[b]);
+        let un = dot3(&r.hn_a, &ua) - dot3(&r.hn_b, &ub);
+        let ut = dot3(&r.ht_a, &ua) - dot3(&r.ht_b, &ub);
+        let w = r.w;
+        let [pn, pt] = r.p;
+        let u0n = un - (w.nn * pn + w.nt * pt);
+        let u0t = ut - (w.nt * pn + w.tt * pt) + r.shift_t;
+        let [mut qn, mut qt] = solve(w, [u0n, u0t], r.s_open, r.c_closed, r.mu);
+        if omega != 1.0 {
+            qn = (pn + omega * (qn - pn)).max(0.0);
+            qt = (pt + omega * (qt - pt)).clamp(-r.mu * qn, r.mu * qn);
+        }
+        let (dn, dt) = (qn - pn, qt - pt);
+        let changed = dn != 0.0 || dt != 0.0;
+        if UPDATE && changed {
+            r.p = [qn, qt];
+            apply(&mut u[a], &inv_m[a], &r.hn_a, dn, &r.ht_a, dt, 1.0);
+            apply(&mut u[b], &inv_m[b], &r.hn_b, dn, &r.ht_b, dt, -1.0);
+        }
+        add_contact_norms(norms, w, [pn, pt], [qn, qt], changed);
     }
 }

@@ -5,8 +5,11 @@
 //!
 //! Data flow of a step: [`stepper`] (θ-method) → [`detection`] ([`broad_phase`]
 //! grid, [`shadow_overlap`] / [`narrow_phase`]) → [`contact`] rows → [`nlgs`]
-//! ([`coulomb`] local solver, [`sublayer`] springs, [`criterion`]; [`split`]:
-//! two halves swept side by side on large problems).
+//! ([`coulomb`] local solver, [`sublayer`] springs). The method of the step's solve
+//! — Gauss–Seidel, its policies ([`criterion`]), the check pass and the split of two
+//! halves swept side by side ([`split`]) — is [`method`], generic over the contact's
+//! dimension; this folder brings the 2D rows and the finishers on the 2D law
+//! ([`apgd`], `interior`).
 //!
 //! A system built in code: [`System::new`] with the parameters
 //! ([`NscdParams::default`]: θ = 1/2, g = 9.81 m/s² down, the scenes' NLGS
@@ -42,13 +45,12 @@
 pub mod apgd;
 pub mod contact;
 pub mod coulomb;
-pub mod criterion;
 pub mod engine;
 #[cfg(feature = "faer")]
 pub mod interior;
 pub mod measure;
+pub mod method;
 pub mod nlgs;
-pub mod split;
 pub mod stepper;
 pub mod sublayer;
 pub mod system;
@@ -56,6 +58,8 @@ pub mod system;
 // The bodies, loads and detection shared with the 2D MD engine ([`crate::plane`]),
 // under their former paths.
 pub use crate::plane::{bodies, broad_phase, detection, loads, narrow_phase, relax, shadow_overlap};
+// The method's convergence policies and split, under their former paths.
+pub use method::{criterion, split};
 
 pub use bodies::{Bodies, BodyInfo};
 pub use contact::ContactLaw;

@@ -115,7 +115,7 @@ impl System {
                 settings,
                 &mut ws.split,
                 ws.threads,
-                &ws.q_m,
+                |i| ws.q_m[i][0],
                 &mut self.bodies.u,
                 &self.bodies.inv_m,
                 &mut ws.rows,

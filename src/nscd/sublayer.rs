@@ -13,6 +13,8 @@
 //! trapezoidal rule (no numerical damping); any stiffness is stable.
 //! A `compression_only` spring's impulse is clamped to `P ≥ 0`.
 
+use super::contact::{apply, dot3};
+use super::method::{Row, SweepNorms};
 pub use crate::plane::springs::Spring;
 
 /// The solver's record of one spring.
@@ -87,5 +89,76 @@ impl SpringRow {
         } else {
             p
         }
+    }
+}
+
+/// The sublayer spring as a row of the NSCD method: its affine law (17), solved exactly ([`SpringRow::solve`]).
+impl Row for SpringRow {
+    type Dofs = [f64; 3];
+
+    #[inline(always)]
+    fn bodies(&self) -> (u32, u32) {
+        (self.a, self.b)
+    }
+
+    #[inline(always)]
+    fn set_bodies(&mut self, a: u32, b: u32) {
+        (self.a, self.b) = (a, b);
+    }
+
+    #[inline(always)]
+    fn take_impulse(&mut self, other: &Self) {
+        self.p = other.p;
+    }
+
+    #[inline(always)]
+    fn add_impulse(&self, u: &mut [[f64; 3]], inv_m: &[[f64; 3]], sign: f64) {
+        apply(&mut u[self.a as usize], &inv_m[self.a as usize], &self.hn_a, self.p, &[0.0; 3], 0.0, sign);
+        if self.b != u32::MAX {
+            apply(&mut u[self.b as usize], &inv_m[self.b as usize], &self.hn_b, self.p, &[0.0; 3], 0.0, -sign);
+        }
+    }
+
+    #[inline(always)]
+    fn visit<const UPDATE: bool>(
+        &mut self,
+        u: &mut [[f64; 3]],
+        inv_m: &[[f64; 3]],
+        omega: f64,
+        norms: &mut SweepNorms,
+    ) {
+        let s = self;
+        let (a, b) = (s.a as usize, s.b as usize);
+        let mut un = dot3(&s.hn_a, &u[a]);
+        if s.b != u32::MAX {
+            un -= dot3(&s.hn_b, &u[b]);
+        }
+        let mut p = s.solve(un - s.w * s.p);
+        if omega != 1.0 {
+            p = s.p + omega * (p - s.p);
+            if s.compression_only {
+                p = p.max(0.0);
+            }
+        }
+        let dp = p - s.p;
+        if UPDATE && dp != 0.0 {
+            s.p = p;
+            apply(&mut u[a], &inv_m[a], &s.hn_a, dp, &[0.0; 3], 0.0, 1.0);
+            if s.b != u32::MAX {
+                apply(&mut u[b], &inv_m[b], &s.hn_b, dp, &[0.0; 3], 0.0, -1.0);
+            }
+        }
+        let (p_old, du) = (p - dp, s.w * dp);
+        let pm = 0.5 * (p_old + p);
+        let (wp_old, wp) = (s.w * p_old, s.w * p);
+        norms.add(
+            du * du,
+            pm * pm,
+            pm * du,
+            0.5 * (p_old * wp_old + p * wp),
+            0.5 * (wp_old * wp_old + wp * wp),
+            p * wp,
+            dp != 0.0,
+        );
     }
 }

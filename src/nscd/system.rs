@@ -122,7 +122,7 @@ pub(crate) struct Workspace {
     pub geoms: Vec<ContactGeom>,
     pub spring_rows: Vec<SpringRow>,
     pub detector: Detector,
-    pub split: super::split::SplitWorkspace,
+    pub split: super::nlgs::SplitWorkspace,
     /// Buffers of the accelerated solver ([`super::apgd`]).
     pub apgd: super::apgd::ApgdWorkspace,
     /// Buffers of the interior-point solver (`super::interior`).

@@ -13,7 +13,7 @@
 //! its own copy of them.
 //!
 //! Each part owns its velocities (`[its mobile bodies | fixed bodies]`) and its
-//! rows with renumbered body indices, so the plain [`super::nlgs::sweep`] runs
+//! rows with renumbered body indices, so the plain [`super::gauss_seidel::sweep`] runs
 //! on it. Between two sweeps the interface bodies' velocities are gathered from
 //! the halves and scattered back. The order of the updates (left rows, right
 //! rows, interface rows, each in key order) depends on the positions only,
@@ -26,10 +26,9 @@
 //!
 //! Nothing is allocated once the buffers have grown to the problem's size.
 
-use super::contact::ContactRow;
 use super::criterion::SweepNorms;
-use super::nlgs::{pass, Pass};
-use super::sublayer::SpringRow;
+use super::gauss_seidel::{pass, Pass};
+use super::Row;
 use crate::team::Team;
 
 const LEFT: u8 = 0;
@@ -38,12 +37,12 @@ const FIXED: u8 = 2;
 const NONE: u32 = u32::MAX;
 
 /// One part of the split problem, with its own velocities and rows.
-#[derive(Debug, Clone, Default)]
-struct Part {
-    u: Vec<[f64; 3]>,
-    inv_m: Vec<[f64; 3]>,
-    rows: Vec<ContactRow>,
-    springs: Vec<SpringRow>,
+#[derive(Debug, Clone)]
+struct Part<R: Row, S: Row<Dofs = R::Dofs>> {
+    u: Vec<R::Dofs>,
+    inv_m: Vec<R::Dofs>,
+    rows: Vec<R>,
+    springs: Vec<S>,
     /// Original index of each row and spring.
     row_of: Vec<u32>,
     spring_of: Vec<u32>,
@@ -51,7 +50,21 @@ struct Part {
     body_of: Vec<u32>,
 }
 
-impl Part {
+impl<R: Row, S: Row<Dofs = R::Dofs>> Default for Part<R, S> {
+    fn default() -> Self {
+        Self {
+            u: Vec::new(),
+            inv_m: Vec::new(),
+            rows: Vec::new(),
+            springs: Vec::new(),
+            row_of: Vec::new(),
+            spring_of: Vec::new(),
+            body_of: Vec::new(),
+        }
+    }
+}
+
+impl<R: Row, S: Row<Dofs = R::Dofs>> Part<R, S> {
     fn pass(&mut self, kind: Pass) -> SweepNorms {
         pass(kind, &mut self.u, &self.inv_m, &mut self.rows, &mut self.springs)
     }
@@ -67,20 +80,36 @@ impl Part {
     }
 }
 
-/// Buffers of the split solve, kept from step to step.
-#[derive(Debug, Clone, Default)]
-pub struct SplitWorkspace {
+/// Buffers of the split solve of contact rows `R` and spring rows `S`, kept from step to step.
+#[derive(Debug, Clone)]
+pub struct SplitWorkspace<R: Row, S: Row<Dofs = R::Dofs>> {
     /// Per body: side, and slot in its part (interface slot in `iface_slot`).
     side: Vec<u8>,
     slot: Vec<u32>,
     iface_slot: Vec<u32>,
     xs: Vec<f64>,
     fixed: Vec<u32>,
-    left: Part,
-    right: Part,
-    iface: Part,
+    left: Part<R, S>,
+    right: Part<R, S>,
+    iface: Part<R, S>,
     /// The caller and, with two threads, the helper that sweeps the right half.
     team: Team,
+}
+
+impl<R: Row, S: Row<Dofs = R::Dofs>> Default for SplitWorkspace<R, S> {
+    fn default() -> Self {
+        Self {
+            side: Vec::new(),
+            slot: Vec::new(),
+            iface_slot: Vec::new(),
+            xs: Vec::new(),
+            fixed: Vec::new(),
+            left: Part::default(),
+            right: Part::default(),
+            iface: Part::default(),
+            team: Team::default(),
+        }
+    }
 }
 
 /// Sums and maxima of two partial sweeps.
@@ -109,20 +138,21 @@ fn part_of(side: &[u8], a: u32, b: u32) -> usize {
     }
 }
 
-impl SplitWorkspace {
-    /// Splits the problem: bodies at abscissae `q[i][0]`, velocities `u`.
+impl<R: Row, S: Row<Dofs = R::Dofs>> SplitWorkspace<R, S> {
+    /// Splits the problem: body `i` at abscissa `abscissa(i)`, velocities `u`.
     pub(crate) fn load(
         &mut self,
-        q: &[[f64; 3]],
-        u: &[[f64; 3]],
-        inv_m: &[[f64; 3]],
-        rows: &[ContactRow],
-        springs: &[SpringRow],
+        abscissa: impl Fn(usize) -> f64,
+        u: &[R::Dofs],
+        inv_m: &[R::Dofs],
+        rows: &[R],
+        springs: &[S],
     ) {
         let n = u.len();
-        let mobile = |i: usize| inv_m[i] != [0.0; 3];
+        let still = R::Dofs::default();
+        let mobile = |i: usize| inv_m[i] != still;
         self.xs.clear();
-        self.xs.extend((0..n).filter(|&i| mobile(i)).map(|i| q[i][0]));
+        self.xs.extend((0..n).filter(|&i| mobile(i)).map(&abscissa));
         let median = if self.xs.is_empty() {
             0.0
         } else {
@@ -135,13 +165,13 @@ impl SplitWorkspace {
         self.left.clear();
         self.right.clear();
         self.iface.clear();
-        for (i, qi) in q.iter().enumerate().take(n) {
+        for i in 0..n {
             let (side, part) = if !mobile(i) {
                 self.slot.push(self.fixed.len() as u32);
                 self.fixed.push(i as u32);
                 self.side.push(FIXED);
                 continue;
-            } else if qi[0] < median {
+            } else if abscissa(i) < median {
                 (LEFT, &mut self.left)
             } else {
                 (RIGHT, &mut self.right)
@@ -154,18 +184,15 @@ impl SplitWorkspace {
         self.iface_slot.clear();
         self.iface_slot.resize(n, NONE);
         let iface_body = |i: u32, slot: &mut Vec<u32>, body_of: &mut Vec<u32>| {
-            if i != NONE && inv_m[i as usize] != [0.0; 3] && slot[i as usize] == NONE {
+            if i != NONE && inv_m[i as usize] != still && slot[i as usize] == NONE {
                 slot[i as usize] = body_of.len() as u32;
                 body_of.push(i);
             }
         };
-        for r in rows.iter().filter(|r| part_of(&self.side, r.a, r.b) == 2) {
-            iface_body(r.a, &mut self.iface_slot, &mut self.iface.body_of);
-            iface_body(r.b, &mut self.iface_slot, &mut self.iface.body_of);
-        }
-        for s in springs.iter().filter(|s| part_of(&self.side, s.a, s.b) == 2) {
-            iface_body(s.a, &mut self.iface_slot, &mut self.iface.body_of);
-            iface_body(s.b, &mut self.iface_slot, &mut self.iface.body_of);
+        let bodies = rows.iter().map(R::bodies).chain(springs.iter().map(S::bodies));
+        for (a, b) in bodies.filter(|&(a, b)| part_of(&self.side, a, b) == 2) {
+            iface_body(a, &mut self.iface_slot, &mut self.iface.body_of);
+            iface_body(b, &mut self.iface_slot, &mut self.iface.body_of);
         }
         // Velocities: each part's mobile bodies, then a copy of the fixed ones.
         let fixed = &self.fixed;
@@ -177,24 +204,26 @@ impl SplitWorkspace {
         }
         // Rows, renumbered into their part, in their original order.
         for (k, r) in rows.iter().enumerate() {
-            let p = part_of(&self.side, r.a, r.b);
+            let (a, b) = r.bodies();
+            let p = part_of(&self.side, a, b);
             let mut r = *r;
-            (r.a, r.b) = (self.index(r.a, p), self.index(r.b, p));
+            r.set_bodies(self.index(a, p), self.index(b, p));
             let part = self.part_mut(p);
             part.rows.push(r);
             part.row_of.push(k as u32);
         }
         for (k, s) in springs.iter().enumerate() {
-            let p = part_of(&self.side, s.a, s.b);
+            let (a, b) = s.bodies();
+            let p = part_of(&self.side, a, b);
             let mut s = *s;
-            (s.a, s.b) = (self.index(s.a, p), self.index(s.b, p));
+            s.set_bodies(self.index(a, p), self.index(b, p));
             let part = self.part_mut(p);
             part.springs.push(s);
             part.spring_of.push(k as u32);
         }
     }
 
-    fn part_mut(&mut self, p: usize) -> &mut Part {
+    fn part_mut(&mut self, p: usize) -> &mut Part<R, S> {
         match p {
             0 => &mut self.left,
             1 => &mut self.right,
@@ -217,7 +246,14 @@ impl SplitWorkspace {
     }
 
     /// Copies the interface bodies' velocities from the halves (`to_iface`) or back.
-    fn exchange(left: &mut Part, right: &mut Part, iface: &mut Part, side: &[u8], slot: &[u32], to_iface: bool) {
+    fn exchange(
+        left: &mut Part<R, S>,
+        right: &mut Part<R, S>,
+        iface: &mut Part<R, S>,
+        side: &[u8],
+        slot: &[u32],
+        to_iface: bool,
+    ) {
         for (k, &i) in iface.body_of.iter().enumerate() {
             let half = if side[i as usize] == LEFT { &mut *left } else { &mut *right };
             let j = slot[i as usize] as usize;
@@ -231,7 +267,7 @@ impl SplitWorkspace {
 
     /// Runs `sweeps` with a function doing one split sweep (on one thread, or on
     /// two when `threads ≥ 2`), then nothing more: call [`Self::store`] after.
-    pub(crate) fn run<R>(&mut self, threads: usize, sweeps: impl FnOnce(&mut dyn FnMut(Pass) -> SweepNorms) -> R) -> R {
+    pub(crate) fn run<T>(&mut self, threads: usize, sweeps: impl FnOnce(&mut dyn FnMut(Pass) -> SweepNorms) -> T) -> T {
         if (threads >= 2) != (self.team.threads() >= 2) {
             self.team = Team::new(threads);
         }
@@ -257,7 +293,7 @@ impl SplitWorkspace {
     }
 
     /// Writes the velocities and impulses back in the caller's order.
-    pub(crate) fn store(&self, u: &mut [[f64; 3]], rows: &mut [ContactRow], springs: &mut [SpringRow]) {
+    pub(crate) fn store(&self, u: &mut [R::Dofs], rows: &mut [R], springs: &mut [S]) {
         for part in [&self.left, &self.right] {
             for (&i, ui) in part.body_of.iter().zip(&part.u) {
                 u[i as usize] = *ui;
@@ -265,10 +301,10 @@ impl SplitWorkspace {
         }
         for part in [&self.left, &self.right, &self.iface] {
             for (r, &k) in part.rows.iter().zip(&part.row_of) {
-                rows[k as usize].p = r.p;
+                rows[k as usize].take_impulse(r);
             }
             for (s, &k) in part.springs.iter().zip(&part.spring_of) {
-                springs[k as usize].p = s.p;
+                springs[k as usize].take_impulse(s);
             }
         }
     }

@@ -177,29 +177,6 @@ impl SweepNorms {
         self.sum_wrwr += wrwr;
     }
 
-    /// Adds one contact row whose impulse goes from `p` to `q` (N·s) under its local
-    /// Delassus block `w`: `ΔU = W (q − p)`, `P̄ = ½ (p + q)`, and the midpoint
-    /// averages of `P·WP` and `|WP|²`.
-    #[inline(always)]
-    pub fn add_contact(&mut self, w: super::coulomb::Delassus, p: [f64; 2], q: [f64; 2], changed: bool) {
-        let ([pn, pt], [qn, qt]) = (p, q);
-        let (dn, dt) = (qn - pn, qt - pt);
-        let (dun, dut) = (w.nn * dn + w.nt * dt, w.nt * dn + w.tt * dt);
-        let (wpn, wpt) = (w.nn * pn + w.nt * pt, w.nt * pn + w.tt * pt);
-        let (wqn, wqt) = (w.nn * qn + w.nt * qt, w.nt * qn + w.tt * qt);
-        let (mn, mt) = (0.5 * (pn + qn), 0.5 * (pt + qt));
-        let wqq = qn * wqn + qt * wqt;
-        self.add(
-            dun * dun + dut * dut,
-            mn * mn + mt * mt,
-            mn * dun + mt * dut,
-            0.5 * (pn * wpn + pt * wpt + wqq),
-            0.5 * (wpn * wpn + wpt * wpt + wqn * wqn + wqt * wqt),
-            wqq,
-            changed,
-        );
-    }
-
     /// `(QuadDV, MaxmDV, QuadDVR, MaxmDVR, MeanDVoR)`; all zero when no impulse changed
     /// or no row carries an impulse, infinite if the scales vanish while impulses change.
     pub fn norms(&self) -> [f64; 5] {
