@@ -15,8 +15,8 @@
 
 use super::apgd::{solve_apgd_with, ApgdOptions};
 use super::contact::ContactRow;
-use super::nlgs::{apply_impulses, solve_nlgs_split, NlgsSettings, OnStall, Solver};
-use super::system::{StepStats, System};
+use super::nlgs::{apply_impulses, solve_nlgs_split, NlgsReport, NlgsSettings, OnStall, Solver};
+use super::system::{StepStats, System, Workspace};
 use crate::error::{Error, Result};
 use crate::geometry::Vec2;
 
@@ -29,7 +29,6 @@ impl System {
         }
         let h = self.params.dt;
         let theta = self.params.theta;
-        let n = self.bodies.len();
         let t_f = self.origin.time_at(self.step + 1, h);
         let t_m = t_f - theta * h;
         let mut ws = std::mem::take(&mut self.ws);
@@ -48,7 +47,72 @@ impl System {
         if let Some(i) = ws.q_m.iter().position(|q| q.iter().any(|x| !x.is_finite() || x.abs() > 1e12)) {
             return Err(self.roll_back(ws, i, "non-finite or runaway position".into()));
         }
-        // 2. Detection.
+        // 2. Detection, contact and spring rows at q_m.
+        self.build_rows(&mut ws, h, theta, v_max);
+
+        // 3. Free velocity.
+        self.free_velocity(h, t_m, t_f);
+
+        // 4. The step's solve.
+        let report = self.solve(&mut ws);
+        if !report.converged && self.params.nlgs.on_stall == OnStall::Stop {
+            self.restore_start(ws);
+            return Err(Error::Stalled {
+                step: self.step + 1,
+                iterations: report.iterations,
+                criterion: report.criterion,
+                tolerance: self.params.nlgs.tolerance,
+            });
+        }
+
+        // 5. Final configuration.
+        for ((q, qm), u) in self.bodies.q.iter_mut().zip(&ws.q_m).zip(&self.bodies.u) {
+            for d in 0..3 {
+                q[d] = qm[d] + theta * h * u[d];
+            }
+        }
+
+        // Statistics and sanity checks.
+        let (stats, failure) = self.statistics(&ws, &report, t_f, h, theta);
+        if let Some((body, what)) = failure {
+            return Err(self.roll_back(ws, body, what));
+        }
+
+        // Keep the contacts and impulses for the next warm start.
+        self.contacts.clear();
+        self.contacts.extend_from_slice(&ws.geoms);
+        self.impulses.clear();
+        self.impulses.extend(ws.rows.iter().map(|r| r.p));
+        for (s, row) in self.springs.iter_mut().zip(&ws.spring_rows) {
+            s.impulse = row.p;
+        }
+        self.time = t_f;
+        self.step += 1;
+        self.ws = ws;
+        Ok(stats)
+    }
+
+    /// Puts the bodies back at the start of the step and the workspace in place.
+    fn restore_start(&mut self, ws: Workspace) {
+        self.bodies.q.clone_from(&ws.q_i);
+        self.bodies.u.clone_from(&ws.u_i);
+        self.ws = ws;
+    }
+
+    /// Restores the state of the start of the failed step and names the culprit.
+    fn roll_back(&mut self, ws: Workspace, body: usize, what: String) -> Error {
+        self.restore_start(ws);
+        Error::Diverged { step: self.step + 1, body, name: self.bodies.info[body].name.clone(), what }
+    }
+}
+
+/// The stages of a step, in the order [`System::step`] calls them (`ws` is the workspace, taken out of the
+/// system for the step).
+impl System {
+    /// Stage 2: detection at `q_m` within the alert distance (at least the distance covered in two steps at the
+    /// largest speed `v_max`), the contact rows with their frames, Delassus blocks and thresholds, warm-started
+    /// with the impulses of the previous step matched by contact key, and the sublayer springs' rows.
+    fn build_rows(&self, ws: &mut Workspace, h: f64, theta: f64, v_max: f64) {
         let alert = self.params.alert_distance.max(2.0 * h * v_max);
         ws.detector.run(&self.bodies, &ws.q_m, alert);
         ws.rows.clear();
@@ -83,8 +147,12 @@ impl System {
         for s in &self.springs {
             ws.spring_rows.push(s.row((&ws.q_i, &ws.u_i), &ws.q_m, &self.bodies.inv_m, h, theta));
         }
+    }
 
-        // 3. Free velocity.
+    /// Stage 3: `u_free = u_i + h M⁻¹ F(q_m, t_m)` (gravity and the loads at `t_m`); imposed velocity
+    /// components take their value at `t_f`.
+    fn free_velocity(&mut self, h: f64, t_m: f64, t_f: f64) {
+        let n = self.bodies.len();
         let g = self.params.gravity;
         for i in 0..n {
             let info = &self.bodies.info[i];
@@ -106,11 +174,13 @@ impl System {
                 }
             }
         }
+    }
 
-        // 4. NLGS.
+    /// Stage 4: the step's problem solved by the scene's solver, from `u_free` plus the warm-start impulses.
+    fn solve(&mut self, ws: &mut Workspace) -> NlgsReport {
         apply_impulses(&mut self.bodies.u, &self.bodies.inv_m, &ws.rows, &ws.spring_rows);
         let settings = &self.params.nlgs;
-        let report = match settings.solver {
+        match settings.solver {
             Solver::Nlgs => solve_nlgs_split(
                 settings,
                 &mut ws.split,
@@ -150,29 +220,22 @@ impl System {
             // `params.check` (the first thing a step does) refuses a solver this build
             // does not have, so this arm is never taken.
             #[cfg(not(feature = "faer"))]
-            Solver::InteriorPoint => {
-                super::nlgs::NlgsReport { iterations: 0, criterion: f64::INFINITY, converged: false }
-            }
-        };
-
-        if !report.converged && self.params.nlgs.on_stall == OnStall::Stop {
-            self.restore_start(ws);
-            return Err(Error::Stalled {
-                step: self.step + 1,
-                iterations: report.iterations,
-                criterion: report.criterion,
-                tolerance: self.params.nlgs.tolerance,
-            });
+            Solver::InteriorPoint => NlgsReport { iterations: 0, criterion: f64::INFINITY, converged: false },
         }
+    }
 
-        // 5. Final configuration.
-        for ((q, qm), u) in self.bodies.q.iter_mut().zip(&ws.q_m).zip(&self.bodies.u) {
-            for d in 0..3 {
-                q[d] = qm[d] + theta * h * u[d];
-            }
-        }
-
-        // Statistics and sanity checks.
+    /// The step's statistics at `q_f` and the first failure found (the body to name and what went wrong): a
+    /// runaway overlap (beyond half the smaller inradius of the pair), a non-finite state, a crushed spring, a
+    /// body beyond the scene's bounds or a kinetic energy overflow.
+    fn statistics(
+        &self,
+        ws: &Workspace,
+        report: &NlgsReport,
+        t_f: f64,
+        h: f64,
+        theta: f64,
+    ) -> (StepStats, Option<(usize, String)>) {
+        let n = self.bodies.len();
         let mut stats = StepStats {
             time: t_f,
             step: self.step + 1,
@@ -228,34 +291,6 @@ impl System {
             let i = (0..n).max_by(|&a, &b| speed(a).total_cmp(&speed(b))).unwrap_or(0);
             failure = Some((i, "kinetic energy overflow".to_string()));
         }
-        if let Some((body, what)) = failure {
-            return Err(self.roll_back(ws, body, what));
-        }
-
-        // Keep the contacts and impulses for the next warm start.
-        self.contacts.clear();
-        self.contacts.extend_from_slice(&ws.geoms);
-        self.impulses.clear();
-        self.impulses.extend(ws.rows.iter().map(|r| r.p));
-        for (s, row) in self.springs.iter_mut().zip(&ws.spring_rows) {
-            s.impulse = row.p;
-        }
-        self.time = t_f;
-        self.step += 1;
-        self.ws = ws;
-        Ok(stats)
-    }
-
-    /// Puts the bodies back at the start of the step and the workspace in place.
-    fn restore_start(&mut self, ws: super::system::Workspace) {
-        self.bodies.q.clone_from(&ws.q_i);
-        self.bodies.u.clone_from(&ws.u_i);
-        self.ws = ws;
-    }
-
-    /// Restores the state of the start of the failed step and names the culprit.
-    fn roll_back(&mut self, ws: super::system::Workspace, body: usize, what: String) -> Error {
-        self.restore_start(ws);
-        Error::Diverged { step: self.step + 1, body, name: self.bodies.info[body].name.clone(), what }
+        (stats, failure)
     }
 }
