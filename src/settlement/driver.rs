@@ -223,23 +223,7 @@ impl<E: Engine> Accelerated<E> {
         opts: &RunOptions,
         progress: &mut dyn FnMut(&AccelerationProgress),
     ) -> Result<AccelerationOutcome<E>> {
-        self.check()?;
-        crate::run::check_options(opts)?;
-        crate::run::check_built(opts)?;
-        if opts.vtk_every > 0 {
-            return Err(Error::Scene(format!(
-                "vtk_every: an accelerated run writes no snapshots (its extrapolated cycles have no steps); got \
-                 {}, use 0",
-                opts.vtk_every
-            )));
-        }
-        if opts.figures && self.figures.is_none() {
-            return Err(Error::Scene(
-                "figures: this run has no figure drawer (a run of a scene file draws them; a system built in \
-                 code draws them after the run with ballast::report::settlement::draw)"
-                    .into(),
-            ));
-        }
+        self.check_run(opts)?;
         let (mut st, mut files) = if opts.resume { self.resume(out)? } else { self.start(out)? };
         st.sys.set_threads(opts.threads.max(1));
         let law = self.spec.law.estimator();
@@ -250,104 +234,20 @@ impl<E: Engine> Accelerated<E> {
         let mut checkpointed = Instant::now();
         let mut end = "finished";
         let mut failure = None;
-        let vertical = E::DIM - 1;
-        let per_cycle = (1.0 / (self.frequency * st.sys.dt())).ceil() as u64 + 2;
         while st.cycle < self.target {
-            // One computed cycle.
-            let before = cycles_at(st.sys.time(), self.frequency, st.sys.dt());
-            let mut made = 0;
-            let mut last = None;
-            while cycles_at(st.sys.time(), self.frequency, st.sys.dt()) == before {
-                stepped += 1;
-                match st.sys.step() {
-                    Ok(stats) => last = Some(stats),
-                    Err(e) => {
-                        failure = Some(e);
-                        break;
-                    }
-                }
-                made += 1;
-                if made > per_cycle {
-                    failure = Some(Error::Scene(format!(
-                        "settlement: {made} steps did not close cycle {} (frequency {} Hz, dt {} s)",
-                        before + 1,
-                        self.frequency,
-                        st.sys.dt()
-                    )));
-                    break;
-                }
-            }
-            let mut c = None;
-            if failure.is_none() {
-                // The largest overlap at the cycle's end (a jump's relaxation target).
-                if let Some(stats) = last {
-                    st.computed_overlap = E::summary(&stats).max_overlap;
-                }
-                st.cycle += 1;
-                st.computed += 1;
-                let conf = st.sys.configuration();
-                match check_domain(&st.sys, &st.origin, &conf, || format!("computed cycle {}", st.cycle)) {
-                    Ok(()) => c = Some(conf),
-                    Err(e) => failure = Some(e),
-                }
-            }
-            let Some(c) = c else {
+            let c = match self.computed_cycle(&mut st, &mut stepped) {
+                Ok(c) => c,
                 // A failure while a landing is on probation rolls it back.
-                let e = failure.take().expect("a cycle without its configuration failed");
-                match self.recover(&mut st, law, &mut files, out, e, (wall0, &started)) {
+                Err(e) => match self.recover(&mut st, law, &mut files, out, e, (wall0, &started)) {
                     Ok(()) => continue,
                     Err(e) => {
                         failure = Some(e);
                         end = "diverged";
                         break;
                     }
-                }
+                },
             };
-            let bounds = st.sys.boundaries();
-            let s = st.settlement(&c, &bounds, vertical, self.spec.settlement_boundary);
-            let b = coordinates(&bounds);
-            let increment = s - st.last_settlement;
-            st.last_settlement = s;
-            if let Some(p) = files.positions.as_mut() {
-                p.append(&c)?;
-            }
-            files.rows.write(&SettlementRow {
-                cycle: st.cycle,
-                computed: 1,
-                settlement_m: s,
-                coordination: Some(st.sys.coordination()),
-                max_overlap_before_relax_m: None,
-                max_overlap_after_relax_m: None,
-                wall_time_s: wall0 + started.elapsed().as_secs_f64(),
-            })?;
-            // The history starts at the end of the initial cycles (empty until then:
-            // `start`; with none, it holds cycle 0).
-            if st.cycle >= self.spec.initial_cycles {
-                // After a jump the first `settle_cycles − 1` computed cycles are
-                // not data (the landing re-seats in them), nor, with
-                // `settle_rate`, the next ones while the settlement still runs
-                // ahead of the landing's rate; the next one starts a new segment.
-                let after_jump = (st.jumps > 0).then_some(st.since_jump + 1);
-                let extra = after_jump == Some(self.spec.settle_cycles) && self.still_settling(&st, increment);
-                match after_jump {
-                    Some(n) if n < self.spec.settle_cycles || extra => st.settling += 1,
-                    _ => {
-                        if after_jump == Some(self.spec.settle_cycles) {
-                            st.window.push_segment(st.cycle as f64, c);
-                        } else {
-                            st.window.push(st.cycle as f64, c);
-                        }
-                        st.window_settlement.push(s);
-                        st.window_boundaries.push(b);
-                    }
-                }
-                if st.cycle > self.spec.initial_cycles && !extra {
-                    st.since_jump += 1;
-                }
-            }
-            if st.jumps > 0 {
-                st.last_increment = Some(increment);
-            }
+            self.record_cycle(&mut st, &mut files, c, wall0 + started.elapsed().as_secs_f64())?;
             // A jump when the window is long enough and cycles are left.
             if let Err(e) = self.attempt_jump(&mut st, law, &mut files, out, wall0, &started) {
                 failure = Some(e);
@@ -376,6 +276,129 @@ impl<E: Engine> Accelerated<E> {
             }
         }
         st.wall_time_s = wall0 + started.elapsed().as_secs_f64();
+        let summary = self.finish(out, opts, &mut st, files, end)?;
+        if let Some(e) = failure {
+            return Err(e);
+        }
+        Ok(AccelerationOutcome { summary, system: st.sys, out: out.to_path_buf() })
+    }
+
+    /// The run options an accelerated run honours, or the one it refuses, named.
+    fn check_run(&self, opts: &RunOptions) -> Result<()> {
+        self.check()?;
+        crate::run::check_options(opts)?;
+        crate::run::check_built(opts)?;
+        if opts.vtk_every > 0 {
+            return Err(Error::Scene(format!(
+                "vtk_every: an accelerated run writes no snapshots (its extrapolated cycles have no steps); got \
+                 {}, use 0",
+                opts.vtk_every
+            )));
+        }
+        if opts.figures && self.figures.is_none() {
+            return Err(Error::Scene(
+                "figures: this run has no figure drawer (a run of a scene file draws them; a system built in \
+                 code draws them after the run with ballast::report::settlement::draw)"
+                    .into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// One computed cycle: steps until the engine's clock closes the loading cycle (counted in `stepped`);
+    /// returns the configuration at its end, checked, or the failure (a step's, a cycle that does not close, a
+    /// body out of the domain).
+    fn computed_cycle(&self, st: &mut State<E>, stepped: &mut u64) -> Result<Configuration> {
+        let per_cycle = (1.0 / (self.frequency * st.sys.dt())).ceil() as u64 + 2;
+        let before = cycles_at(st.sys.time(), self.frequency, st.sys.dt());
+        let mut made = 0;
+        let mut last = None;
+        while cycles_at(st.sys.time(), self.frequency, st.sys.dt()) == before {
+            *stepped += 1;
+            last = Some(st.sys.step()?);
+            made += 1;
+            if made > per_cycle {
+                return Err(Error::Scene(format!(
+                    "settlement: {made} steps did not close cycle {} (frequency {} Hz, dt {} s)",
+                    before + 1,
+                    self.frequency,
+                    st.sys.dt()
+                )));
+            }
+        }
+        // The largest overlap at the cycle's end (a jump's relaxation target).
+        if let Some(stats) = last {
+            st.computed_overlap = E::summary(&stats).max_overlap;
+        }
+        st.cycle += 1;
+        st.computed += 1;
+        let conf = st.sys.configuration();
+        check_domain(&st.sys, &st.origin, &conf, || format!("computed cycle {}", st.cycle))?;
+        Ok(conf)
+    }
+
+    /// Records a computed cycle ending on `c`: its settlement row (and positions), and its place in the fit's
+    /// window (a point, a new segment's first point after a landing, or a landing's re-seating cycle).
+    fn record_cycle(&self, st: &mut State<E>, files: &mut Files, c: Configuration, wall_time_s: f64) -> Result<()> {
+        let vertical = E::DIM - 1;
+        let bounds = st.sys.boundaries();
+        let s = st.settlement(&c, &bounds, vertical, self.spec.settlement_boundary);
+        let b = coordinates(&bounds);
+        let increment = s - st.last_settlement;
+        st.last_settlement = s;
+        if let Some(p) = files.positions.as_mut() {
+            p.append(&c)?;
+        }
+        files.rows.write(&SettlementRow {
+            cycle: st.cycle,
+            computed: 1,
+            settlement_m: s,
+            coordination: Some(st.sys.coordination()),
+            max_overlap_before_relax_m: None,
+            max_overlap_after_relax_m: None,
+            wall_time_s,
+        })?;
+        // The history starts at the end of the initial cycles (empty until then:
+        // `start`; with none, it holds cycle 0).
+        if st.cycle >= self.spec.initial_cycles {
+            // After a jump the first `settle_cycles − 1` computed cycles are
+            // not data (the landing re-seats in them), nor, with
+            // `settle_rate`, the next ones while the settlement still runs
+            // ahead of the landing's rate; the next one starts a new segment.
+            let after_jump = (st.jumps > 0).then_some(st.since_jump + 1);
+            let extra = after_jump == Some(self.spec.settle_cycles) && self.still_settling(st, increment);
+            match after_jump {
+                Some(n) if n < self.spec.settle_cycles || extra => st.settling += 1,
+                _ => {
+                    if after_jump == Some(self.spec.settle_cycles) {
+                        st.window.push_segment(st.cycle as f64, c);
+                    } else {
+                        st.window.push(st.cycle as f64, c);
+                    }
+                    st.window_settlement.push(s);
+                    st.window_boundaries.push(b);
+                }
+            }
+            if st.cycle > self.spec.initial_cycles && !extra {
+                st.since_jump += 1;
+            }
+        }
+        if st.jumps > 0 {
+            st.last_increment = Some(increment);
+        }
+        Ok(())
+    }
+
+    /// The end of a run: the tables closed, `summary.json`, and unless stopped `final.json`, the checkpoint
+    /// removed and the figures drawn.
+    fn finish(
+        &self,
+        out: &Path,
+        opts: &RunOptions,
+        st: &mut State<E>,
+        files: Files,
+        end: &str,
+    ) -> Result<AccelerationSummary> {
         files.rows.finish()?;
         files.jumps.finish()?;
         let summary = AccelerationSummary {
@@ -400,10 +423,7 @@ impl<E: Engine> Accelerated<E> {
                 draw(out)?;
             }
         }
-        if let Some(e) = failure {
-            return Err(e);
-        }
-        Ok(AccelerationOutcome { summary, system: st.sys, out: out.to_path_buf() })
+        Ok(summary)
     }
 }
 

@@ -3,6 +3,7 @@
 //! rows, and the landing in stages ([`crate::settlement::sweep`]); and the domain check of a configuration.
 
 use super::*;
+use crate::settlement::estimate::Fit;
 
 /// The factor on the median of the bodies' trend moves below which a jump does
 /// not bound a move: the coherent motion of the sample (the grains under the
@@ -120,43 +121,16 @@ impl<E: Engine> Accelerated<E> {
         let sc = law.fit(n, settlements, segments);
         // The fitted settlement's increment over the jump's last cycle.
         let landing_rate = law.trend(&sc, n_last + h as f64) - law.trend(&sc, n_last + (h - 1) as f64);
-        // Bounded moves: a body without a force-carrying contact is held, the
-        // others move at most `extrapolation_limit` of their size or
-        // `MEDIAN_MOVES` times the median trend move, whichever is larger
-        // (docs/settlement-driver.md, "Bounded moves").
-        let bodies = &window.origin.bodies;
-        let contacts = st.sys.contact_counts(bodies);
-        let mut moves = trend_moves(law, &window, &f, h as f64);
-        let coherent = MEDIAN_MOVES * median(&mut moves);
-        // With `hold_anchored`, the sprung pads stay where the computed cycle
-        // left them, through the extrapolation and the relaxation alike.
-        let anchored = if self.spec.hold_anchored { st.sys.anchored_bodies() } else { Vec::new() };
-        let pinned: Vec<bool> =
-            (bodies.iter().zip(&contacts)).map(|(b, &n)| n == 0 || anchored.binary_search(b).is_ok()).collect();
-        let max_move: Vec<f64> = (st.sys.body_sizes(bodies).iter().zip(&pinned))
-            .map(|(size, &pin)| if pin { 0.0 } else { (self.spec.extrapolation_limit * size).max(coherent) })
-            .collect();
-        let held = pinned.iter().filter(|&&pin| pin).count() as u64;
-        let smoothing = self.spec.smoothing_length.map(|length| {
-            let last = window.configurations.last().expect("a fitted window has points");
-            let excluded: Vec<bool> =
-                (bodies.iter().zip(&pinned)).map(|(&b, &pin)| pin || Some(b) == self.spec.settlement_body).collect();
-            Smoothing::new(last, E::DIM, length, &excluded)
-        });
-        for j in 1..h {
-            if let Some(p) = files.positions.as_mut() {
-                p.append(&extrapolate_within(law, &window, &f, j as f64, &max_move, smoothing.as_ref()).0)?;
-            }
-            files.rows.write(&SettlementRow {
-                cycle: st.cycle + j,
-                computed: 0,
-                settlement_m: law.extrapolate(&sc, n_last, st.last_settlement, j as f64),
-                coordination: None,
-                max_overlap_before_relax_m: None,
-                max_overlap_after_relax_m: None,
-                wall_time_s: wall0 + started.elapsed().as_secs_f64(),
-            })?;
-        }
+        let Moves { anchored, max_move, held, smoothing } = self.bounded_moves(st, law, &window, &f, h);
+        self.write_extrapolated(
+            st,
+            law,
+            (&window, &f, &sc),
+            (h, &max_move, smoothing.as_ref()),
+            files,
+            wall0,
+            started,
+        )?;
         let (target, limited) = extrapolate_within(law, &window, &f, h as f64, &max_move, smoothing.as_ref());
         let mut row = JumpRow {
             jump: st.jumps + 1,
@@ -189,57 +163,11 @@ impl<E: Engine> Accelerated<E> {
         {
             return Ok(Landing::Failed(row, e.to_string()));
         }
-        // The boundaries (the MD plate) follow the same law.
-        let mut series = vec![0.0; n.len()];
-        let boundaries: Vec<f64> = (0..st.boundary_origin.len())
-            .map(|j| {
-                series.iter_mut().zip(boundary_points).for_each(|(v, b)| *v = b[j] - st.boundary_origin[j]);
-                let c = law.fit(n, &series, segments);
-                st.boundary_origin[j] + law.extrapolate(&c, n_last, series[series.len() - 1], h as f64)
-            })
-            .collect();
-        // The landing, in stages (`sweep`): from the computed configuration the
-        // window ends on (the system's) to the extrapolated one.
-        let from = window.configurations.last().expect("a fitted window has points").clone();
-        let stages = sweep::stages(&from, &target, &st.sys.body_sizes(bodies), E::DIM, self.spec.relax_stage);
-        row.relax_stages = stages;
-        let boundaries_from = coordinates(&st.sys.boundaries());
-        let t0 = Instant::now();
-        let mut relax = self.spec.relax.clone();
-        for &b in &anchored {
-            if !relax.held.contains(&b) {
-                relax.held.push(b);
-            }
-        }
-        if self.spec.relax_to_computed {
-            // A floor for a configuration without contacts: a millionth of the
-            // smallest body (any overlap a jump makes there is spurious).
-            let smallest = st.sys.body_sizes(bodies).iter().copied().fold(f64::INFINITY, f64::min);
-            let floor = if smallest.is_finite() { 1e-6 * smallest } else { f64::MIN_POSITIVE };
-            relax.tolerance = st.computed_overlap.max(floor);
-        }
-        row.relax_tolerance_m = relax.tolerance;
-        let report: RelaxReport =
-            match sweep::relax_along(&mut st.sys, &from, &target, (&boundaries_from, &boundaries), &relax, stages) {
-                Ok(r) => r,
-                Err(e) => return Ok(Landing::Failed(row, format!("its relaxation failed: {e}"))),
-            };
-        row.relax_iterations = report.iterations;
-        row.relax_evaluations = report.evaluations;
-        row.relax_converged = report.converged;
-        row.max_overlap_before_relax_m = report.max_overlap_before;
-        row.max_overlap_after_relax_m = report.max_overlap_after;
-        row.relax_largest_move = report.largest_move;
-        row.relax_wall_time_s = t0.elapsed().as_secs_f64();
-        if !report.converged {
-            return Ok(Landing::Failed(
-                row,
-                format!(
-                    "its relaxation did not reach {:.3e} m ({:.3e} m left after {} iterations: {})",
-                    relax.tolerance, report.max_overlap_after, report.iterations, report.reason
-                ),
-            ));
-        }
+        let system = (&mut st.sys, &st.boundary_origin[..], st.computed_overlap);
+        let report = match self.land(system, law, (&window, boundary_points), (&target, h), &anchored, &mut row) {
+            Ok(report) => report,
+            Err(reason) => return Ok(Landing::Failed(row, reason)),
+        };
         if let Err(e) = check_domain(&st.sys, &st.origin, &st.sys.configuration(), || {
             format!("the relaxation of jump {}", st.jumps + 1)
         }) {
@@ -272,6 +200,143 @@ impl<E: Engine> Accelerated<E> {
         // the landing (the relaxed configuration re-seats in that cycle).
         st.since_jump = 0;
         Ok(Landing::Landed(row))
+    }
+}
+
+/// What a jump may move ([`Accelerated::bounded_moves`]).
+struct Moves {
+    /// The anchored bodies held with `hold_anchored` (indices in the engine, sorted).
+    anchored: Vec<usize>,
+    /// The largest move of each body of the window (m); zero for a held body.
+    max_move: Vec<f64>,
+    /// How many bodies are held.
+    held: u64,
+    /// The smoothing of the moves over a length, if asked.
+    smoothing: Option<Smoothing>,
+}
+
+impl<E: Engine> Accelerated<E> {
+    /// Bounded moves: a body without a force-carrying contact is held, the others move at most
+    /// `extrapolation_limit` of their size or `MEDIAN_MOVES` times the median trend move over `h` cycles,
+    /// whichever is larger (docs/settlement-driver.md, "Bounded moves"); with `hold_anchored`, the sprung pads
+    /// stay where the computed cycle left them, through the extrapolation and the relaxation alike.
+    fn bounded_moves(&self, st: &State<E>, law: &dyn ResidualLaw, window: &Training, f: &Fit, h: u64) -> Moves {
+        let bodies = &window.origin.bodies;
+        let contacts = st.sys.contact_counts(bodies);
+        let mut moves = trend_moves(law, window, f, h as f64);
+        let coherent = MEDIAN_MOVES * median(&mut moves);
+        let anchored = if self.spec.hold_anchored { st.sys.anchored_bodies() } else { Vec::new() };
+        let pinned: Vec<bool> =
+            (bodies.iter().zip(&contacts)).map(|(b, &n)| n == 0 || anchored.binary_search(b).is_ok()).collect();
+        let max_move: Vec<f64> = (st.sys.body_sizes(bodies).iter().zip(&pinned))
+            .map(|(size, &pin)| if pin { 0.0 } else { (self.spec.extrapolation_limit * size).max(coherent) })
+            .collect();
+        let held = pinned.iter().filter(|&&pin| pin).count() as u64;
+        let smoothing = self.spec.smoothing_length.map(|length| {
+            let last = window.configurations.last().expect("a fitted window has points");
+            let excluded: Vec<bool> =
+                (bodies.iter().zip(&pinned)).map(|(&b, &pin)| pin || Some(b) == self.spec.settlement_body).collect();
+            Smoothing::new(last, E::DIM, length, &excluded)
+        });
+        Moves { anchored, max_move, held, smoothing }
+    }
+
+    /// The rows (and positions) of the extrapolated cycles 1 … h − 1 of a jump, on the fitted trend.
+    #[allow(clippy::too_many_arguments)]
+    fn write_extrapolated(
+        &self,
+        st: &State<E>,
+        law: &dyn ResidualLaw,
+        (window, f, sc): (&Training, &Fit, &[f64; 3]),
+        (h, max_move, smoothing): (u64, &[f64], Option<&Smoothing>),
+        files: &mut Files,
+        wall0: f64,
+        started: &Instant,
+    ) -> Result<()> {
+        let n_last = *window.cycles.last().expect("a window has points");
+        for j in 1..h {
+            if let Some(p) = files.positions.as_mut() {
+                p.append(&extrapolate_within(law, window, f, j as f64, max_move, smoothing).0)?;
+            }
+            files.rows.write(&SettlementRow {
+                cycle: st.cycle + j,
+                computed: 0,
+                settlement_m: law.extrapolate(sc, n_last, st.last_settlement, j as f64),
+                coordination: None,
+                max_overlap_before_relax_m: None,
+                max_overlap_after_relax_m: None,
+                wall_time_s: wall0 + started.elapsed().as_secs_f64(),
+            })?;
+        }
+        Ok(())
+    }
+
+    /// The landing of a jump on `target`, `h` cycles on: the boundaries (the MD plate) extrapolated by the same
+    /// law from their points in the window, then the relaxation in stages ([`sweep`]) from the computed
+    /// configuration the window ends on (the system's) to the extrapolated one, holding the anchored bodies;
+    /// fills the relaxation's columns of `row`. Returns why the landing failed (the relaxation failed or did not
+    /// converge).
+    fn land(
+        &self,
+        (sys, boundary_origin, computed_overlap): (&mut E, &[f64], f64),
+        law: &dyn ResidualLaw,
+        (window, boundary_points): (&Training, &[Vec<f64>]),
+        (target, h): (&Configuration, u64),
+        anchored: &[usize],
+        row: &mut JumpRow,
+    ) -> std::result::Result<RelaxReport, String> {
+        let (n, segments) = (&window.cycles, &window.segments);
+        let n_last = *n.last().expect("a window has points");
+        let bodies = &window.origin.bodies;
+        // The boundaries (the MD plate) follow the same law.
+        let mut series = vec![0.0; n.len()];
+        let boundaries: Vec<f64> = (0..boundary_origin.len())
+            .map(|j| {
+                series.iter_mut().zip(boundary_points).for_each(|(v, b)| *v = b[j] - boundary_origin[j]);
+                let c = law.fit(n, &series, segments);
+                boundary_origin[j] + law.extrapolate(&c, n_last, series[series.len() - 1], h as f64)
+            })
+            .collect();
+        // The landing, in stages (`sweep`): from the computed configuration the
+        // window ends on (the system's) to the extrapolated one.
+        let from = window.configurations.last().expect("a fitted window has points").clone();
+        let stages = sweep::stages(&from, target, &sys.body_sizes(bodies), E::DIM, self.spec.relax_stage);
+        row.relax_stages = stages;
+        let boundaries_from = coordinates(&sys.boundaries());
+        let t0 = Instant::now();
+        let mut relax = self.spec.relax.clone();
+        for &b in anchored {
+            if !relax.held.contains(&b) {
+                relax.held.push(b);
+            }
+        }
+        if self.spec.relax_to_computed {
+            // A floor for a configuration without contacts: a millionth of the
+            // smallest body (any overlap a jump makes there is spurious).
+            let smallest = sys.body_sizes(bodies).iter().copied().fold(f64::INFINITY, f64::min);
+            let floor = if smallest.is_finite() { 1e-6 * smallest } else { f64::MIN_POSITIVE };
+            relax.tolerance = computed_overlap.max(floor);
+        }
+        row.relax_tolerance_m = relax.tolerance;
+        let report: RelaxReport =
+            match sweep::relax_along(sys, &from, target, (&boundaries_from, &boundaries), &relax, stages) {
+                Ok(r) => r,
+                Err(e) => return Err(format!("its relaxation failed: {e}")),
+            };
+        row.relax_iterations = report.iterations;
+        row.relax_evaluations = report.evaluations;
+        row.relax_converged = report.converged;
+        row.max_overlap_before_relax_m = report.max_overlap_before;
+        row.max_overlap_after_relax_m = report.max_overlap_after;
+        row.relax_largest_move = report.largest_move;
+        row.relax_wall_time_s = t0.elapsed().as_secs_f64();
+        if !report.converged {
+            return Err(format!(
+                "its relaxation did not reach {:.3e} m ({:.3e} m left after {} iterations: {})",
+                relax.tolerance, report.max_overlap_after, report.iterations, report.reason
+            ));
+        }
+        Ok(report)
     }
 }
 
