@@ -105,6 +105,14 @@ pub struct Runner<E: Engine> {
 }
 
 /// The state of a run in progress.
+/// How the loop ended: the last step's statistics and whether its series row was written, the failure that
+/// stopped it, whether it stopped at equilibrium.
+struct Ending<S> {
+    last_stats: Option<(S, bool)>,
+    diverged: Option<Error>,
+    at_equilibrium: bool,
+}
+
 struct Live<E: Engine> {
     sys: E,
     summary: RunSummary,
@@ -226,27 +234,8 @@ impl<E: Engine> Runner<E> {
                 at_equilibrium = live.summary.equilibrium.observe(rule, rule.holds(en.kinetic, en.potential));
             }
             let written = k % plan.output_every == 0 || k == end_step || at_equilibrium;
-            if written {
-                live.series.write(&live.sys.series_row(&stats))?;
-            }
+            self.record_step(&mut live, &stats, written, opts.vtk_every, (&vtk_dir, &pvd_path))?;
             last_stats = Some((stats, written));
-            if let (Some(c), Some((state, table))) = (plan.cycles, live.cycles.as_mut()) {
-                live.sys.cycle_step(state, &stats);
-                let done = cycles_at(live.sys.time(), c.frequency, live.sys.dt());
-                if done > live.cycles_done {
-                    table.write(&live.sys.cycle_end(state, done))?;
-                    live.cycles_done = done;
-                    if let Some(p) = live.positions.as_mut() {
-                        let bodies = p.reference().bodies.clone();
-                        p.append(&live.sys.configuration_of(&bodies))?;
-                    }
-                }
-            }
-            if opts.vtk_every > 0 && k % opts.vtk_every == 0 {
-                io::create_output_dir(&vtk_dir)?;
-                live.sys.snapshot(&vtk_dir, &mut live.snapshots)?;
-                live.snapshots.write(&pvd_path)?;
-            }
             progress(&Progress {
                 step: k,
                 end_step,
@@ -266,6 +255,56 @@ impl<E: Engine> Runner<E> {
             }
         }
         live.summary.wall_time_s = wall0 + started.elapsed().as_secs_f64();
+        self.finish(out, opts, live, Ending { last_stats, diverged, at_equilibrium }, (end_step, &started))
+    }
+
+    /// The outputs of step `k` (made, with its statistics `stats`): its series row when `written`, the cycle
+    /// table's row and positions at a cycle's end, a VTK snapshot every `vtk_every` steps (into `vtk_dir`, listed
+    /// in the `.pvd` file).
+    fn record_step(
+        &self,
+        live: &mut Live<E>,
+        stats: &E::Stats,
+        written: bool,
+        vtk_every: u64,
+        (vtk_dir, pvd_path): (&Path, &Path),
+    ) -> Result<()> {
+        let k = live.sys.steps_done();
+        if written {
+            live.series.write(&live.sys.series_row(stats))?;
+        }
+        if let (Some(c), Some((state, table))) = (self.plan.cycles, live.cycles.as_mut()) {
+            live.sys.cycle_step(state, stats);
+            let done = cycles_at(live.sys.time(), c.frequency, live.sys.dt());
+            if done > live.cycles_done {
+                table.write(&live.sys.cycle_end(state, done))?;
+                live.cycles_done = done;
+                if let Some(p) = live.positions.as_mut() {
+                    let bodies = p.reference().bodies.clone();
+                    p.append(&live.sys.configuration_of(&bodies))?;
+                }
+            }
+        }
+        if vtk_every > 0 && k.is_multiple_of(vtk_every) {
+            io::create_output_dir(vtk_dir)?;
+            live.sys.snapshot(vtk_dir, &mut live.snapshots)?;
+            live.snapshots.write(pvd_path)?;
+        }
+        Ok(())
+    }
+
+    /// The end of a run (the last step's statistics and whether its row was written, the failure, whether it
+    /// ended at equilibrium): on a stop, a checkpoint; otherwise the last row, `final.json`, `contacts.csv`,
+    /// `summary.json`, the figures, `final_scene.toml`, and the failure returned.
+    fn finish(
+        &self,
+        out: &Path,
+        opts: &RunOptions,
+        mut live: Live<E>,
+        Ending { last_stats, diverged, at_equilibrium }: Ending<E::Stats>,
+        (end_step, started): (u64, &Instant),
+    ) -> Result<RunOutcome> {
+        let plan = &self.plan;
         let end = match (&diverged, at_equilibrium) {
             (Some(Error::Stalled { .. }), _) => RunEnd::Stalled,
             (Some(_), _) => RunEnd::Diverged,
