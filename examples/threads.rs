@@ -28,9 +28,10 @@
 use ballast::md::MdSystem;
 use ballast::nscd::System;
 use ballast::scenarios::md_bed::{bed_system, BedSpec};
+use ballast::scenarios::saussine::LoadingSpec;
 use ballast::scenarios::{pentagon_deposit, DepositSpec};
 use ballast::scene::Scene;
-use ballast::studies::saussine::{load, Loading};
+use ballast::studies::saussine::load;
 use ballast::team::TeamStats;
 use std::process::{Child, Command};
 use std::time::Instant;
@@ -115,7 +116,7 @@ fn loaded(dir: &std::path::Path) -> Result<Work, Error> {
     // `saussine load` takes the grains of the material named `ballast`.
     std::fs::write(&sample, pile.replace("\"grain\"", "\"ballast\""))?;
     let scene = dir.join("loaded536.toml");
-    load(&sample, &Loading { cycles: 2, ..Loading::default() }, &scene)?;
+    load(&sample, &LoadingSpec { cycles: 2, ..LoadingSpec::default() }, &scene)?;
     Ok(Work::Nscd(Box::new(Scene::load(&scene)?.build()?)))
 }
 

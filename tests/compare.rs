@@ -8,11 +8,12 @@
 mod scratch;
 
 use ballast::io::read_csv;
+use ballast::scenarios::saussine::LoadingSpec;
 use ballast::scenarios::saussine::SampleSpec;
 use ballast::studies::campaigns::StudyOptions;
 use ballast::studies::compare::{compare, CompareReport, CompareRow, CompareSpec};
 use ballast::studies::replicas::Replicas;
-use ballast::studies::saussine::{self, Loading};
+use ballast::studies::saussine;
 use ballast::studies::Quiet;
 use ballast::Error;
 use std::path::{Path, PathBuf};
@@ -24,7 +25,7 @@ fn spec(sample: &Path, overlaps: &[f64], cycles: u64, replicas: u64) -> CompareS
         model: "linear".into(),
         dt_fraction: None,
         replicas: Replicas { count: replicas, ..Replicas::default() },
-        loading: Loading { cycles, ..Loading::default() },
+        loading: LoadingSpec { cycles, ..LoadingSpec::default() },
     }
 }
 

@@ -85,7 +85,7 @@ fn generated_scenes_are_those_of_the_former_text_generators_bit_for_bit() {
     let sample = saussine::sample_scene(&SampleSpec::saussine(1).scaled(121)).unwrap();
     let f = SampleSpec::saussine(1).scaled(121).width;
     let load =
-        LoadingSpec { bars: 1, guide: Guide::Level, inclination_deg: 5.0, ..LoadingSpec::saussine(10).scaled(f) };
+        LoadingSpec { bars: 1, guide: Some(Guide::Level), inclination_deg: 5.0, ..LoadingSpec::saussine(10).scaled(f) };
     let mut loaded = saussine::loaded_scene(&sample, &load).unwrap();
     // Added since the former generators: the loaded scenes write the grains'
     // positions at every cycle's end (what `--reference` measures E_r on).
@@ -123,8 +123,8 @@ fn every_generated_scene_round_trips_through_toml() {
     round_trips(&saussine::open_bank(&bank).unwrap());
     for guide in [Guide::Vertical, Guide::Level, Guide::Free] {
         for bars in [0, 1, 2] {
-            let spec =
-                LoadingSpec { guide, bars, inclination_deg: 3.0, ..LoadingSpec::saussine(3) }.scaled(60.0 / 724.0);
+            let spec = LoadingSpec { guide: Some(guide), bars, inclination_deg: 3.0, ..LoadingSpec::saussine(3) }
+                .scaled(60.0 / 724.0);
             round_trips(&saussine::loaded_scene(&sample, &spec).unwrap());
         }
     }
@@ -227,7 +227,7 @@ fn small_samples_are_loaded_by_a_scaled_sleeper() {
     let sample = saussine::sample_scene(&SampleSpec::saussine(1).scaled(60)).unwrap();
     let f = 60.0 / 724.0;
     let spec = LoadingSpec::saussine(100).scaled(f);
-    assert_eq!(spec.sleeper_width, 0.25 * f);
+    assert_eq!(spec.sleeper_width, Some(0.25 * f));
     assert_eq!(spec.bar_size, 0.25 * f / 5.0);
     let loaded = saussine::loaded_scene(&sample, &spec).unwrap();
     let sleeper = loaded.bodies.iter().find(|b| b.name == SLEEPER).unwrap();
@@ -235,12 +235,12 @@ fn small_samples_are_loaded_by_a_scaled_sleeper() {
     assert_eq!(parts.len(), 3);
     // Bars one bar width from the ends and from each other.
     let b = spec.bar_size;
-    let (w, x0, x1) = (spec.sleeper_width, parts[1][0][0], parts[2][0][0]);
+    let (w, x0, x1) = (spec.width(), parts[1][0][0], parts[2][0][0]);
     assert!((x0 - (-w / 2.0 + b)).abs() < 1e-15 && (x1 - (x0 + 2.0 * b)).abs() < 1e-15, "{parts:?}");
     // A sample that holds the 10 mm bars keeps them (the 121-grain sample: 41.8 mm).
     assert_eq!(LoadingSpec::saussine(1).scaled(121.0 / 724.0).bar_size, 0.01);
     // A sleeper given too narrow for its bars is still refused.
-    let narrow = LoadingSpec { sleeper_width: 0.03, ..LoadingSpec::saussine(1) };
+    let narrow = LoadingSpec { sleeper_width: Some(0.03), ..LoadingSpec::saussine(1) };
     says(&message(saussine::loaded_scene(&sample, &narrow)), &["too narrow for 2 bars of 0.01 m", "use fewer bars"]);
 
     // Through the CLI, with the default options.
@@ -275,15 +275,18 @@ fn bad_loading_parameters_are_named() {
     let sample = saussine::sample_scene(&SampleSpec::saussine(1).scaled(121)).unwrap();
     let base = LoadingSpec::saussine(10).scaled(121.0 / 724.0);
     for (spec, needle) in [
-        (LoadingSpec { frequency: 0.0, ..base.clone() }, "loaded_scene: frequency (Hz)"),
-        (LoadingSpec { cycles: 0, ..base.clone() }, "loaded_scene: cycles"),
-        (LoadingSpec { dt: f64::NAN, ..base.clone() }, "loaded_scene: dt (s)"),
-        (LoadingSpec { criterion: "fast".into(), ..base.clone() }, "loaded_scene: criterion 'fast'"),
-        (LoadingSpec { inclination_deg: 90.0, ..base.clone() }, "loaded_scene: inclination_deg"),
-        (LoadingSpec { sleeper_width: 0.0, ..base.clone() }, "loaded_scene: sleeper_width (m)"),
-        (LoadingSpec { bar_size: -0.01, ..base.clone() }, "loaded_scene: bar_size (m)"),
-        (LoadingSpec { mean: f64::INFINITY, ..base.clone() }, "loaded_scene: mean (N)"),
-        (LoadingSpec { max_iterations: 0, ..base.clone() }, "loaded_scene: min_iterations"),
+        (LoadingSpec { frequency: 0.0, ..base.clone() }, "frequency: the loading frequency (Hz) must be positive"),
+        (LoadingSpec { cycles: 0, ..base.clone() }, "cycles: must be at least 1"),
+        (LoadingSpec { dt: f64::NAN, ..base.clone() }, "dt: the time step (s) must be positive"),
+        (LoadingSpec { criterion: "fast".into(), ..base.clone() }, "criterion: 'fast' is not one of"),
+        (LoadingSpec { inclination_deg: 90.0, ..base.clone() }, "inclination_deg: must be in (-90, 90)"),
+        (
+            LoadingSpec { sleeper_width: Some(0.0), ..base.clone() },
+            "sleeper_width: the sleeper's width (m) must be positive",
+        ),
+        (LoadingSpec { bar_size: -0.01, ..base.clone() }, "bar_size: the bars' side (m) must be positive"),
+        (LoadingSpec { mean: f64::INFINITY, ..base.clone() }, "mean: the load's mean A (N) must be finite"),
+        (LoadingSpec { max_iterations: 0, ..base.clone() }, "min_iterations: must be at least 1"),
     ] {
         says(&message(saussine::loaded_scene(&sample, &spec)), &[needle]);
     }

@@ -7,13 +7,14 @@ mod scratch;
 use ballast::io::table::write_all;
 use ballast::run::{Progress, RunOptions, RunOutcome};
 use ballast::scenarios::karrech::Loading as Plate;
+use ballast::scenarios::saussine::LoadingSpec;
 use ballast::scenarios::saussine::{SampleSpec, SLEEPER};
 use ballast::scene::Scene;
 use ballast::studies::campaigns::{self, ConvergenceSpec, EnsembleRow, EnsembleSpec, StudyOptions};
 use ballast::studies::luding::{self, CompareRow, Compression, LoopRow, StrainRow};
 use ballast::studies::md_stage::{Stage, TestSpec};
 use ballast::studies::replicas::Replicas;
-use ballast::studies::saussine::{self, Loading, Sample};
+use ballast::studies::saussine::{self, Sample};
 use ballast::studies::{karrech, Quiet, RunDisplay};
 use ballast::Error;
 use std::path::{Path, PathBuf};
@@ -72,14 +73,14 @@ fn saussine_sample_load_and_convergence_study() {
 
     // The loading is checked, naming the fields.
     for (bad, needle) in [
-        (Loading { stiffness_factor: 0.0, ..Loading::default() }, "stiffness_factor:"),
-        (Loading { inclination_deg: 90.0, ..Loading::default() }, "inclination_deg:"),
-        (Loading { cycles: 0, ..Loading::default() }, "cycles:"),
+        (LoadingSpec { stiffness_factor: 0.0, ..LoadingSpec::default() }, "stiffness_factor:"),
+        (LoadingSpec { inclination_deg: 90.0, ..LoadingSpec::default() }, "inclination_deg:"),
+        (LoadingSpec { cycles: 0, ..LoadingSpec::default() }, "cycles:"),
     ] {
-        assert!(input_error(bad.spec()).contains(needle), "{needle}");
+        assert!(input_error(saussine::load(&sample.path, &bad, &dir.join("bad.toml"))).contains(needle), "{needle}");
     }
     // The load of a 60-grain sample is scaled with it (same pressure).
-    let loading = Loading { cycles: 1, dt: 1e-3, bars: 0, ..Loading::default() };
+    let loading = LoadingSpec { cycles: 1, dt: 1e-3, bars: 0, ..LoadingSpec::default() };
     let loaded = dir.join("loaded.toml");
     saussine::load(&sample.path, &loading, &loaded).unwrap();
     let scene = Scene::load(&loaded).unwrap();
@@ -140,7 +141,7 @@ fn saussine_sample_load_and_convergence_study() {
 #[test]
 fn saussine_ensemble_of_two_samples() {
     let dir = scratch::dir("ensemble");
-    let loading = Loading { cycles: 1, dt: 1e-3, bars: 0, ..Loading::default() };
+    let loading = LoadingSpec { cycles: 1, dt: 1e-3, bars: 0, ..LoadingSpec::default() };
     let spec = EnsembleSpec {
         samples: 2,
         first_seed: 3,
@@ -150,7 +151,7 @@ fn saussine_ensemble_of_two_samples() {
         loading: loading.clone(),
     };
     let study = StudyOptions { jobs: Some(2), ..StudyOptions::new(dir.join("ens")) };
-    let no_cycle = EnsembleSpec { loading: Loading { cycles: 0, ..loading }, ..spec.clone() };
+    let no_cycle = EnsembleSpec { loading: LoadingSpec { cycles: 0, ..loading }, ..spec.clone() };
     assert!(input_error(campaigns::ensemble(&no_cycle, &study, &Quiet)).contains("cycles:"));
     assert!(!dir.join("ens/samples").exists());
 

@@ -3,7 +3,7 @@
 //! second for the one line an input error prints.
 
 /// A library message's leading field, and the flag of the command line that sets it.
-const FLAGS: [(&str, &str); 22] = [
+const FLAGS: [(&str, &str); 28] = [
     ("threads", "--threads"),
     ("checkpoint_every_s", "--checkpoint-every"),
     ("resume", "--resume"),
@@ -14,6 +14,12 @@ const FLAGS: [(&str, &str); 22] = [
     ("from", "--from"),
     ("stiffness_factor", "--stiffness-factor"),
     ("inclination_deg", "--inclination"),
+    ("sleeper_width", "--sleeper-width"),
+    ("bars", "--bars"),
+    ("dt", "--dt"),
+    ("criterion", "--criterion"),
+    ("tolerance", "--tolerance"),
+    ("min_iterations", "--min-iterations"),
     ("cycles", "--cycles"),
     ("jobs", "--jobs"),
     ("perturbation.distance_m", "--perturb"),

@@ -21,12 +21,13 @@
 use super::{input, print_sample, print_study, Bars, Failure};
 use ballast::io::layout;
 use ballast::run::default_threads;
+use ballast::scenarios::saussine::LoadingSpec;
 use ballast::scenarios::saussine::{Guide, SampleSpec};
 use ballast::studies::campaigns::{self, ConvergenceSpec, EnsembleSpec, StepsSpec, StudyOptions};
 use ballast::studies::replicas::{
     Perturbation, Replicas, Start, DEFAULT_PERTURBATION_M, DEFAULT_PERTURB_SEED, DEFAULT_SEATING_CYCLES,
 };
-use ballast::studies::saussine::{self, Loading, SettleOptions, SettleReplicas};
+use ballast::studies::saussine::{self, SettleOptions, SettleReplicas};
 use clap::Subcommand;
 use std::path::PathBuf;
 
@@ -174,36 +175,36 @@ pub enum SaussineCommand {
 #[derive(Debug, Clone, clap::Args)]
 pub struct LoadingArgs {
     /// Number of loading cycles.
-    #[arg(long, default_value_t = Loading::default().cycles)]
+    #[arg(long, default_value_t = LoadingSpec::default().cycles)]
     pub cycles: u64,
     /// Angle of the load from the vertical (degrees).
-    #[arg(long, default_value_t = Loading::default().inclination_deg)]
+    #[arg(long, default_value_t = LoadingSpec::default().inclination_deg)]
     pub inclination: f64,
     /// Sleeper guide: vertical (vx, spin imposed), level (spin imposed) or free;
     /// default: vertical for a vertical load, level otherwise.
     #[arg(long)]
     pub guide: Option<String>,
     /// Factor on the sublayer stiffness k_N (§4.2: 1, 100, 1000).
-    #[arg(long, default_value_t = Loading::default().stiffness_factor)]
+    #[arg(long, default_value_t = LoadingSpec::default().stiffness_factor)]
     pub stiffness_factor: f64,
     /// Time step (s).
-    #[arg(long, default_value_t = Loading::default().dt)]
+    #[arg(long, default_value_t = LoadingSpec::default().dt)]
     pub dt: f64,
     /// Convergence policy: strict, quad, quad_max, energy, velocity (default: the cheapest measured to
     /// keep the max overlap below 1 % of the smallest grain over 1000 cycles; it under-predicts the
     /// settlement accrued after the seating by about half on a small sample: for accrual rates use
     /// quad 1e-6, where the settlement of a small sample stops changing, BENCHMARKS.md).
-    #[arg(long, default_value_t = Loading::default().criterion)]
+    #[arg(long, default_value_t = LoadingSpec::default().criterion)]
     pub criterion: String,
     /// Tolerance of the policy.
-    #[arg(long, default_value_t = Loading::default().tolerance)]
+    #[arg(long, default_value_t = LoadingSpec::default().tolerance)]
     pub tolerance: f64,
-    #[arg(long, default_value_t = Loading::default().min_iterations)]
+    #[arg(long, default_value_t = LoadingSpec::default().min_iterations)]
     pub min_iterations: usize,
-    #[arg(long, default_value_t = Loading::default().max_iterations)]
+    #[arg(long, default_value_t = LoadingSpec::default().max_iterations)]
     pub max_iterations: usize,
     /// Square bars under the sleeper (0: a flat sleeper).
-    #[arg(long, default_value_t = Loading::default().bars)]
+    #[arg(long, default_value_t = LoadingSpec::default().bars)]
     pub bars: usize,
     /// Width of the sleeper (m).
     #[arg(long)]
@@ -212,7 +213,7 @@ pub struct LoadingArgs {
 
 impl LoadingArgs {
     /// The library's loading (checked by it when a scene is made from it).
-    pub fn loading(&self) -> Result<Loading, Failure> {
+    pub fn loading(&self) -> Result<LoadingSpec, Failure> {
         let guide = match self.guide.as_deref() {
             None => None,
             Some("vertical") => Some(Guide::Vertical),
@@ -220,7 +221,7 @@ impl LoadingArgs {
             Some("free") => Some(Guide::Free),
             Some(g) => return Err(input(format!("--guide: expected vertical, level or free, got '{g}'"))),
         };
-        Ok(Loading {
+        Ok(LoadingSpec {
             cycles: self.cycles,
             inclination_deg: self.inclination,
             guide,
@@ -232,6 +233,7 @@ impl LoadingArgs {
             max_iterations: self.max_iterations,
             bars: self.bars,
             sleeper_width: self.sleeper_width,
+            ..LoadingSpec::default()
         })
     }
 }

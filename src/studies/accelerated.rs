@@ -8,11 +8,12 @@
 
 use super::replicas::{Replicas, Start};
 use super::saussine::{finish_replicas, replica_dir, replica_jobs, settle_accelerated};
-use super::saussine::{Accelerate, Loading, SettleOptions, SettleReplicas};
+use super::saussine::{Accelerate, SettleOptions, SettleReplicas};
 use crate::error::Result;
 use crate::io;
 use crate::io::layout;
 use crate::run::Prior;
+use crate::scenarios::saussine::LoadingSpec;
 use crate::settlement::SettlementRow;
 use std::path::Path;
 
@@ -32,7 +33,7 @@ use std::path::Path;
 /// [`SettleReplicas::failed`].
 pub fn settle_accelerated_replicas(
     sample: &Path,
-    loading: &Loading,
+    loading: &LoadingSpec,
     accelerate: &Accelerate,
     out: &Path,
     opts: &SettleOptions,

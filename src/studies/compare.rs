@@ -31,12 +31,12 @@ use super::campaigns::{
     StudyReport,
 };
 use super::replicas::{welch, Difference, Estimate, Replicas, SettlementSummary};
-use super::saussine::Loading;
 use super::{write_file, RunDisplay};
 use crate::error::{Error, Result};
 use crate::io::figures::{self, Series};
 use crate::io::table::write_all;
 use crate::scenarios::saussine::loaded_scene;
+use crate::scenarios::saussine::LoadingSpec;
 use crate::scene::{Scene, SoftSection};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -51,7 +51,7 @@ pub struct CompareSpec {
     /// A deposited Saussine sample (`sample.toml`, loaded here with
     /// [`Self::loading`]) or a loaded 2D scene with a followed body
     /// (`[output.cycles] body`, its own loading kept; only its duration is set
-    /// to [`Loading::cycles`] cycles).
+    /// to [`LoadingSpec::cycles`] cycles).
     pub sample: PathBuf,
     /// The MD settings: `[soft] max_overlap_ratio` of each, in (0, 0.1].
     pub overlaps: Vec<f64>,
@@ -62,7 +62,7 @@ pub struct CompareSpec {
     /// The replicas of each setting.
     pub replicas: Replicas,
     /// The loading of a deposited sample (its `cycles` applies to a loaded scene too).
-    pub loading: Loading,
+    pub loading: LoadingSpec,
 }
 
 /// One row of `compare.csv`: one run (an engine, a stiffness, a replica) at
@@ -113,7 +113,7 @@ pub struct SettingSummary {
     pub normal_stiffness: Option<f64>,
     /// Time step (s).
     pub dt_s: f64,
-    /// Loading period over the time step.
+    /// LoadingSpec period over the time step.
     pub steps_per_cycle: f64,
     /// The settlement statistics of its replicas (`None` if one completed no cycle).
     pub settlement: Option<SettlementSummary>,

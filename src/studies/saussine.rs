@@ -14,10 +14,10 @@
 //!   ([`super::replicas`]), with the ensemble's settlement per cycle and its
 //!   95 % confidence interval (`settlement_ensemble.csv`).
 //!
-//! The settings of the loaded stage are a [`Loading`] (the options of
+//! The settings of the loaded stage are a [`LoadingSpec`] (the options of
 //! `ballast saussine load`); a sample scaled to fewer grains is loaded with the
 //! sleeper's width and the load scaled alike (same pressure,
-//! [`Loading::for_sample`]), unless the sleeper's width is given.
+//! [`LoadingSpec::for_sample`]), unless the sleeper's width is given.
 
 use super::replicas::{
     perturb_scene, settlement_ensemble, CycleSettlement, Replicas, SettlementEnsembleRow, Start, REPLICA_FILE,
@@ -29,128 +29,10 @@ use crate::io::figures::Series;
 use crate::io::layout;
 use crate::run::{default_threads, Prior, RunOptions, RunOutcome};
 use crate::scenarios::saussine::{
-    loaded_scene, measure_sample, open_bank, sample_scene, Guide, LoadingSpec, SampleReport, SampleSpec, GRAIN_PREFIX,
+    loaded_scene, measure_sample, open_bank, sample_scene, LoadingSpec, SampleReport, SampleSpec,
 };
 use crate::scene::Scene;
 use std::path::{Path, PathBuf};
-
-/// The settings of a loaded stage, as `ballast saussine load` takes them
-/// ([`Loading::default`]: its defaults). [`Loading::spec`] checks them.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Loading {
-    /// Number of loading cycles.
-    pub cycles: u64,
-    /// Angle of the load from the vertical (degrees).
-    pub inclination_deg: f64,
-    /// Sleeper guide; `None`: vertical for a vertical load, level otherwise.
-    pub guide: Option<Guide>,
-    /// Factor on the sublayer stiffness k_N (§4.2: 1, 100, 1000).
-    pub stiffness_factor: f64,
-    /// Time step (s).
-    pub dt: f64,
-    /// NLGS convergence policy by name: `strict`, `quad`, `quad_max` or `energy`.
-    pub criterion: String,
-    /// Tolerance of the policy (dimensionless), in (0, 1).
-    pub tolerance: f64,
-    /// Fewest NLGS sweeps per step (≥ 1).
-    pub min_iterations: usize,
-    /// Most NLGS sweeps per step; a step reaching it counts as not converged.
-    pub max_iterations: usize,
-    /// Square bars under the sleeper (0: a flat sleeper).
-    pub bars: usize,
-    /// Width of the sleeper (m); `None`: the paper's, scaled with the sample.
-    pub sleeper_width: Option<f64>,
-}
-
-impl Default for Loading {
-    /// 100 cycles of a vertical load, sublayer ×1, dt = 2e-4 s, the energy
-    /// policy at 1.66e-5 (the cheapest measured to keep the max overlap below
-    /// 1 % of the smallest grain over 1000 cycles, BENCHMARKS.md), 1 to 2000
-    /// sweeps, two bars.
-    fn default() -> Self {
-        Self {
-            cycles: 100,
-            inclination_deg: 0.0,
-            guide: None,
-            stiffness_factor: 1.0,
-            dt: 2e-4,
-            criterion: "energy".into(),
-            tolerance: 1.66e-5,
-            min_iterations: 1,
-            max_iterations: 2000,
-            bars: 2,
-            sleeper_width: None,
-        }
-    }
-}
-
-impl Loading {
-    /// The loading of the reference (724-grain) sample.
-    ///
-    /// # Errors
-    /// [`Error::Scene`] naming the option: a stiffness factor that is not
-    /// positive, an inclination outside (−90°, 90°), no cycle.
-    pub fn spec(&self) -> Result<LoadingSpec> {
-        let guide = match self.guide {
-            Some(g) => g,
-            None if self.inclination_deg == 0.0 => Guide::Vertical,
-            None => Guide::Level,
-        };
-        if !(self.stiffness_factor.is_finite() && self.stiffness_factor > 0.0) {
-            return Err(Error::Scene(format!("stiffness_factor: must be positive, got {}", self.stiffness_factor)));
-        }
-        if !(self.inclination_deg.is_finite() && self.inclination_deg.abs() < 90.0) {
-            return Err(Error::Scene(format!(
-                "inclination_deg: must be in (-90, 90) degrees, got {}",
-                self.inclination_deg
-            )));
-        }
-        if self.cycles == 0 {
-            return Err(Error::Scene("cycles: must be at least 1".into()));
-        }
-        let base = LoadingSpec::saussine(self.cycles);
-        Ok(LoadingSpec {
-            inclination_deg: self.inclination_deg,
-            guide,
-            stiffness_factor: self.stiffness_factor,
-            dt: self.dt,
-            criterion: self.criterion.clone(),
-            tolerance: self.tolerance,
-            min_iterations: self.min_iterations,
-            max_iterations: self.max_iterations,
-            bars: self.bars,
-            sleeper_width: self.sleeper_width.unwrap_or(base.sleeper_width),
-            ..base
-        })
-    }
-
-    /// The loading for `sample`: the sleeper's width and the load scaled with a
-    /// sample scaled by [`SampleSpec::scaled`] (same pressure under the
-    /// sleeper), unless the sleeper's width is given (it then keeps its bars).
-    ///
-    /// # Errors
-    /// As [`Loading::spec`].
-    pub fn for_sample(&self, sample: &Scene) -> Result<LoadingSpec> {
-        let spec = self.spec()?;
-        let grains = sample.bodies.iter().filter(|b| b.name.starts_with(GRAIN_PREFIX)).count();
-        let f = grains as f64 / reference_grains() as f64;
-        if grains == 0 || (f - 1.0).abs() < 1e-3 {
-            return Ok(spec);
-        }
-        let mut scaled = spec.clone().scaled(f);
-        if let Some(w) = self.sleeper_width {
-            // The given sleeper keeps its bars.
-            scaled.sleeper_width = w;
-            scaled.bar_size = spec.bar_size;
-        }
-        Ok(scaled)
-    }
-}
-
-/// The number of grains of the reference sample (361 + 242 + 121).
-fn reference_grains() -> usize {
-    SampleSpec::saussine(0).grading.iter().map(|g| g.1).sum()
-}
 
 /// Writes `scene` to `path` with a header line saying `what` it is.
 ///
@@ -226,8 +108,8 @@ fn run_stage(
 }
 
 /// The loaded scene of the sample at `sample` under `loading` (the sample's
-/// own scaling, [`Loading::for_sample`]), and the loading spec it was made with.
-fn loaded(sample: &Path, loading: &Loading) -> Result<(Scene, LoadingSpec)> {
+/// own scaling, [`LoadingSpec::for_sample`]), and the loading spec it was made with.
+fn loaded(sample: &Path, loading: &LoadingSpec) -> Result<(Scene, LoadingSpec)> {
     let scene = Scene::load(sample)?;
     let spec = loading.for_sample(&scene)?;
     Ok((loaded_scene(&scene, &spec)?, spec))
@@ -240,7 +122,7 @@ fn loaded(sample: &Path, loading: &Loading) -> Result<(Scene, LoadingSpec)> {
 /// # Errors
 /// [`Error::Scene`] for an unreadable sample or an invalid loading;
 /// [`Error::Io`] if `out` cannot be written.
-pub fn load(sample: &Path, loading: &Loading, out: &Path) -> Result<()> {
+pub fn load(sample: &Path, loading: &LoadingSpec, out: &Path) -> Result<()> {
     let (scene, _) = loaded(sample, loading)?;
     write_scene(out, &scene, &format!("loaded from {}", sample.display()))
 }
@@ -268,7 +150,7 @@ pub struct SettleOptions {
 /// or checkpoint; else as [`crate::run::Runner::run`].
 pub fn settle(
     sample: &Path,
-    loading: &Loading,
+    loading: &LoadingSpec,
     start: &Start,
     out: &Path,
     opts: &SettleOptions,
@@ -329,7 +211,7 @@ pub use super::Accelerate;
 #[allow(clippy::too_many_arguments)]
 pub fn settle_accelerated(
     sample: &Path,
-    loading: &Loading,
+    loading: &LoadingSpec,
     start: &Start,
     accelerate: &Accelerate,
     out: &Path,
@@ -421,7 +303,7 @@ pub fn replica_dir(out: &Path, r: u64) -> PathBuf {
 /// [`Error::Io`].
 pub fn settle_replicas(
     sample: &Path,
-    loading: &Loading,
+    loading: &LoadingSpec,
     out: &Path,
     opts: &SettleOptions,
     replicas: &Replicas,

@@ -16,11 +16,16 @@ pub enum Guide {
     Free,
 }
 
-/// The loading stage.
+/// The width of the paper's sleeper (m): 250 mm.
+pub const SLEEPER_WIDTH: f64 = 0.25;
+
+/// The loading stage: the one type of its settings, for the scene generator ([`loaded_scene`]), the studies
+/// (`crate::studies::saussine`) and the command line. [`LoadingSpec::default`] is the paper's, 100 cycles.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoadingSpec {
-    /// Width of the sleeper block (m).
-    pub sleeper_width: f64,
+    /// Width of the sleeper block (m); `None`: the paper's [`SLEEPER_WIDTH`], scaled with the sample by
+    /// [`LoadingSpec::for_sample`].
+    pub sleeper_width: Option<f64>,
     /// Height of the sleeper block, bars excluded (m).
     pub sleeper_height: f64,
     /// Density of the sleeper and its bars (kg/m³; 2700 for aluminium).
@@ -42,8 +47,9 @@ pub struct LoadingSpec {
     pub phase: f64,
     /// Angle of the load from the vertical (degrees, towards +x).
     pub inclination_deg: f64,
-    /// Which of the sleeper's degrees of freedom the loading frame holds.
-    pub guide: Guide,
+    /// Which of the sleeper's degrees of freedom the loading frame holds; `None`: [`Guide::Vertical`] for a
+    /// vertical load, [`Guide::Level`] otherwise.
+    pub guide: Option<Guide>,
     /// Factor on the sublayer's `k_N` (1, 100, 1000 in §4.2).
     pub stiffness_factor: f64,
     /// Number of loading cycles.
@@ -75,7 +81,7 @@ impl LoadingSpec {
     /// `data/saussine2006/README.md` (a 100 mm block punches into the layer).
     pub fn saussine(cycles: u64) -> Self {
         Self {
-            sleeper_width: 0.25,
+            sleeper_width: None,
             sleeper_height: 0.04,
             sleeper_density: 2700.0,
             bar_size: 0.01,
@@ -85,7 +91,7 @@ impl LoadingSpec {
             frequency: 20.0,
             phase: -PI,
             inclination_deg: 0.0,
-            guide: Guide::Vertical,
+            guide: None,
             stiffness_factor: 1.0,
             cycles,
             dt: 2e-4,
@@ -106,13 +112,52 @@ impl LoadingSpec {
     /// the ends and from each other (before, [`loaded_scene`] refused the sleeper
     /// of any sample of fewer than 116 grains).
     pub fn scaled(mut self, f: f64) -> Self {
-        self.sleeper_width *= f;
+        let width = self.width() * f;
+        self.sleeper_width = Some(width);
         self.mean *= f;
         self.amplitude *= f;
-        if self.bars > 0 && self.sleeper_width < self.min_sleeper_width() {
-            self.bar_size = self.sleeper_width / (2 * self.bars + 1) as f64;
+        if self.bars > 0 && width < self.min_sleeper_width() {
+            self.bar_size = width / (2 * self.bars + 1) as f64;
         }
         self
+    }
+
+    /// The loading for `sample`: scaled as the sample is from the paper's ([`SampleSpec::scaled`]: the load,
+    /// and the sleeper's width unless it is given, which then keeps its bars), so the pressure under the paper's
+    /// sleeper is the same; the guide resolved. A sample of the paper's size (or without grains) takes the
+    /// loading as it is.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming the field: a parameter out of range (as [`loaded_scene`] checks them).
+    pub fn for_sample(&self, sample: &Scene) -> Result<LoadingSpec> {
+        self.check()?;
+        let spec = LoadingSpec { guide: Some(self.guide()), ..self.clone() };
+        let grains = sample.bodies.iter().filter(|b| b.name.starts_with(GRAIN_PREFIX)).count();
+        let f = grains as f64 / SampleSpec::saussine(0).grading.iter().map(|g| g.1).sum::<usize>() as f64;
+        if grains == 0 || (f - 1.0).abs() < 1e-3 {
+            return Ok(spec);
+        }
+        let mut scaled = spec.clone().scaled(f);
+        if self.sleeper_width.is_some() {
+            // The given sleeper keeps its width and bars.
+            scaled.sleeper_width = self.sleeper_width;
+            scaled.bar_size = spec.bar_size;
+        }
+        Ok(scaled)
+    }
+
+    /// The sleeper's width (m): the given one or the paper's.
+    pub fn width(&self) -> f64 {
+        self.sleeper_width.unwrap_or(SLEEPER_WIDTH)
+    }
+
+    /// The guide: the given one, or vertical for a vertical load and level otherwise.
+    pub fn guide(&self) -> Guide {
+        match self.guide {
+            Some(g) => g,
+            None if self.inclination_deg == 0.0 => Guide::Vertical,
+            None => Guide::Level,
+        }
     }
 
     /// The narrowest sleeper (m) that holds its bars, `(bars + 2) × bar_size`: the
@@ -126,56 +171,62 @@ impl LoadingSpec {
         }
     }
 
-    /// Checks every parameter (one-line errors naming it).
-    fn check(&self) -> Result<()> {
-        let w = positive("loaded_scene: sleeper_width (m)", self.sleeper_width)?;
-        positive("loaded_scene: sleeper_height (m)", self.sleeper_height)?;
-        positive("loaded_scene: sleeper_density (kg/m³)", self.sleeper_density)?;
+    /// Checks every parameter (one-line errors led by the field's name).
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming the first field out of range.
+    pub fn check(&self) -> Result<()> {
+        let w = positive("sleeper_width: the sleeper's width (m)", self.width())?;
+        positive("sleeper_height: the sleeper's height (m)", self.sleeper_height)?;
+        positive("sleeper_density: the sleeper's density (kg/m³)", self.sleeper_density)?;
         if self.bars > 0 {
-            let b = positive("loaded_scene: bar_size (m)", self.bar_size)?;
+            let b = positive("bar_size: the bars' side (m)", self.bar_size)?;
             if w < self.min_sleeper_width() {
                 return refuse(format!(
-                    "loaded_scene: a sleeper {w} m wide is too narrow for {} bars of {b} m (at least {} m); use fewer bars",
+                    "bars: a sleeper {w} m wide is too narrow for {} bars of {b} m (at least {} m); use fewer bars",
                     self.bars,
                     self.min_sleeper_width()
                 ));
             }
         }
-        finite("loaded_scene: mean (N)", self.mean)?;
-        finite("loaded_scene: amplitude (N)", self.amplitude)?;
-        positive("loaded_scene: frequency (Hz)", self.frequency)?;
-        finite("loaded_scene: phase (rad)", self.phase)?;
+        finite("mean: the load's mean A (N)", self.mean)?;
+        finite("amplitude: the load's amplitude B (N)", self.amplitude)?;
+        positive("frequency: the loading frequency (Hz)", self.frequency)?;
+        finite("phase: the load's phase φ (rad)", self.phase)?;
         if !(self.inclination_deg.is_finite() && self.inclination_deg.abs() < 90.0) {
-            return refuse(format!(
-                "loaded_scene: inclination_deg must be in (-90, 90) degrees, got {}",
-                self.inclination_deg
-            ));
+            return refuse(format!("inclination_deg: must be in (-90, 90) degrees, got {}", self.inclination_deg));
         }
-        positive("loaded_scene: stiffness_factor", self.stiffness_factor)?;
+        positive("stiffness_factor: the factor on the sublayer's stiffness", self.stiffness_factor)?;
         if self.cycles == 0 {
-            return refuse("loaded_scene: cycles must be at least 1, got 0".into());
+            return refuse("cycles: must be at least 1, got 0".into());
         }
-        positive("loaded_scene: dt (s)", self.dt)?;
+        positive("dt: the time step (s)", self.dt)?;
         if Policy::from_name(&self.criterion).is_none() {
             return refuse(format!(
-                "loaded_scene: criterion '{}' is not one of 'strict', 'quad', 'quad_max', 'energy', 'velocity'",
+                "criterion: '{}' is not one of 'strict', 'quad', 'quad_max', 'energy', 'velocity'",
                 self.criterion
             ));
         }
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
-            return refuse(format!("loaded_scene: tolerance must be in (0, 1), got {}", self.tolerance));
+            return refuse(format!("tolerance: must be in (0, 1), got {}", self.tolerance));
         }
         if self.min_iterations == 0 || self.max_iterations < self.min_iterations {
             return refuse(format!(
-                "loaded_scene: min_iterations must be at least 1 and max_iterations at least min_iterations, got {} \
-                 and {}",
+                "min_iterations: must be at least 1 and max_iterations at least min_iterations, got {} and {}",
                 self.min_iterations, self.max_iterations
             ));
         }
         if self.output_every == 0 {
-            return refuse("loaded_scene: output_every must be at least 1, got 0".into());
+            return refuse("output_every: must be at least 1, got 0".into());
         }
         Ok(())
+    }
+}
+
+impl Default for LoadingSpec {
+    /// The paper's loading ([`LoadingSpec::saussine`]), 100 cycles.
+    fn default() -> Self {
+        Self::saussine(100)
     }
 }
 
@@ -216,7 +267,7 @@ pub fn loaded_scene(sample: &Scene, spec: &LoadingSpec) -> Result<Scene> {
         return Err(Error::Scene("loaded_scene: the sample still has its mould; run open_bank first".into()));
     }
     spec.check()?;
-    let (w, h, b) = (spec.sleeper_width, spec.sleeper_height, spec.bar_size);
+    let (w, h, b) = (spec.width(), spec.sleeper_height, spec.bar_size);
     let sys = sample.build()?;
     let top = surface_under(sample, &sys, -w / 2.0, w / 2.0)?;
     let mut out = sample.clone();
@@ -268,7 +319,7 @@ pub fn loaded_scene(sample: &Scene, spec: &LoadingSpec) -> Result<Scene> {
         parts.push(rect(x0, 0.0, x0 + b, b));
     }
     let zero = Some(Drive::Constant(0.0));
-    let imposed = match spec.guide {
+    let imposed = match spec.guide() {
         Guide::Vertical => Some(ImposedSpec { vx: zero, vy: None, spin: zero }),
         Guide::Level => Some(ImposedSpec { vx: None, vy: None, spin: zero }),
         Guide::Free => None,

@@ -26,7 +26,7 @@
 mod loading;
 mod measure;
 
-pub use loading::{loaded_scene, Guide, LoadingSpec};
+pub use loading::{loaded_scene, Guide, LoadingSpec, SLEEPER_WIDTH};
 pub use measure::{measure_sample, SampleReport};
 
 use super::{body, finite, non_negative, positive, rect, refuse, validated};

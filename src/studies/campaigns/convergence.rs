@@ -17,7 +17,7 @@ pub struct ConvergenceSpec {
     /// The replicas of each setting ([`Replicas::default`]: one, today's single run).
     pub replicas: Replicas,
     /// The loading of every run (its criterion and tolerance replaced by each run's).
-    pub loading: Loading,
+    pub loading: LoadingSpec,
 }
 
 /// The reference setting of [`ConvergenceSpec::reference`] among `runs`: its index.

@@ -43,7 +43,7 @@ pub struct EnsembleSpec {
     /// Time step of the deposits (s).
     pub sample_dt: f64,
     /// The loading of every run (its stiffness factor replaced by each run's).
-    pub loading: Loading,
+    pub loading: LoadingSpec,
 }
 
 /// §4.2 (`ballast saussine ensemble`): the samples deposited side by side in
@@ -67,10 +67,10 @@ pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisp
         return Err(Error::Scene(format!("factors: every stiffness factor must be positive, got {f}")));
     }
     // The loading and the options are checked before the deposits.
-    let loadings: Vec<Loading> =
-        factors.iter().map(|&k| Loading { stiffness_factor: k, ..spec.loading.clone() }).collect();
+    let loadings: Vec<LoadingSpec> =
+        factors.iter().map(|&k| LoadingSpec { stiffness_factor: k, ..spec.loading.clone() }).collect();
     for loading in &loadings {
-        loading.spec()?;
+        loading.check()?;
     }
     let threads = study.threads()?;
     let out = &study.out;

@@ -47,7 +47,7 @@ use super::replicas::{
     perturb_scene, settlement_ensemble, EnsembleColumns, Estimate, Perturbation, ReferenceColumns, Replicas,
     SettlementSummary, ENSEMBLE_COLUMNS, REFERENCE_COLUMNS, REPLICA_FILE,
 };
-use super::saussine::{sample, Loading};
+use super::saussine::sample;
 use super::{axes, output_error, run_scene, RunDisplay, SummaryTable};
 use crate::error::{Error, Result};
 use crate::io;

@@ -15,7 +15,7 @@ pub struct StepsSpec {
     /// The replicas of each setting ([`Replicas::default`]: one, today's single run).
     pub replicas: Replicas,
     /// The loading of every run (its time step and inclination replaced by each run's).
-    pub loading: Loading,
+    pub loading: LoadingSpec,
 }
 
 /// §3.3 (`ballast saussine steps`): one run per inclination and time step,
@@ -41,7 +41,7 @@ pub fn steps(spec: &StepsSpec, study: &StudyOptions, display: &dyn RunDisplay) -
     let mut settings = Vec::new();
     let mut keys = Vec::new();
     for &a in inclinations {
-        let base = Loading { inclination_deg: a, ..spec.loading.clone() }.for_sample(&sample_scene)?;
+        let base = LoadingSpec { inclination_deg: a, ..spec.loading.clone() }.for_sample(&sample_scene)?;
         for &dt in dts {
             settings.push(Job::loaded(
                 format!("incl_{}_dt_{}", label_number(a), label_number(dt)),
