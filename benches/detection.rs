@@ -4,6 +4,7 @@
 
 use ballast::nscd::detection::Detector;
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 
 fn bench(c: &mut Criterion) {

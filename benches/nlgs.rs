@@ -15,6 +15,7 @@ use ballast::nscd::nlgs::{solve_nlgs, solve_nlgs_split, sweep, NlgsSettings, Spl
 use ballast::nscd::{Measure, Policy};
 use ballast::scenarios::saussine::{loaded_scene, LoadingSpec};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use std::hint::black_box;
 

@@ -28,6 +28,7 @@ use ballast::nscd::apgd::{solve_apgd_with, ApgdOptions, ApgdWorkspace, FrictionB
 use ballast::nscd::nlgs::{apply_impulses, solve_nlgs, NlgsProblem, NlgsReport};
 use ballast::nscd::{Measure, NlgsSettings, Policy, System};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use serde::Serialize;
 use std::time::Instant;
 

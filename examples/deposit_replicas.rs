@@ -15,6 +15,7 @@
 
 use ballast::run::{RunOptions, Runner};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use ballast::studies::replicas::{perturb_scene, Perturbation, DEFAULT_PERTURB_SEED};
 use std::path::PathBuf;
 

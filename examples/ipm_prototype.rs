@@ -93,6 +93,7 @@ use ballast::nscd::nlgs::{check, solve_nlgs, NlgsProblem, NlgsSettings};
 use ballast::nscd::sublayer::SpringRow;
 use ballast::nscd::Measure;
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use gmres::{gmres, Op};
 use jacobian::{add_force, free_velocity, gather, local, rebuild, Jacobian, LuJacobian};
 use std::time::Instant;

@@ -12,6 +12,7 @@ use ballast::md::{Ghosts, LawTable, Material, MdSettings, MdSystem, Motion, Pair
 use ballast::nscd::{BodyInfo, ContactLaw, NscdParams, System};
 use ballast::open::run_file;
 use ballast::run::{RunOptions, RunPlan, Runner};
+use ballast::scene::SceneFile;
 use std::path::PathBuf;
 
 fn main() -> Result<(), ballast::Error> {

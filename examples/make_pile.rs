@@ -5,6 +5,7 @@
 //! (defaults: 536 grains, 0.4 m, seed 1, `data/pentagon_pile_536.toml`).
 
 use ballast::scenarios::{pentagon_deposit, DepositSpec};
+use ballast::scene::SceneFile;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -45,6 +45,7 @@ use ballast::nscd::nlgs::{check, solve_nlgs, NlgsSettings};
 use ballast::nscd::sublayer::SpringRow;
 use ballast::nscd::Measure;
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use jacobian::{add_force, free_velocity, gather, rebuild, scatter, Jacobian, NONE};
 use std::time::Instant;
 

@@ -22,6 +22,7 @@
 use ballast::nscd::nlgs::Solver;
 use ballast::nscd::{Measure, Policy};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use serde::Serialize;
 use std::time::Instant;
 

@@ -20,6 +20,7 @@ use ballast::report::plane::settlement_series;
 use ballast::run::{RunOptions, Status};
 use ballast::scenarios::saussine::{loaded_scene, measure_sample, sample_scene, LoadingSpec, SampleSpec};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use std::path::PathBuf;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

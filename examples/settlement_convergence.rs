@@ -34,6 +34,7 @@ use ballast::run::positions::CyclePositions;
 use ballast::run::{RunOptions, Runner, Status};
 use ballast::scenarios::saussine::{loaded_scene, sample_scene, LoadingSpec, SampleSpec};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use ballast::settlement::{configuration_error, Accelerated, Acceleration, AccelerationSummary, SettlementRow};
 use ballast::studies::replicas::{perturb_scene, Estimate, Perturbation};
 use rayon::prelude::*;

@@ -26,6 +26,7 @@ use ballast::nscd::contact::ContactRow;
 use ballast::nscd::nlgs::{solve_nlgs, NlgsProblem, NlgsSettings};
 use ballast::nscd::{Measure, Policy};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use std::time::Instant;
 
 fn settings(policy: Policy, tolerance: f64, max: usize) -> NlgsSettings {

@@ -31,6 +31,7 @@ use ballast::scenarios::md_bed::{bed_system, BedSpec};
 use ballast::scenarios::saussine::LoadingSpec;
 use ballast::scenarios::{pentagon_deposit, DepositSpec};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use ballast::studies::saussine::load;
 use ballast::team::TeamStats;
 use std::process::{Child, Command};

@@ -45,7 +45,8 @@
 //! ```
 //! use ballast::engine::Engine;
 //! use ballast::run::{RunOptions, RunPlan, Runner};
-//! let scene = ballast::scene::Scene::load("examples/block_on_floor.toml")?;
+//! use ballast::scene::{Scene, SceneFile}; // SceneFile: reading and writing a scene file
+//! let scene = Scene::load("examples/block_on_floor.toml")?;
 //! let mut sys = scene.build()?; // nscd::System: plain serde data
 //! let mut c = sys.configuration(); // (x, y, θ) of every mobile body
 //! c.q[1] += 1e-3; // the first one 1 mm higher

@@ -14,7 +14,8 @@ use crate::md::planar::PlanarSystem;
 use crate::md::MdSystem;
 use crate::nscd::System;
 use crate::run::{Figures, Progress, Restart, RunOptions, RunOutcome, Runner};
-use crate::scene::common::{AccelerationPlan, RecordedText};
+use crate::scene::common::AccelerationPlan;
+use crate::scene::SceneFile;
 use crate::scene::{planar_length, scene_on, MdScene, Scene, SceneKind, SoftModelInfo};
 use crate::settlement::{Accelerated, AccelerationProgress, AccelerationSummary, FolderFigures};
 use std::path::{Path, PathBuf};
@@ -53,7 +54,7 @@ pub enum Loaded {
 /// [`Error::File`] naming the file if it cannot be read; [`Error::Scene`] (one line naming the key) for an
 /// invalid scene or override.
 pub fn open(path: &Path, opts: &RunOptions) -> Result<Loaded> {
-    let text = Scene::read_text(path)?;
+    let text = crate::scene::read_text(path)?;
     let name = path.display().to_string();
     match SceneKind::of(&text, &name, opts.engine.as_deref())? {
         SceneKind::Md => {

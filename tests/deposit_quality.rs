@@ -22,6 +22,7 @@
 use ballast::run::RunEnd;
 use ballast::run::{RunOptions, Runner};
 use ballast::scenarios::{pentagon_deposit, DepositSpec};
+use ballast::scene::SceneFile;
 
 #[test]
 fn a_scaled_deposit_comes_to_rest_with_small_overlaps() {

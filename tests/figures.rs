@@ -5,6 +5,7 @@ mod scratch;
 
 use ballast::io::figures::{displacement_field, force_chains, line_chart, Arrow, Axes, ForceLine, Series};
 use ballast::report::plane::{force_lines_of, polygons_of};
+use ballast::scene::SceneFile;
 use std::path::Path;
 
 /// Width and height of a PNG, from its IHDR chunk, after checking the signature.

@@ -39,6 +39,7 @@ mod scratch;
 use ballast::open::run_file;
 use ballast::run::checkpoint::crc32;
 use ballast::run::{Progress, RunOptions, RunOutcome, Status};
+use ballast::scene::SceneFile;
 use ballast::scene::{engine_of, MdScene, Scene};
 use ballast::Error;
 use rand::{RngExt, SeedableRng};

@@ -12,6 +12,7 @@ use ballast::scenarios::saussine::{
     self, Guide, LoadingSpec, SampleSpec, GRAIN_PREFIX, MIN_SCALED_GRAINS, PAD_PREFIX, SLEEPER,
 };
 use ballast::scenarios::{pentagon_deposit, DepositSpec};
+use ballast::scene::SceneFile;
 use ballast::scene::{MdScene, Scene};
 use std::path::Path;
 use std::process::Command;

@@ -21,6 +21,7 @@ use ballast::engine::{Configuration, Engine};
 use ballast::nscd::measure::world_polygon;
 use ballast::nscd::System;
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use ballast::settlement::sweep;
 
 /// The relaxation tolerance of the full run: 1 % of the smallest grain's inradius (m).

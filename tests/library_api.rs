@@ -9,6 +9,7 @@ use ballast::md::{
     self, Ghosts, LawTable, Material, MdSettings, MdSystem, Motion, PairLaw, Particles, SymmetryPlane, Wall, V3,
 };
 use ballast::nscd::{BodyInfo, Harmonic, Imposed, Load, NscdParams, System};
+use ballast::scene::SceneFile;
 use ballast::scene::{MdScene, Scene};
 use ballast::Error;
 use std::f64::consts::PI;

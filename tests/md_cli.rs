@@ -4,6 +4,7 @@
 
 mod scratch;
 
+use ballast::scene::SceneFile;
 use std::path::Path;
 use std::process::{Command, Output};
 

@@ -10,6 +10,7 @@ mod scratch;
 use ballast::open::run_file;
 use ballast::run::RunOptions;
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use std::path::{Path, PathBuf};
 
 const BLOCK: &str = "examples/block_on_floor.toml";

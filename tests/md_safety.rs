@@ -14,6 +14,7 @@ use ballast::md::neighbours::{grid, Neighbours};
 use ballast::md::{Damping, GearSet, Integrator, Material, PairLaw, Particles, V3};
 use ballast::scenarios::{karrech, luding, md_bed};
 use ballast::scene::MdScene;
+use ballast::scene::SceneFile;
 use md_common::*;
 use std::f64::consts::PI;
 use std::fmt::Write;

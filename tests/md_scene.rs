@@ -4,6 +4,7 @@
 //! message names the section, the entry and the field.
 
 use ballast::md::{self, Damping, Drive, GearSet, History1, Integrator, Model, Motion, Shape, V3};
+use ballast::scene::SceneFile;
 use ballast::scene::{engine_of, MdScene, Scene};
 use std::f64::consts::PI;
 

@@ -9,6 +9,7 @@ use ballast::nscd::criterion::{evaluate, Measure, Policy};
 use ballast::nscd::nlgs::{check, solve_nlgs, sweep, NlgsProblem, NlgsSettings, OnStall};
 use ballast::run::RunOptions;
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use ballast::Error;
 
 const PILE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/data/pentagon_pile_536.toml");

@@ -7,6 +7,7 @@ mod common;
 use ballast::geometry::{rotate, Compound, GeometryError, Shape, Vec2};
 use ballast::nscd::{BodyInfo, Harmonic, Imposed, Load, System};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use ballast::Error;
 use common::{floor, params, rect, run, system, G};
 

@@ -12,6 +12,7 @@ use ballast::nscd::interior::{solve_interior, InteriorOptions, InteriorWorkspace
 use ballast::nscd::nlgs::{solve_nlgs, NlgsProblem, NlgsReport, NlgsSettings, Solver};
 use ballast::nscd::{Measure, Policy, System};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use common::*;
 
 /// The interior point alone.

@@ -3,6 +3,7 @@
 
 mod common;
 use ballast::nscd::{Policy, System};
+use ballast::scene::SceneFile;
 use ballast::Error;
 use common::*;
 

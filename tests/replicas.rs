@@ -5,6 +5,7 @@
 
 mod scratch;
 
+use ballast::scene::SceneFile;
 use ballast::scene::{MdScene, Scene};
 use ballast::studies::replicas::{ball_point, perturb_md_scene, perturb_scene, t_quantile_975, Perturbation};
 use std::collections::HashMap;

@@ -11,6 +11,7 @@ use ballast::engine::Engine;
 use ballast::engine::FinalState;
 use ballast::run::RunEnd;
 use ballast::run::{RunOptions, RunPlan, Runner, Status};
+use ballast::scene::SceneFile;
 use ballast::scene::{MdScene, Scene};
 use ballast::Error;
 use std::path::{Path, PathBuf};

@@ -10,6 +10,7 @@ mod scratch;
 use ballast::run::{RunOptions, Runner, Status};
 use ballast::scenarios::saussine::{loaded_scene, measure_sample, sample_scene, LoadingSpec, SampleSpec};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use std::sync::OnceLock;
 
 const GRAINS: usize = 121;

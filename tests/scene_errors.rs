@@ -3,6 +3,7 @@
 //! round-trips the state.
 
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use ballast::Error;
 
 /// A valid scene with a floor, a block, a pentagon with an imposed velocity and

@@ -10,6 +10,7 @@ use ballast::run::positions::CyclePositions;
 use ballast::run::{RunOptions, Runner, Status};
 use ballast::scenarios::saussine::{loaded_scene, sample_scene, LoadingSpec, SampleSpec};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use ballast::settlement::estimate::configuration_error;
 use ballast::settlement::{Accelerated, Acceleration, Law, SettlementRow};
 use ballast::studies::replicas::{perturb_scene, Perturbation};

@@ -12,6 +12,7 @@ mod scratch;
 use ballast::engine::Engine;
 use ballast::run::{RunOptions, Runner};
 use ballast::scenarios::karrech::{deposit_scene, loading_scene, KarrechSpec, Loading};
+use ballast::scene::SceneFile;
 use ballast::settlement::{Accelerated, Acceleration, SettlementRow};
 
 const CYCLES: u64 = 90;

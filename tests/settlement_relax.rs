@@ -13,6 +13,7 @@ use ballast::engine::Engine;
 use ballast::engine::{Functional, Method, RelaxReport, RelaxSettings};
 use ballast::md::relax::Potential;
 use ballast::md::{Ghosts, Integrator, LawTable, Material, MdSystem, PairLaw, Particles, SymmetryPlane, V3};
+use ballast::scene::SceneFile;
 use md_common::{plane, settings};
 
 /// Karrech et al. Table 1: diorite.

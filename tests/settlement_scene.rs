@@ -6,6 +6,7 @@ mod scratch;
 
 use ballast::open::settle_file;
 use ballast::run::RunOptions;
+use ballast::scene::SceneFile;
 use ballast::settlement::{AccelerationSummary, JumpRow, SettlementRow};
 use std::path::Path;
 

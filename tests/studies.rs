@@ -10,6 +10,7 @@ use ballast::scenarios::karrech::Loading as Plate;
 use ballast::scenarios::saussine::LoadingSpec;
 use ballast::scenarios::saussine::{SampleSpec, SLEEPER};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use ballast::studies::campaigns::{self, ConvergenceSpec, EnsembleRow, EnsembleSpec, StudyOptions};
 use ballast::studies::luding::{self, CompareRow, Compression, LoopRow, StrainRow};
 use ballast::studies::md_stage::{Stage, TestSpec};

@@ -24,6 +24,7 @@ use ballast::nscd::System;
 use ballast::scenarios::md_bed::{bed_system, BedSpec};
 use ballast::scenarios::saussine::{loaded_scene, LoadingSpec};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 

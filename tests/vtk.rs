@@ -5,6 +5,7 @@ use ballast::io::vtk::PvdCollection;
 use ballast::nscd::System;
 use ballast::plane::vtk::{write_bodies, write_contacts, DISC_VERTICES};
 use ballast::scene::Scene;
+use ballast::scene::SceneFile;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 

@@ -8,6 +8,7 @@
 
 use ballast::engine::{Configuration, Engine};
 use ballast::md::{Ghosts, MdSystem};
+use ballast::scene::SceneFile;
 use ballast::scene::{MdScene, Scene};
 
 /// Pentagons and a disc on a pad held by two sublayer springs above a fixed

@@ -1,6 +1,7 @@
 //! `ballast deposit`: writes the scene of a loose pentagon deposit.
 
 use super::{input, Failure};
+use ballast::scene::SceneFile;
 use std::path::PathBuf;
 
 /// The arguments of `ballast deposit`.

@@ -115,7 +115,8 @@ fn bodies_and_contacts(bodies: PathBuf, contacts: PathBuf) -> Vec<PvdPart> {
 /// ```no_run
 /// # fn main() -> ballast::Result<()> {
 /// use ballast::io::vtk::PvdCollection;
-/// let scene = ballast::scene::Scene::load("examples/block_on_floor.toml")?;
+/// use ballast::scene::{Scene, SceneFile};
+/// let scene = Scene::load("examples/block_on_floor.toml")?;
 /// let mut sys = scene.build()?;
 /// let dir = std::path::Path::new("out");
 /// std::fs::create_dir_all(dir)?;

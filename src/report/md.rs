@@ -27,6 +27,7 @@ use crate::io::figures::{self, Axes, Series};
 use crate::io::layout;
 use crate::md::rows::{MdSeriesRow, MD_SERIES_COLUMNS};
 use crate::md::{MdSystem, Shape, Wall, V3};
+use crate::scene::SceneFile;
 use std::path::Path;
 
 /// Sides of the polygon a sphere is drawn as.

@@ -20,6 +20,7 @@ use crate::error::{Error, Result};
 use crate::io::figures::{self, Arrow, Axes, ForceLine, Series};
 use crate::io::layout;
 use crate::nscd::System;
+use crate::scene::SceneFile;
 use std::path::Path;
 
 /// Series of a settlement curve from `cycles.csv` rows, multiplied by `scale`

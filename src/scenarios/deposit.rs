@@ -10,7 +10,7 @@
 //! energy below 1e-11 J per grain for 500 steps) or after `duration`.
 //!
 //! [`pentagon_deposit`] builds the [`Scene`] value (validated like a scene file);
-//! save it with [`Scene::to_toml_string`].
+//! save it with [`Scene::to_toml_string`](crate::scene::SceneFile::to_toml_string).
 
 use super::{body, non_negative, positive, rect, refuse, validated};
 use crate::error::Result;

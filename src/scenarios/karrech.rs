@@ -20,13 +20,14 @@
 //! - the time step: 1e-7 s (the paper's order of magnitude, §2.3).
 //!
 //! [`deposit_scene`] and [`loading_scene`] build [`MdScene`] values, validated
-//! like a scene file; save them with [`MdScene::to_toml_string`].
+//! like a scene file; save them with [`MdScene::to_toml_string`](crate::scene::SceneFile::to_toml_string).
 
 use super::{md_material, md_plane, md_sphere, non_negative, positive, refuse, xyz};
 use crate::error::Result;
 use crate::md::V3;
 use crate::run::Equilibrium;
 use crate::scene::md::{CylinderSpec, DiscSpec, MdContact, MdSection, ServoSpec, SymmetrySpec, WallSpec};
+use crate::scene::SceneFile;
 use crate::scene::{CyclesSpec, MdScene, OutputSection, Simulation};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -20,13 +20,14 @@
 //! wall law is the same linear law with μ = 0.
 //!
 //! Both stages are [`MdScene`] values, validated like a scene file; save them
-//! with [`MdScene::to_toml_string`].
+//! with [`MdScene::to_toml_string`](crate::scene::SceneFile::to_toml_string).
 
 use super::{md_material, md_plane, md_sphere, non_negative, positive, refuse};
 use crate::error::Result;
 use crate::md::V3;
 use crate::run::Equilibrium;
 use crate::scene::md::{MdContact, MdSection, ServoSpec};
+use crate::scene::SceneFile;
 use crate::scene::{CyclesSpec, MdScene, OutputSection, Simulation};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

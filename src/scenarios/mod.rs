@@ -21,6 +21,7 @@ pub mod saussine;
 pub use deposit::{pentagon_deposit, DepositSpec};
 
 use crate::error::{Error, Result};
+use crate::scene::SceneFile;
 use crate::scene::{BodySpec, Scene};
 
 /// `Err(Error::Scene(msg))`.

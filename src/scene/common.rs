@@ -458,26 +458,3 @@ pub(crate) fn write_settlement(out: &mut String, s: Option<&SettlementSection>) 
     opt(out, "relax_stage", s.relax_stage, float);
     opt(out, "hold_anchored", s.hold_anchored, |b| b.to_string());
 }
-
-/// A scene of either engine as a run records it (`scene.toml`): the text it was
-/// read from, or, when a run's length replaces its `[simulation] duration`, the
-/// scene written again with it.
-pub(crate) trait RecordedText {
-    /// `[simulation]`, to change.
-    fn simulation_mut(&mut self) -> &mut Simulation;
-
-    /// The scene as TOML text.
-    fn to_text(&self) -> Result<String>;
-
-    /// `text` (the file as read) if `length` is `None`; else the scene with its
-    /// duration replaced by `length` (the scene itself changed too), as text.
-    fn text_with_length(&mut self, text: String, length: Option<crate::run::RunLength>) -> Result<String> {
-        match length {
-            Some(length) => {
-                self.simulation_mut().set_length(length)?;
-                self.to_text()
-            }
-            None => Ok(text),
-        }
-    }
-}

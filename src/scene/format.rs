@@ -1,7 +1,7 @@
 //! The serde mirror of the TOML scene format (see `docs/scene-format.md`).
 //!
 //! Every table refuses unknown keys. Optional keys are `Option`s (or empty
-//! vectors) so that a scene written back with [`Scene::to_toml_string`] keeps
+//! vectors) so that a scene written back with [`Scene::to_toml_string`](crate::scene::SceneFile::to_toml_string) keeps
 //! exactly the keys the user gave; the engine's defaults are those of
 //! [`crate::nscd::NscdParams::default`] (θ, gravity, NLGS settings), the others
 //! live in the accessor methods and the `DEFAULT_*` constants. All quantities

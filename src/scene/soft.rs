@@ -18,6 +18,7 @@ use super::validate::{err, num};
 use crate::error::{Error, Result};
 use crate::md::planar::stiffness::{self, Reference, DEFAULT_DT_FRACTION};
 use crate::md::planar::{PlanarParams, PlanarSystem, SoftLaw, SoftModel};
+use crate::scene::SceneFile;
 use serde::{Deserialize, Serialize};
 
 /// The default `max_overlap_ratio` when the scene gives no stiffness.
@@ -352,7 +353,7 @@ pub fn planar_length(length: Option<crate::run::RunLength>, dt: f64) -> Option<c
 
 impl Scene {
     /// The run plan of the scene on the planar MD engine, whose step is `dt`
-    /// (s): as [`Scene::plan`], with `round(duration / dt)` steps.
+    /// (s): as [`Scene::plan`](crate::scene::SceneFile::plan), with `round(duration / dt)` steps.
     ///
     /// # Errors
     /// [`Error::Scene`] if the scene is invalid.

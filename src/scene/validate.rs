@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{rotate, Compound, ConvexPolygon, GeometryError, Shape, Vec2};
 use crate::nscd::nlgs::{OnStall, Solver};
 use crate::nscd::{Measure, NlgsSettings, NscdParams, Policy};
+use crate::scene::SceneFile;
 use std::collections::HashMap;
 
 /// Largest number of steps a scene may ask for (2⁵³, where `f64` stops counting exactly).

@@ -37,6 +37,7 @@ use crate::io::figures::{self, Series};
 use crate::io::table::write_all;
 use crate::scenarios::saussine::loaded_scene;
 use crate::scenarios::saussine::LoadingSpec;
+use crate::scene::SceneFile;
 use crate::scene::{Scene, SoftSection};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;

@@ -17,6 +17,7 @@ use super::replicas::{perturb_md_scene, REPLICA_FILE};
 use super::RunDisplay;
 use crate::error::{Error, Result};
 use crate::scenarios::karrech::{self, KarrechSpec, Loading};
+use crate::scene::SceneFile;
 use std::path::Path;
 
 /// The deposit: the Table 1 sample of `spheres` spheres (850: the paper's

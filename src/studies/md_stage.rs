@@ -14,6 +14,7 @@ use crate::io::layout;
 use crate::md::{MdSystem, V3};
 use crate::run::{RunOptions, RunOutcome};
 use crate::scene::MdScene;
+use crate::scene::SceneFile;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 

@@ -32,6 +32,7 @@ use crate::scenarios::saussine::{
     loaded_scene, measure_sample, open_bank, sample_scene, LoadingSpec, SampleReport, SampleSpec,
 };
 use crate::scene::Scene;
+use crate::scene::SceneFile;
 use std::path::{Path, PathBuf};
 
 /// Writes `scene` to `path` with a header line saying `what` it is.

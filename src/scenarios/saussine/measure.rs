@@ -2,6 +2,7 @@
 //! height, solid fraction and coordination (Saussine et al. 2006, §3).
 
 use super::*;
+use crate::scene::SceneFile;
 
 /// What `sample.json` records about a deposited sample.
 #[derive(Debug, Clone, serde::Serialize)]

@@ -3,7 +3,7 @@
 //! bars under its lower face, loaded by `F = A + B cos(2π f t − φ)`.
 //!
 //! Two stages, each a plain [`Scene`] value, validated like a scene file and
-//! saved with [`Scene::to_toml_string`] to be run by `ballast run`, so that every
+//! saved with [`Scene::to_toml_string`](crate::scene::SceneFile::to_toml_string) to be run by `ballast run`, so that every
 //! stage is saved, validated and rerun like a hand-written scene:
 //! 1. [`sample_scene`]: the loose sample above the sublayer, between two side
 //!    walls, to deposit until equilibrium. With [`SampleSpec::bank`] the side walls

@@ -3,7 +3,7 @@
 //! planes, materials with elastic moduli and pairwise contact laws.
 //!
 //! As for NSCD scenes, every table refuses unknown keys and optional keys are
-//! `Option`s, so that [`MdScene::to_toml_string`] writes back exactly the keys the
+//! `Option`s, so that [`MdScene::to_toml_string`](crate::scene::SceneFile::to_toml_string) writes back exactly the keys the
 //! user gave; the defaults are those of [`crate::md::MdSettings::default`]
 //! (and of the shared sections, [`crate::scene::common`]). Vectors are arrays of exactly 3 numbers. All quantities are SI.
 

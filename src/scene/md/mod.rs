@@ -7,7 +7,8 @@
 //! which of the two formats a file is in.
 //!
 //! ```
-//! let scene = ballast::scene::MdScene::from_toml_str(r#"
+//! use ballast::scene::{MdScene, SceneFile};
+//! let scene = MdScene::from_toml_str(r#"
 //!     [simulation]
 //!     engine = "md"
 //!     dt = 1e-6
@@ -43,78 +44,36 @@ mod write;
 
 pub use format::*;
 
-use crate::error::{Error, Result};
-use crate::scene::{parse, Scene, DEFAULT_OUTPUT_EVERY};
-use std::path::Path;
+use crate::error::Result;
+use crate::scene::common::Simulation;
+use crate::scene::{OutputSection, SceneFile};
 
-impl crate::scene::common::RecordedText for MdScene {
-    fn simulation_mut(&mut self) -> &mut crate::scene::common::Simulation {
-        &mut self.simulation
-    }
-
-    fn to_text(&self) -> Result<String> {
-        self.to_toml_string()
-    }
-}
-
-impl MdScene {
-    /// Parses and fully validates an MD scene. Errors are [`Error::Scene`] with a
-    /// single-line message; TOML syntax errors, unknown keys and missing fields
-    /// read `scene.toml line L: …`.
-    pub fn from_toml_str(text: &str) -> Result<MdScene> {
-        Self::from_toml_str_named(text, "scene.toml")
-    }
-
-    /// As [`MdScene::from_toml_str`], with `name` in place of `scene.toml` in the
-    /// messages of syntax errors.
-    pub fn from_toml_str_named(text: &str, name: &str) -> Result<MdScene> {
-        let scene: MdScene = toml::from_str(text).map_err(|e| Error::Scene(parse::one_line(name, text, &e)))?;
-        validate::check(&scene)?;
-        Ok(scene)
-    }
-
-    /// Reads, parses and validates the MD scene file at `path`; syntax errors name
-    /// the file as given. A file that cannot be read is an [`Error::File`].
-    pub fn load(path: impl AsRef<Path>) -> Result<MdScene> {
-        let path = path.as_ref();
-        Self::from_toml_str_named(&Scene::read_text(path)?, &path.display().to_string())
-    }
-
-    /// Validates a scene built as a value (e.g. by a generator of
-    /// [`crate::scenarios`]) exactly as [`MdScene::from_toml_str`] validates a
-    /// file: the same one-line [`Error::Scene`] messages.
-    pub fn validate(&self) -> Result<()> {
+impl SceneFile for MdScene {
+    fn check(&self) -> Result<()> {
         validate::check(self).map(|_| ())
     }
 
-    /// The scene as TOML text that [`MdScene::from_toml_str`] reads back to an
-    /// equal scene (only the keys the scene has; floats in their shortest exact
-    /// form). It does not fail at present; the `Result` leaves room for formats
-    /// that might.
-    pub fn to_toml_string(&self) -> Result<String> {
+    fn to_toml_string(&self) -> Result<String> {
         Ok(write::to_toml(self))
     }
 
-    /// Number of time steps of the run, `round(duration / dt)` (0 if `dt` is not positive).
-    pub fn steps(&self) -> u64 {
-        self.simulation.steps()
+    fn simulation(&self) -> &Simulation {
+        &self.simulation
     }
 
-    /// Random seed recorded in the outputs (default 0).
-    pub fn seed(&self) -> u64 {
-        self.simulation.seed()
+    fn simulation_mut(&mut self) -> &mut Simulation {
+        &mut self.simulation
     }
 
-    /// Number of steps between two rows of `series.csv` (default 1, never 0).
-    pub fn output_every(&self) -> u64 {
-        self.output.as_ref().and_then(|o| o.every).unwrap_or(DEFAULT_OUTPUT_EVERY).max(1)
+    fn output(&self) -> Option<&OutputSection> {
+        self.output.as_ref()
     }
 
     /// The run plan of the scene: steps, output, equilibrium stop, cycles, seed.
     ///
     /// # Errors
-    /// [`Error::Scene`] if the scene is invalid.
-    pub fn plan(&self) -> Result<crate::run::RunPlan> {
+    /// [`Error::Scene`](crate::Error::Scene) if the scene is invalid.
+    fn plan(&self) -> Result<crate::run::RunPlan> {
         let cycles = crate::scene::common::check_output(self.output.as_ref(), false, |_| None)?;
         Ok(crate::scene::common::run_plan(&self.simulation, self.output.as_ref(), cycles))
     }
@@ -122,8 +81,8 @@ impl MdScene {
     /// The settlement-acceleration procedure the scene asks for (`[settlement]`), if any.
     ///
     /// # Errors
-    /// [`Error::Scene`] if the scene is invalid.
-    pub fn acceleration(&self) -> Result<Option<crate::scene::common::AccelerationPlan>> {
+    /// [`Error::Scene`](crate::Error::Scene) if the scene is invalid.
+    fn acceleration(&self) -> Result<Option<crate::scene::common::AccelerationPlan>> {
         let plan = self.plan()?;
         let sim = &self.simulation;
         use crate::scene::common::SettlementRef;
@@ -142,7 +101,9 @@ impl MdScene {
             }
         })
     }
+}
 
+impl MdScene {
     /// Force-evaluation threads the scene asks for (`md.threads`), if any.
     pub fn threads(&self) -> Option<usize> {
         self.md.as_ref().and_then(|m| m.threads)

@@ -2,6 +2,7 @@
 //! table (`ballast saussine convergence`).
 
 use super::*;
+use crate::scene::SceneFile;
 
 /// §3.2: the loaded sample under each convergence policy and tolerance.
 #[derive(Debug, Clone, PartialEq)]

@@ -2,6 +2,7 @@
 //! same cycles (`ballast saussine ensemble`).
 
 use super::*;
+use crate::scene::SceneFile;
 
 /// Statistics over the samples of an ensemble.
 #[derive(Debug, Clone, Copy, PartialEq)]

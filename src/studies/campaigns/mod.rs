@@ -60,6 +60,7 @@ use crate::run::RunReport;
 use crate::run::{cores, default_threads, Prior, RunOptions};
 use crate::scenarios::saussine::{loaded_scene, LoadingSpec, SampleSpec};
 use crate::scene::Scene;
+use crate::scene::SceneFile;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};

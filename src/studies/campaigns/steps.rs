@@ -2,6 +2,7 @@
 //! (`ballast saussine steps`).
 
 use super::*;
+use crate::scene::SceneFile;
 
 /// §3.3: the loaded sample with each time step, at each inclination.
 #[derive(Debug, Clone, PartialEq)]

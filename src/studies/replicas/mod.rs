@@ -38,7 +38,7 @@
 //!
 //! One replica's start, perturbed:
 //! ```no_run
-//! use ballast::scene::Scene;
+//! use ballast::scene::{Scene, SceneFile};
 //! use ballast::studies::replicas::{perturb_scene, Perturbation};
 //! let mut scene = Scene::load("out/sample1/sample.toml")?;
 //! let record = perturb_scene(&mut scene, &Perturbation { distance_m: 1e-9, seed: 7 }, 3)?;

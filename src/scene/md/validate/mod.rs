@@ -19,6 +19,7 @@ use crate::md::{
     Wall, V3,
 };
 use crate::scene::validate::{err, finite, label, non_negative, num, positive, MAX_LENGTH, MIN_SIZE};
+use crate::scene::SceneFile;
 use laws::{check_contact, check_laws_cover, pair_law};
 use std::collections::HashMap;
 use std::sync::Mutex;
