@@ -55,7 +55,7 @@ fn compare_writes_every_run_and_cycle_and_derives_the_md_settings_from_the_ratio
     for (i, r) in rows.iter().enumerate() {
         let (setting, replica, cycle) = (i / 4, (i / 2) % 2, i % 2 + 1);
         assert_eq!((r.replica, r.cycle), (replica as u64, cycle as u64), "row {i}");
-        assert_eq!(r.engine, if setting == 0 { "nscd" } else { "md" });
+        assert_eq!(r.engine, if setting == 0 { "nscd" } else { "md2d" });
         assert_eq!(r.overlap_ratio, [None, Some(1e-2), Some(1e-3)][setting]);
         assert!(r.settlement_m.is_finite() && r.wall_time_s > 0.0 && r.coordination >= 0.0, "{r:?}");
         assert!(r.mean_overlap_m >= 0.0 && r.max_overlap_m >= r.mean_overlap_m, "{r:?}");

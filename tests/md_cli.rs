@@ -382,7 +382,7 @@ fn invalid_scenes_exit_with_code_2_and_one_line() {
         &text.replace("engine = \"md\"", "engine = \"dem\""),
         &[],
         "engine",
-        "unknown engine 'dem', expected 'nscd' or 'md'",
+        "unknown engine 'dem', expected 'nscd', 'md2d' or 'md'",
     );
     assert_refused(
         &text.replace("between = [\"diorite\", \"steel\"]", "between = [\"steel\", \"steel\"]"),

@@ -1,5 +1,5 @@
-//! 2D scenes on the planar MD engine (`engine = "md"`, `dimension = 2`, or
-//! `ballast run --engine md`): the stiffness derived from `[soft]
+//! 2D scenes on the planar MD engine (`engine = "md2d"`, formerly `engine = "md"` with `dimension = 2`, or
+//! `ballast run --engine md2d`, formerly `--engine md`): the stiffness derived from `[soft]
 //! max_overlap_ratio` gives the overlap it promises under the scene's load,
 //! both engines write the same files from one scene, a stopped run resumes to
 //! the same bytes, the settlement driver runs on it, and bad `[soft]` tables or
@@ -61,6 +61,36 @@ fn a_block_run_with_engine_md_rests_at_the_overlap_its_stiffness_was_derived_for
     // Critically damped (no [[contact]] restitution: e = 0) and 200 contact times
     // later at rest: the face's two points carry the weight at k_n / 2 each.
     assert!((sunk - expected).abs() < 1e-6 * expected, "sunk {sunk} m against {expected} m");
+}
+
+/// One vocabulary: the planar engine is `md2d` in scenes, in `--engine` and in the outputs; its former
+/// spellings (`engine = "md"` with `dimension = 2`, `--engine md` on a 2D scene) are still read, and a scene
+/// rewritten for it (`--engine`) names it `md2d`.
+#[test]
+fn the_planar_engine_is_md2d_in_scenes_engine_and_outputs() {
+    let text = std::fs::read_to_string(BLOCK).unwrap();
+    let dir = scratch::path("vocabulary");
+    let new = scene_file(&dir.join("new"), &text.replace("engine = \"nscd\"", "engine = \"md2d\""));
+    let old = scene_file(&dir.join("old"), &text.replace("engine = \"nscd\"", "engine = \"md\"\ndimension = 2"));
+    for path in [&new, &old] {
+        let scene_text = std::fs::read_to_string(path).unwrap();
+        assert_eq!(ballast::scene::engine_of(&scene_text).unwrap(), "md2d");
+        assert!(Scene::from_toml_str(&scene_text).unwrap().is_planar_md());
+    }
+    let short = |o: RunOptions| RunOptions { length: Some(ballast::run::RunLength::Steps(20)), ..o };
+    for (k, (path, engine)) in [(&new, None), (&old, None), (&PathBuf::from(BLOCK), Some("md2d"))].iter().enumerate() {
+        let out = dir.join(format!("out{k}"));
+        run_file(path, &out, &short(opts(*engine)), &mut |_| {}).unwrap();
+        assert_eq!(json(&out.join("run.json"))["engine"], "md2d", "run {k}");
+        assert_eq!(json(&out.join("summary.json"))["engine"], "md2d", "run {k}");
+    }
+    // The rewritten scene (the engine changed by --engine, and the length by `length`) names md2d alone.
+    let recorded = std::fs::read_to_string(dir.join("out2/scene.toml")).unwrap();
+    assert!(recorded.contains("engine = \"md2d\"") && !recorded.contains("dimension"), "{recorded}");
+    // A 3D scene runs on md only.
+    let e = run_file("examples/md_two_spheres.toml".as_ref(), &dir.join("out3"), &opts(Some("md2d")), &mut |_| {});
+    let e = e.unwrap_err().one_line();
+    assert!(e.contains("engine: md2d runs 2D scenes") && e.contains("use md"), "{e}");
 }
 
 /// One scene, both engines: the same files with the same columns.

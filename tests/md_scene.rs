@@ -370,7 +370,7 @@ fn engine_of_tells_the_formats_apart() {
     let nscd = "[simulation]\nengine = \"nscd\"\ndt = 1e-3\nduration = 1.0\n";
     assert_eq!(engine_of(nscd).unwrap(), "nscd");
     let e = engine_of(&BASE.replace("engine = \"md\"", "engine = \"dem\"")).unwrap_err().to_string();
-    assert_eq!(e, "simulation.engine: unknown engine 'dem', expected 'nscd' or 'md'");
+    assert_eq!(e, "simulation.engine: unknown engine 'dem', expected 'nscd', 'md2d' or 'md'");
     let e = engine_of(&BASE.replace("engine = \"md\"\n", "")).unwrap_err().to_string();
     assert!(e.starts_with("scene.toml line 2: missing field `engine`"), "{e}");
     let e = engine_of("[simulation\n").unwrap_err().to_string();

@@ -53,9 +53,10 @@ pub struct RunArgs {
     #[arg(long, value_name = "STEPS")]
     steps: Option<u64>,
     /// Run a 2D scene on this engine instead of its own: `nscd` (rigid contacts)
-    /// or `md` (soft contacts, the scene's `[soft]` table: stiffness and time
-    /// step); the scene copy in DIR records it. A 3D MD scene runs on `md` only.
-    #[arg(long, value_name = "ENGINE", value_parser = ["nscd", "md"])]
+    /// or `md2d` (soft contacts, the scene's `[soft]` table: stiffness and time
+    /// step; `md` on a 2D scene, its former spelling, is the same); the scene copy
+    /// in DIR records it. A 3D MD scene runs on `md` only.
+    #[arg(long, value_name = "ENGINE", value_parser = ["nscd", "md2d", "md"])]
     engine: Option<String>,
 }
 

@@ -121,12 +121,12 @@ pub struct CyclesSpec {
 pub(crate) fn check_simulation(sim: &Simulation, engine: &str, dimension: i64) -> Result<()> {
     if !super::ENGINES.contains(&sim.engine.as_str()) {
         return err(format!(
-            "simulation.engine: unknown engine '{}', expected 'nscd' or 'md'",
+            "simulation.engine: unknown engine '{}', expected 'nscd', 'md2d' or 'md'",
             crate::error::clip(&sim.engine)
         ));
     }
     if sim.engine != engine {
-        let other = if engine == "nscd" { "scene::MdScene" } else { "scene::Scene" };
+        let other = if engine == "md" { "scene::Scene" } else { "scene::MdScene" };
         return err(format!(
             "simulation.engine: expected '{engine}', got '{}' (read it with {other})",
             crate::error::clip(&sim.engine)

@@ -46,21 +46,25 @@ pub use validate::{MAX_LENGTH, MAX_SIDES, MAX_STEPS, MIN_SIZE};
 use crate::error::{clip, Error, Result};
 use serde::Deserialize;
 
-/// The engines a scene file can be for: `"nscd"` ([`Scene`]) and `"md"` ([`MdScene`]).
-pub const ENGINES: [&str; 2] = ["nscd", "md"];
+/// The engines a scene file can be for: `"nscd"` and `"md2d"` ([`Scene`]), `"md"` ([`MdScene`]).
+pub const ENGINES: [&str; 3] = ["nscd", "md2d", "md"];
 
-/// The engine a scene file is for, `"nscd"` or `"md"`: the value of
-/// `[simulation] engine`, read without validating the rest of the file. Load an
-/// `"nscd"` scene with [`Scene`], an `"md"` one with [`MdScene`].
+/// The engine a scene file is for, as the scenes, the command line (`--engine`) and the outputs (`run.json`,
+/// `summary.json`) name it: `"nscd"` (rigid contacts, 2D), `"md2d"` (soft contacts, the same 2D format) or
+/// `"md"` (soft contacts, 3D spheres). Read from `[simulation] engine` without validating the rest of the file;
+/// the former spelling of the planar engine, `engine = "md"` with `dimension = 2`, reads as `"md2d"`. Load an
+/// `"nscd"` or `"md2d"` scene with [`Scene`], an `"md"` one with [`MdScene`].
 ///
 /// # Errors
 /// [`Error::Scene`] with a one-line message: TOML syntax errors and a missing or
 /// mistyped `engine` as `scene.toml line L: …`, any other engine as
-/// `simulation.engine: unknown engine 'x', expected 'nscd' or 'md'`.
+/// `simulation.engine: unknown engine 'x', expected 'nscd', 'md2d' or 'md'`.
 ///
 /// ```
 /// let text = "[simulation]\nengine = \"md\"\ndt = 1e-5\n";
 /// assert_eq!(ballast::scene::engine_of(text).unwrap(), "md");
+/// let planar = "[simulation]\nengine = \"md\"\ndimension = 2\ndt = 1e-5\n";
+/// assert_eq!(ballast::scene::engine_of(planar).unwrap(), "md2d");
 /// ```
 pub fn engine_of(text: &str) -> Result<String> {
     engine_of_named(text, "scene.toml")
@@ -75,14 +79,18 @@ pub fn engine_of_named(text: &str, name: &str) -> Result<String> {
     #[derive(Deserialize)]
     struct ProbeSimulation {
         engine: String,
+        dimension: Option<toml::Value>,
     }
     let probe: Probe = toml::from_str(text).map_err(|e| Error::Scene(parse::one_line(name, text, &e)))?;
-    let engine = probe.simulation.engine;
-    if ENGINES.contains(&engine.as_str()) {
-        Ok(engine)
-    } else {
-        Err(Error::Scene(format!("simulation.engine: unknown engine '{}', expected 'nscd' or 'md'", clip(&engine))))
+    let sim = probe.simulation;
+    if !ENGINES.contains(&sim.engine.as_str()) {
+        return Err(Error::Scene(format!(
+            "simulation.engine: unknown engine '{}', expected 'nscd', 'md2d' or 'md'",
+            clip(&sim.engine)
+        )));
     }
+    let planar = sim.engine == "md" && sim.dimension.and_then(|d| d.as_integer()) == Some(2);
+    Ok(if planar { "md2d".into() } else { sim.engine })
 }
 
 impl SceneFile for Scene {

@@ -151,31 +151,34 @@ pub(crate) fn check_soft(s: &SoftSection) -> Result<SoftModel> {
 }
 
 impl Scene {
-    /// Whether the scene asks for the planar MD engine (`engine = "md"`, `dimension = 2`).
+    /// Whether the scene asks for the planar MD engine (`engine = "md2d"`, or its former spelling
+    /// `engine = "md"` with `dimension = 2`).
     pub fn is_planar_md(&self) -> bool {
-        self.simulation.engine == "md" && self.simulation.dimension == Some(2)
+        let sim = &self.simulation;
+        sim.engine == "md2d" || (sim.engine == "md" && sim.dimension == Some(2))
     }
 
-    /// The same scene set to run on `engine` (`"nscd"` or `"md"`, the latter as
-    /// the planar MD engine: `dimension = 2`), validated.
+    /// The same scene set to run on `engine` (`"nscd"`, or `"md2d"` for the planar MD engine, also read as
+    /// `"md"`: the engine a 2D scene has on the MD side), validated; the scene then names it `"nscd"` or
+    /// `"md2d"`.
     ///
     /// # Errors
     /// [`Error::Scene`] for another engine name or if the scene is then invalid.
     pub fn on_engine(&self, engine: &str) -> Result<Scene> {
         let mut out = self.clone();
+        // A `dimension = 2` that only spelled the planar engine goes with it.
+        let dimension = self.simulation.dimension.filter(|_| self.simulation.engine != "md");
         match engine {
-            "nscd" => {
-                out.simulation.engine = "nscd".into();
-                out.simulation.dimension = self.simulation.dimension.filter(|_| !self.is_planar_md());
-            }
-            "md" => {
-                out.simulation.engine = "md".into();
-                out.simulation.dimension = Some(2);
-            }
+            "nscd" => out.simulation.engine = "nscd".into(),
+            "md2d" | "md" => out.simulation.engine = "md2d".into(),
             other => {
-                return err(format!("engine: unknown engine '{}', expected 'nscd' or 'md'", crate::error::clip(other)))
+                return err(format!(
+                    "engine: unknown engine '{}', expected 'nscd', 'md2d' or 'md'",
+                    crate::error::clip(other)
+                ))
             }
         }
+        out.simulation.dimension = dimension;
         out.validate()?;
         Ok(out)
     }
@@ -286,36 +289,37 @@ pub enum SceneKind {
 }
 
 impl SceneKind {
-    /// The engine of the scene text `text` (named `name` in messages), or of
-    /// `engine` (`"nscd"` or `"md"`) if given: a 2D scene runs on either, a 3D
-    /// MD scene on MD only.
+    /// The engine of the scene text `text` (named `name` in messages), or `engine` if given (`"nscd"`,
+    /// `"md2d"` or `"md"`, [`super::ENGINES`]): a 2D scene runs on `nscd` or `md2d` (`md` on a 2D scene is read
+    /// as `md2d`, its former spelling), a 3D MD scene on `md` only.
     ///
     /// # Errors
     /// [`Error::Scene`] for a scene whose engine cannot be read, an unknown
-    /// `engine`, or `"nscd"` asked of a 3D MD scene.
+    /// `engine`, or a 2D engine asked of a 3D MD scene.
     pub fn of(text: &str, name: &str, engine: Option<&str>) -> Result<SceneKind> {
-        #[derive(Deserialize)]
-        struct Probe {
-            simulation: ProbeSimulation,
-        }
-        #[derive(Deserialize)]
-        struct ProbeSimulation {
-            dimension: Option<toml::Value>,
-        }
         let own = super::engine_of_named(text, name)?;
-        let dimension = toml::from_str::<Probe>(text).ok().and_then(|p| p.simulation.dimension);
-        let spheres = own == "md" && dimension.and_then(|d| d.as_integer()) != Some(2);
+        let spheres = own == "md";
         match engine {
             None if spheres => Ok(SceneKind::Md),
-            None if own == "md" => Ok(SceneKind::PlanarMd),
+            None if own == "md2d" => Ok(SceneKind::PlanarMd),
             None => Ok(SceneKind::Nscd),
             Some("md") if spheres => Ok(SceneKind::Md),
-            Some("md") => Ok(SceneKind::PlanarMd),
-            Some("nscd") if spheres => err("engine: nscd runs 2D scenes, and this is a 3D MD scene (spheres)".into()),
-            Some("nscd") => Ok(SceneKind::Nscd),
-            Some(other) => {
-                err(format!("engine: unknown engine '{}', expected 'nscd' or 'md'", crate::error::clip(other)))
+            Some("md" | "md2d") if !spheres => Ok(SceneKind::PlanarMd),
+            Some(e @ ("nscd" | "md2d")) => {
+                err(format!("engine: {e} runs 2D scenes, and this is a 3D MD scene (spheres): use md"))
             }
+            Some(other) => {
+                err(format!("engine: unknown engine '{}', expected 'nscd', 'md2d' or 'md'", crate::error::clip(other)))
+            }
+        }
+    }
+
+    /// The engine's name, as scenes, `--engine` and the outputs write it: `nscd`, `md2d`, `md`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SceneKind::Nscd => "nscd",
+            SceneKind::PlanarMd => "md2d",
+            SceneKind::Md => "md",
         }
     }
 }
@@ -328,13 +332,11 @@ impl SceneKind {
 /// [`Error::Scene`] for an invalid scene, or a 3D `kind`.
 pub fn scene_on(text: &str, name: &str, kind: SceneKind, overridden: bool) -> Result<(Scene, String)> {
     let scene = Scene::from_toml_str_named(text, name)?;
-    let engine = match kind {
-        SceneKind::Nscd => "nscd",
-        SceneKind::PlanarMd => "md",
-        SceneKind::Md => return err("a 3D MD scene is read with scene::MdScene".into()),
-    };
+    if kind == SceneKind::Md {
+        return err("a 3D MD scene is read with scene::MdScene".into());
+    }
     if overridden && scene.is_planar_md() != (kind == SceneKind::PlanarMd) {
-        let scene = scene.on_engine(engine)?;
+        let scene = scene.on_engine(kind.name())?;
         let text = scene.to_toml_string()?;
         Ok((scene, text))
     } else {

@@ -246,7 +246,12 @@ fn check_drive(ctx: &str, d: Drive) -> Result<()> {
 /// Checks the whole scene, one section after the other, and resolves names,
 /// shapes and defaults.
 pub(crate) fn check(scene: &Scene) -> Result<Checked> {
-    let engine = if scene.is_planar_md() { "md" } else { "nscd" };
+    // The 2D format's engines: nscd, md2d, and md2d's former spelling `engine = "md"` with `dimension = 2`.
+    let engine = match scene.simulation.engine.as_str() {
+        "md2d" => "md2d",
+        "md" if scene.is_planar_md() => "md",
+        _ => "nscd",
+    };
     super::common::check_simulation(&scene.simulation, engine, 2)?;
     if let Some(soft) = &scene.soft {
         super::soft::check_soft(soft)?;

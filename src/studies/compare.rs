@@ -70,7 +70,7 @@ pub struct CompareSpec {
 /// the end of one cycle (SI units).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CompareRow {
-    /// Column `engine`: `nscd` or `md`.
+    /// Column `engine`: `nscd` or `md2d` (the planar MD engine).
     pub engine: String,
     /// Column `overlap_ratio`: the MD setting's `max_overlap_ratio`; empty for NSCD.
     pub overlap_ratio: Option<f64>,
@@ -214,7 +214,7 @@ fn settings(spec: &CompareSpec) -> Result<Vec<Setting>> {
             dt_fraction: spec.dt_fraction,
             ..nscd.soft.clone().unwrap_or_default()
         });
-        let mut md = md.on_engine("md").map_err(|e| match e {
+        let mut md = md.on_engine("md2d").map_err(|e| match e {
             Error::Scene(m) if m.starts_with("soft.max_overlap_ratio") => {
                 Error::Scene(format!("overlaps: {ratio:e}: {m}"))
             }
@@ -230,7 +230,7 @@ fn settings(spec: &CompareSpec) -> Result<Vec<Setting>> {
         md.output.get_or_insert_with(Default::default).every = Some(md_every);
         out.push(Setting {
             label: format!("md_{}", label_number(ratio)),
-            engine: "md",
+            engine: "md2d",
             ratio: Some(ratio),
             stiffness: Some(info.normal_stiffness),
             dt: info.dt_s,
@@ -301,7 +301,7 @@ pub fn compare(spec: &CompareSpec, study: &StudyOptions, display: &dyn RunDispla
         .map(|(s, runs)| {
             let settlement = SettlementSummary::of(&cycles_of(runs), seating);
             let versus = |f: fn(&SettlementSummary) -> &[f64]| match (&settlement, &nscd) {
-                (Some(a), Some(b)) if s.engine == "md" => welch(f(a), f(b)),
+                (Some(a), Some(b)) if s.engine == "md2d" => welch(f(a), f(b)),
                 _ => None,
             };
             let reports: Vec<_> = runs.iter().filter_map(|o| o.report.as_ref()).collect();
