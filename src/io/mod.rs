@@ -71,6 +71,12 @@ pub struct RunInfo {
 }
 
 impl RunInfo {
+    /// The record of a run on `engine` made by this version of `ballast`: `seed`, `steps` of `dt` (s), the
+    /// resolved `model` if any.
+    pub fn new(engine: &str, seed: u64, (steps, dt): (u64, f64), model: Option<serde_json::Value>) -> Self {
+        Self { seed, engine: engine.into(), version: env!("CARGO_PKG_VERSION").into(), steps, dt, model }
+    }
+
     /// Writes `dir/run.json`.
     pub fn write(&self, dir: &Path) -> Result<PathBuf> {
         write_json(&dir.join("run.json"), self)

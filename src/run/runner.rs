@@ -430,14 +430,7 @@ impl<E: Engine> Runner<E> {
     /// Writes the record of the run's input: the copy of the scene (or the
     /// initial state of a system built in code) and `run.json`.
     fn write_records(&self, out: &Path) -> Result<()> {
-        let info = RunInfo {
-            seed: self.plan.seed,
-            engine: E::NAME.to_string(),
-            version: env!("CARGO_PKG_VERSION").to_string(),
-            steps: self.plan.steps,
-            dt: self.system.dt(),
-            model: self.model.clone(),
-        };
+        let info = RunInfo::new(E::NAME, self.plan.seed, (self.plan.steps, self.system.dt()), self.model.clone());
         self.source.write_records(out, &info)
     }
 

@@ -26,14 +26,7 @@ impl<E: Engine> Accelerated<E> {
             &[layout::CHECKPOINT, layout::SUMMARY, layout::FINAL, layout::SCENE, layout::INITIAL_STATE],
         )?;
         let steps = (self.target as f64 / (self.frequency * self.system.dt())).round() as u64;
-        let info = RunInfo {
-            seed: self.seed,
-            engine: E::NAME.into(),
-            version: env!("CARGO_PKG_VERSION").into(),
-            steps,
-            dt: self.system.dt(),
-            model: self.model.clone(),
-        };
+        let info = RunInfo::new(E::NAME, self.seed, (steps, self.system.dt()), self.model.clone());
         self.source.write_records(out, &info)?;
         let origin = self.system.configuration();
         let slot = match self.spec.settlement_body {
