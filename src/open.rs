@@ -1,5 +1,5 @@
 //! Opening a scene file: the one registration point of the engines. [`open`] reads a scene, picks its engine
-//! (`[simulation] engine` and `dimension`, or the `engine` override of [`RunOptions`]), applies a length
+//! (`[simulation] engine`, or the `engine` override of [`RunOptions`]: `nscd`, `md2d` or `md`), applies a length
 //! override, and builds the system as a [`Loaded`] value; [`Loaded::run`] runs it through the run loop
 //! ([`crate::run::Runner`]) and [`Loaded::settle`] through the settlement driver
 //! ([`crate::settlement::Accelerated`], when the scene has a `[settlement]` table), each with its engine's
@@ -40,7 +40,7 @@ pub struct Opened<S, E> {
 pub enum Loaded {
     /// Rigid 2D polygons, non-smooth contact dynamics (`engine = "nscd"`).
     Nscd(Box<Opened<Scene, System>>),
-    /// A 2D scene on soft contacts (`engine = "md"`, `dimension = 2`, or the `engine` override), with the
+    /// A 2D scene on soft contacts (`engine = "md2d"`, or the `engine` override), with the
     /// stiffness and time step its `[soft]` table resolved to (recorded in `run.json`).
     PlanarMd(Box<Opened<Scene, PlanarSystem>>, SoftModelInfo),
     /// Soft 3D spheres, molecular dynamics (`engine = "md"`).

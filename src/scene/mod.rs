@@ -28,6 +28,7 @@ mod build;
 pub mod common;
 mod file;
 mod format;
+mod kind;
 pub mod md;
 mod parse;
 mod soft;
@@ -36,11 +37,9 @@ mod write;
 
 pub use file::{read_text, SceneFile};
 pub use format::*;
+pub use kind::{planar_length, scene_on, SceneKind};
 pub use md::MdScene;
-pub use soft::{
-    planar_length, scene_on, SceneKind, SoftDt, SoftModelInfo, SoftSection, DEFAULT_OVERLAP_RATIO,
-    DEFAULT_TANGENTIAL_RATIO,
-};
+pub use soft::{SoftDt, SoftModelInfo, SoftSection, DEFAULT_OVERLAP_RATIO, DEFAULT_TANGENTIAL_RATIO};
 pub use validate::{MAX_LENGTH, MAX_SIDES, MAX_STEPS, MIN_SIZE};
 
 use crate::error::{clip, Error, Result};
