@@ -24,7 +24,7 @@ impl SceneKind {
     /// as `md2d`, its former spelling), a 3D MD scene on `md` only.
     ///
     /// # Errors
-    /// [`Error::Scene`] for a scene whose engine cannot be read, an unknown
+    /// [`Error::Scene`](crate::Error::Scene) for a scene whose engine cannot be read, an unknown
     /// `engine`, or a 2D engine asked of a 3D MD scene.
     pub fn of(text: &str, name: &str, engine: Option<&str>) -> Result<SceneKind> {
         let own = super::engine_of_named(text, name)?;
@@ -59,7 +59,7 @@ impl SceneKind {
 /// the engine was `overridden` (`--engine`), the scene rewritten with that engine.
 ///
 /// # Errors
-/// [`Error::Scene`] for an invalid scene, or a 3D `kind`.
+/// [`Error::Scene`](crate::Error::Scene) for an invalid scene, or a 3D `kind`.
 pub fn scene_on(text: &str, name: &str, kind: SceneKind, overridden: bool) -> Result<(Scene, String)> {
     let scene = Scene::from_toml_str_named(text, name)?;
     if kind == SceneKind::Md {
