@@ -73,6 +73,30 @@ impl Error {
         self.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
     }
 
+    /// The scene key or argument a bad input ([`Error::Scene`]) names. Its message leads with it followed by a
+    /// colon (`simulation.dt: …`, `nscd.tolerance: …`, `threads: …`, `perturbation.distance_m: …`,
+    /// `spring[0].k_n: …`), or with a named item and its field (`body[1] 'block': polygon: …` gives
+    /// `body[1].polygon`); a message about a call as a whole leads with the function
+    /// (`loaded_scene: the sample already has a sleeper`). A key is a path of identifiers (ASCII letters,
+    /// digits, `_`, `.`, `[`, `]`, starting with a letter). `None` for the other kinds and for a message that
+    /// leads with anything else (a syntax error, `scene.toml line 3: …`).
+    pub fn key(&self) -> Option<String> {
+        let Error::Scene(message) = self else { return None };
+        let is_path = |s: &str| {
+            s.starts_with(|c: char| c.is_ascii_alphabetic())
+                && s.chars().all(|c| c.is_ascii_alphanumeric() || "_.[]".contains(c))
+        };
+        let (head, rest) = message.split_once(':')?;
+        match head.split_once(" '") {
+            // An item named in quotes, then its field.
+            Some((item, name)) if is_path(item) && name.ends_with('\'') => match rest.trim_start().split_once(':') {
+                Some((field, _)) if is_path(field) => Some(format!("{item}.{field}")),
+                _ => Some(item.to_string()),
+            },
+            _ => is_path(head).then(|| head.to_string()),
+        }
+    }
+
     /// Whether the error is the caller's input (a scene, an argument, a file to read, a checkpoint to resume
     /// from, a shape) rather than a run that failed: the command line exits with code 2 on it, and a study
     /// stops on it instead of recording a failed run.

@@ -507,9 +507,26 @@ fn error_kinds_tell_a_file_an_argument_and_a_checkpoint_apart() {
     let e = ballast::open::run_file(scene, &out, &RunOptions { threads: 0, ..RunOptions::default() }, &mut |_| {})
         .unwrap_err();
     assert!(matches!(&e, Error::Scene(m) if m.starts_with("threads:")) && e.is_input(), "{e}");
+    assert_eq!(e.key().as_deref(), Some("threads"));
     let _ = std::fs::remove_dir_all(&out);
     let e = ballast::open::run_file(scene, &out, &RunOptions { resume: true, ..RunOptions::default() }, &mut |_| {})
         .unwrap_err();
     assert!(matches!(&e, Error::Checkpoint(m) if m.starts_with("resume: no checkpoint.json")) && e.is_input(), "{e}");
+    assert_eq!(e.key(), None, "a checkpoint's refusal names a file, not a key");
     let _ = std::fs::remove_dir_all(&out);
+    // A scene's bad value names its key; a syntax error names the file and line, not a key.
+    let text = std::fs::read_to_string(scene).unwrap();
+    let bad = Scene::from_toml_str(&text.replace("dt = 1.0e-3", "dt = -1.0e-3")).unwrap_err();
+    assert_eq!(bad.key().as_deref(), Some("simulation.dt"), "{bad}");
+    let bad =
+        Scene::from_toml_str(&text.replace("[simulation]", "[nscd]\ntolerance = 2.0\n\n[simulation]")).unwrap_err();
+    assert_eq!(bad.key().as_deref(), Some("nscd.tolerance"), "{bad}");
+    let clockwise = "polygon = [[-0.05, -0.05], [-0.05, 0.05], [0.05, 0.05], [0.05, -0.05]]";
+    let bad = Scene::from_toml_str(
+        &text.replace("polygon = [[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]]", clockwise),
+    )
+    .unwrap_err();
+    assert_eq!(bad.key().as_deref(), Some("body[1].polygon"), "{bad}");
+    let syntax = Scene::from_toml_str(&text.replace("dt = 1.0e-3", "dt = = 1")).unwrap_err();
+    assert_eq!(syntax.key(), None, "{syntax}");
 }
