@@ -1,47 +1,15 @@
 //! The `ballast run` command: output files on a valid scene, exit code 2 and a
 //! one-line error on an invalid one.
 
+mod fixtures;
 mod scratch;
 
 use std::process::Command;
 
-const SCENE: &str = r#"
-[simulation]
-engine = "nscd"
-dt = 1.0e-3
-duration = 0.05
-seed = 42
-
-[output]
-every = 7
-
-[[material]]
-name = "grain"
-density = 2700.0
-
-[[contact]]
-between = ["grain", "grain"]
-friction = 0.5
-
-[[body]]
-name = "floor"
-material = "grain"
-polygon = [[-0.5, -0.1], [0.5, -0.1], [0.5, 0.0], [-0.5, 0.0]]
-position = [0.0, 0.0]
-fixed = true
-
-[[body]]
-name = "block"
-material = "grain"
-polygon = [[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]]
-position = [0.0, 0.051]
-
-[[body]]
-name = "pebble"
-material = "grain"
-regular = { sides = 5, radius = 0.02 }
-position = [0.2, 0.1]
-"#;
+/// The block on the floor of `examples/block_on_floor.toml` with a pebble beside it, 50 steps, a row every 7.
+fn scene_text() -> String {
+    fixtures::block_and_pebble()
+}
 
 fn ballast() -> Command {
     Command::new(env!("CARGO_BIN_EXE_ballast"))
@@ -51,7 +19,8 @@ fn ballast() -> Command {
 fn run_writes_the_outputs() {
     let dir = scratch::dir("valid");
     let scene = dir.join("in.toml");
-    std::fs::write(&scene, SCENE).unwrap();
+    let text = scene_text();
+    std::fs::write(&scene, &text).unwrap();
     let out = dir.join("out");
     let result = ballast().arg("run").arg(&scene).arg("--out").arg(&out).arg("--quiet").output().unwrap();
     assert!(result.status.success(), "stderr: {}", String::from_utf8_lossy(&result.stderr));
@@ -60,7 +29,7 @@ fn run_writes_the_outputs() {
         assert!(out.join(name).is_file(), "{name} missing");
     }
     // scene.toml is a byte copy.
-    assert_eq!(std::fs::read(out.join("scene.toml")).unwrap(), SCENE.as_bytes());
+    assert_eq!(std::fs::read(out.join("scene.toml")).unwrap(), text.as_bytes());
 
     // series.csv: required columns, one row every 7 steps and the last (50 steps: 7, 14, …, 49, 50).
     let series = std::fs::read_to_string(out.join("series.csv")).unwrap();
@@ -138,11 +107,11 @@ fn assert_scene_error(args: &[&str], scene: Option<&str>, test: &str, expected: 
 
 #[test]
 fn bad_scene_exits_with_code_2() {
-    let bad = SCENE.replace("friction = 0.5", "friction = -0.5");
+    let bad = scene_text().replace("friction = 0.5", "friction = -0.5");
     assert_scene_error(&["--quiet"], Some(&bad), "bad", "contact[0].friction");
-    let unknown = SCENE.replace("seed = 42", "seed = 42\nsteps = 3");
+    let unknown = scene_text().replace("seed = 42", "seed = 42\nsteps = 3");
     assert_scene_error(&[], Some(&unknown), "unknown", "bad.toml line 7: unknown field `steps`");
-    let polygon = SCENE.replace("[0.05, -0.05], [0.05, 0.05]", "[0.05, 0.05], [0.05, -0.05]");
+    let polygon = scene_text().replace("[0.05, -0.05], [0.05, 0.05]", "[0.05, 0.05], [0.05, -0.05]");
     assert_scene_error(&["--quiet"], Some(&polygon), "polygon", "body[1] 'block': polygon");
 }
 
@@ -220,7 +189,7 @@ fn stopped_and_resumed_run_matches_the_uninterrupted_run() {
     let dir = scratch::dir("resume");
     let scene = dir.join("in.toml");
     // With per-cycle statistics (5 cycles of 10 ms over the 50 steps).
-    let text = SCENE.replace("every = 7", "every = 7\ncycles = { frequency = 100.0, body = \"block\" }");
+    let text = scene_text().replace("every = 7", "every = 7\ncycles = { frequency = 100.0, body = \"block\" }");
     assert!(text.contains("cycles = "), "scene template changed");
     std::fs::write(&scene, &text).unwrap();
     let run = |out: &std::path::Path, extra: &[&str]| {
@@ -294,7 +263,7 @@ fn run_stops_at_equilibrium_and_resumes_into_the_same_stop() {
     let dir = scratch::dir("equilibrium");
     let scene = dir.join("in.toml");
     // 2 s of simulated time; the block and pebble settle within a fraction of it.
-    let text = SCENE
+    let text = scene_text()
         .replace("duration = 0.05", "duration = 2.0")
         .replace("[output]", "equilibrium = { kinetic_energy = 1e-12, steps = 50 }\n\n[output]");
     assert!(text.contains("equilibrium = "), "scene template changed");

@@ -5,57 +5,33 @@
 //! leaves the last good state and its row; every CSV it writes reads back
 //! through the library's row types.
 
+mod fixtures;
 mod scratch;
 
 use ballast::engine::Engine;
 use ballast::engine::FinalState;
 use ballast::run::RunEnd;
 use ballast::run::{RunOptions, RunPlan, Runner, Status};
+use ballast::scene::common::{CyclesSpec, OutputSection};
 use ballast::scene::SceneFile;
 use ballast::scene::{MdScene, Scene};
 use ballast::Error;
 use std::path::{Path, PathBuf};
 
-/// NSCD: a block dropped on a floor and a pentagon beside it, 5 cycles of 10 ms
+/// NSCD: the block of `examples/block_on_floor.toml` dropped 1 cm on its floor and a pentagon beside it, 5 cycles of 10 ms
 /// followed on the block, with the positions of the mobile bodies per cycle.
-const NSCD: &str = r#"
-[simulation]
-engine = "nscd"
-dt = 1.0e-3
-duration = 0.05
-seed = 42
+fn nscd_scene() -> Scene {
+    let mut scene = fixtures::block_and_pebble_scene();
+    scene.bodies[1].position = [0.0, 0.06];
+    let cycles = CyclesSpec { frequency: 100.0, body: Some("block".into()), positions: Some(true) };
+    scene.output.get_or_insert_with(Default::default).cycles = Some(cycles);
+    scene
+}
 
-[output]
-every = 7
-cycles = { frequency = 100.0, body = "block", positions = true }
-
-[[material]]
-name = "grain"
-density = 2700.0
-
-[[contact]]
-between = ["grain", "grain"]
-friction = 0.5
-
-[[body]]
-name = "floor"
-material = "grain"
-polygon = [[-0.5, -0.1], [0.5, -0.1], [0.5, 0.0], [-0.5, 0.0]]
-position = [0.0, 0.0]
-fixed = true
-
-[[body]]
-name = "block"
-material = "grain"
-polygon = [[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]]
-position = [0.0, 0.06]
-
-[[body]]
-name = "pebble"
-material = "grain"
-regular = { sides = 5, radius = 0.02 }
-position = [0.2, 0.1]
-"#;
+/// [`nscd_scene`] as text.
+fn nscd_text() -> String {
+    nscd_scene().to_toml_string().unwrap()
+}
 
 /// MD: two Hertz spheres dropped on a base inside a cylinder (the example
 /// scene, shortened), with `lid` a servo lid above them, cycles of 5 ms.
@@ -140,9 +116,10 @@ fn resume_is_bit_identical<E: Engine>(runner: &Runner<E>, other: &Runner<E>, sto
 
 #[test]
 fn nscd_resume_is_bit_identical() {
-    let scene = Scene::from_toml_str(NSCD).unwrap();
+    let scene = nscd_scene();
     let runner = Runner::from_system(scene.build().unwrap(), scene.plan().unwrap()).unwrap();
-    let other_scene = Scene::from_toml_str(&NSCD.replace("every = 7", "every = 8")).unwrap();
+    let other_scene =
+        Scene { output: Some(OutputSection { every: Some(8), ..scene.output.clone().unwrap() }), ..scene.clone() };
     let other = Runner::from_system(other_scene.build().unwrap(), other_scene.plan().unwrap()).unwrap();
     // Stops at 17 and 34: between rows and inside cycles.
     resume_is_bit_identical(&runner, &other, 17, 10, "nscd_resume");
@@ -188,7 +165,9 @@ fn equilibrium_stop_survives_a_resume<E: Engine>(runner: &Runner<E>, test: &str)
 fn nscd_equilibrium_stop() {
     // The block (1 mm up) and the pebble (8 cm up) land within 0.13 s; the
     // 50-step window follows: far before the 2 s asked for.
-    let text = NSCD
+    let text = nscd_text();
+    assert!(text.contains("duration = 0.05") && text.contains("seed = 42"), "{text}");
+    let text = text
         .replace("duration = 0.05", "duration = 2.0")
         .replace("seed = 42", "seed = 42\nequilibrium = { kinetic_energy = 1e-12, steps = 50 }");
     let scene = Scene::from_toml_str(&text).unwrap();
@@ -235,12 +214,11 @@ fn divergence_keeps_the_last_good_state<E: Engine>(runner: &Runner<E>, body: &st
 fn nscd_divergence_keeps_the_last_good_state() {
     // A block squeezed between the floor and a press whose velocity is imposed:
     // nothing stops the press, the overlap runs away.
-    let text = NSCD
-        .replace("[output]\nevery = 7\ncycles = { frequency = 100.0, body = \"block\", positions = true }\n", "")
-        + "\n[[body]]\nname = \"press\"\nmaterial = \"grain\"\n\
-           polygon = [[-0.1, 0.0], [0.1, 0.0], [0.1, 0.05], [-0.1, 0.05]]\nposition = [0.0, 0.12]\n\
-           imposed = { vx = 0.0, vy = -1.0, spin = 0.0 }\n";
-    let scene = Scene::from_toml_str(&text.replace("position = [0.0, 0.06]", "position = [0.0, 0.05]")).unwrap();
+    let press = "[[body]]\nname = \"press\"\nmaterial = \"grain\"\n\
+                 polygon = [[-0.1, 0.0], [0.1, 0.0], [0.1, 0.05], [-0.1, 0.05]]\nposition = [0.0, 0.12]\n\
+                 imposed = { vx = 0.0, vy = -1.0, spin = 0.0 }\n";
+    let mut scene = fixtures::with_bodies(Scene { output: None, ..nscd_scene() }, press);
+    scene.bodies[1].position = [0.0, 0.05];
     let runner = Runner::from_system(scene.build().unwrap(), RunPlan::new(100, 10)).unwrap();
     divergence_keeps_the_last_good_state(&runner, "block", "nscd_diverge");
 }
@@ -269,7 +247,7 @@ fn md_divergence_keeps_the_last_good_state() {
 fn outputs_read_back_through_the_row_types() {
     use ballast::run::positions;
     let dir = scratch::dir("read_back");
-    let scene = Scene::from_toml_str(NSCD).unwrap();
+    let scene = nscd_scene();
     let nscd = dir.join("nscd");
     Runner::from_system(scene.build().unwrap(), scene.plan().unwrap())
         .unwrap()
@@ -327,7 +305,7 @@ fn a_run_length_replaces_the_scene_duration() {
     let md = dir.join("md.toml");
     std::fs::write(&md, md_scene(0.01, false)).unwrap();
     let nscd = dir.join("nscd.toml");
-    std::fs::write(&nscd, NSCD).unwrap();
+    std::fs::write(&nscd, nscd_text()).unwrap();
     for (scene, dt) in [(&nscd, 1e-3), (&md, 2e-6)] {
         let out = dir.join(format!("out-{}", scene.file_stem().unwrap().to_string_lossy()));
         for (length, steps) in [(RunLength::Steps(7), 7), (RunLength::Duration(11.0 * dt), 11)] {

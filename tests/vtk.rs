@@ -1,6 +1,8 @@
 //! VTK snapshots: the files are parsed back by the small readers below (legacy
 //! ASCII and XML PolyData) and checked against the system they were written from.
 
+mod fixtures;
+
 use ballast::io::vtk::PvdCollection;
 use ballast::nscd::System;
 use ballast::plane::vtk::{write_bodies, write_contacts, DISC_VERTICES};
@@ -9,68 +11,16 @@ use ballast::scene::SceneFile;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-/// A floor, a 10 cm block resting on it, a disc resting on it, and a tilted,
-/// spinning 4 cm block in free flight well above everything.
-const SCENE: &str = r#"
-[simulation]
-engine = "nscd"
-dt = 1.0e-3
-duration = 0.02
-gravity = [0.0, -9.81]
-
-[nscd]
-tolerance = 1.0e-6
-
-[[material]]
-name = "grain"
-density = 2700.0
-
-[[material]]
-name = "concrete"
-density = 2400.0
-
-[[contact]]
-between = ["grain", "concrete"]
-friction = 0.5
-
-[[body]]
-name = "floor"
-material = "concrete"
-polygon = [[-0.5, -0.1], [0.5, -0.1], [0.5, 0.0], [-0.5, 0.0]]
-position = [0.0, 0.0]
-fixed = true
-
-[[body]]
-name = "block"
-material = "grain"
-polygon = [[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]]
-position = [0.0, 0.05]
-
-[[body]]
-name = "disc"
-material = "grain"
-disc = 0.03
-position = [0.3, 0.03]
-
-[[body]]
-name = "flyer"
-material = "grain"
-polygon = [[-0.02, -0.02], [0.02, -0.02], [0.02, 0.02], [-0.02, 0.02]]
-position = [-0.3, 0.5]
-angle = 0.3
-spin = 2.0
-velocity = [0.1, 0.5]
-"#;
-
 const FLOOR: usize = 0;
 const BLOCK: usize = 1;
 const DISC: usize = 2;
 const FLYER: usize = 3;
-/// Half-sizes (m) of the square bodies of [`SCENE`].
+/// Half-sizes (m) of the square bodies of [`scene`].
 const HALF: [(usize, f64); 2] = [(BLOCK, 0.05), (FLYER, 0.02)];
 
+/// The block of `examples/block_on_floor.toml` resting on its floor, a disc beside it, a square flying.
 fn scene() -> Scene {
-    Scene::from_toml_str(SCENE).unwrap()
+    Scene::from_toml_str(&fixtures::block_disc_and_flyer()).unwrap()
 }
 
 /// The scene's system after `steps` steps.
