@@ -26,6 +26,7 @@
 //! `U_T⁺ + e_t U_T⁻`.
 
 use super::coulomb::{solve, Delassus};
+use super::method::apgd::ConeRow;
 use super::method::{Row, SweepNorms};
 use crate::geometry::{perp, Vec2};
 use serde::{Deserialize, Serialize};
@@ -202,9 +203,7 @@ impl Row for ContactRow {
 
     #[inline(always)]
     fn add_impulse(&self, u: &mut [[f64; 3]], inv_m: &[[f64; 3]], sign: f64) {
-        let (a, b) = (self.a as usize, self.b as usize);
-        apply(&mut u[a], &inv_m[a], &self.hn_a, self.p[0], &self.ht_a, self.p[1], sign);
-        apply(&mut u[b], &inv_m[b], &self.hn_b, self.p[0], &self.ht_b, self.p[1], -sign);
+        self.add_impulse_of(u, inv_m, self.p, sign);
     }
 
     #[inline(always)]
@@ -217,9 +216,7 @@ impl Row for ContactRow {
     ) {
         let r = self;
         let (a, b) = (r.a as usize, r.b as usize);
-        let (ua, ub) = (u[a], u[b]);
-        let un = dot3(&r.hn_a, &ua) - dot3(&r.hn_b, &ub);
-        let ut = dot3(&r.ht_a, &ua) - dot3(&r.ht_b, &ub);
+        let [un, ut] = r.local_velocity(u);
         let w = r.w;
         let [pn, pt] = r.p;
         let u0n = un - (w.nn * pn + w.nt * pt);
@@ -237,5 +234,88 @@ impl Row for ContactRow {
             apply(&mut u[b], &inv_m[b], &r.hn_b, dn, &r.ht_b, dt, -1.0);
         }
         add_contact_norms(norms, w, [pn, pt], [qn, qt], changed);
+    }
+}
+
+/// Largest eigenvalue of a symmetric 2×2 block.
+fn lambda_max(nn: f64, nt: f64, tt: f64) -> f64 {
+    0.5 * (nn + tt) + (0.25 * (nn - tt) * (nn - tt) + nt * nt).sqrt()
+}
+
+/// The 2D contact in the accelerated projected gradient: `(P_N, P_T)` projected on `P_N ≥ 0`, `|P_T| ≤ g_α`.
+impl ConeRow for ContactRow {
+    type Impulse = [f64; 2];
+
+    #[inline(always)]
+    fn impulse(&self) -> [f64; 2] {
+        self.p
+    }
+
+    #[inline(always)]
+    fn set_impulse(&mut self, p: [f64; 2]) {
+        self.p = p;
+    }
+
+    #[inline(always)]
+    fn normal(&self) -> f64 {
+        self.p[0]
+    }
+
+    #[inline(always)]
+    fn mu(&self) -> f64 {
+        self.mu
+    }
+
+    #[inline(always)]
+    fn local_velocity(&self, u: &[[f64; 3]]) -> [f64; 2] {
+        let (ua, ub) = (&u[self.a as usize], &u[self.b as usize]);
+        [dot3(&self.hn_a, ua) - dot3(&self.hn_b, ub), dot3(&self.ht_a, ua) - dot3(&self.ht_b, ub)]
+    }
+
+    #[inline(always)]
+    fn gradient(&self, v: [f64; 2], c: f64) -> [f64; 2] {
+        [v[0] - c, v[1] + self.shift_t]
+    }
+
+    /// `c_closed` for a contact whose `U_0N < s_open`, `s_open` otherwise (`c_closed` when the two agree).
+    #[inline]
+    fn label(&self, u: &[[f64; 3]]) -> f64 {
+        if self.s_open >= self.c_closed {
+            return self.c_closed;
+        }
+        let u0n = self.local_velocity(u)[0] - (self.w.nn * self.p[0] + self.w.nt * self.p[1]);
+        if u0n < self.s_open {
+            self.c_closed
+        } else {
+            self.s_open
+        }
+    }
+
+    #[inline(always)]
+    fn diagonal(&self) -> [f64; 2] {
+        [self.w.nn, self.w.tt]
+    }
+
+    fn lambda_max(&self) -> f64 {
+        lambda_max(self.w.nn, self.w.nt, self.w.tt)
+    }
+
+    #[inline(always)]
+    fn project(&self, x: [f64; 2], tresca: Option<f64>) -> [f64; 2] {
+        let pn = x[0].max(0.0);
+        let bound = tresca.unwrap_or(self.mu * pn);
+        [pn, x[1].clamp(-bound, bound)]
+    }
+
+    #[inline(always)]
+    fn add_impulse_of(&self, u: &mut [[f64; 3]], inv_m: &[[f64; 3]], p: [f64; 2], sign: f64) {
+        let (a, b) = (self.a as usize, self.b as usize);
+        apply(&mut u[a], &inv_m[a], &self.hn_a, p[0], &self.ht_a, p[1], sign);
+        apply(&mut u[b], &inv_m[b], &self.hn_b, p[0], &self.ht_b, p[1], -sign);
+    }
+
+    #[inline(always)]
+    fn add_norms(&self, norms: &mut SweepNorms, p: [f64; 2], q: [f64; 2], changed: bool) {
+        add_contact_norms(norms, self.w, p, q, changed);
     }
 }

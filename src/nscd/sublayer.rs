@@ -14,6 +14,7 @@
 //! A `compression_only` spring's impulse is clamped to `P ≥ 0`.
 
 use super::contact::{apply, dot3};
+use super::method::apgd::AffineRow;
 use super::method::{Row, SweepNorms};
 pub use crate::plane::springs::Spring;
 
@@ -113,10 +114,7 @@ impl Row for SpringRow {
 
     #[inline(always)]
     fn add_impulse(&self, u: &mut [[f64; 3]], inv_m: &[[f64; 3]], sign: f64) {
-        apply(&mut u[self.a as usize], &inv_m[self.a as usize], &self.hn_a, self.p, &[0.0; 3], 0.0, sign);
-        if self.b != u32::MAX {
-            apply(&mut u[self.b as usize], &inv_m[self.b as usize], &self.hn_b, self.p, &[0.0; 3], 0.0, -sign);
-        }
+        self.add_impulse_of(u, inv_m, self.p, sign);
     }
 
     #[inline(always)]
@@ -129,10 +127,7 @@ impl Row for SpringRow {
     ) {
         let s = self;
         let (a, b) = (s.a as usize, s.b as usize);
-        let mut un = dot3(&s.hn_a, &u[a]);
-        if s.b != u32::MAX {
-            un -= dot3(&s.hn_b, &u[b]);
-        }
+        let un = s.axial_velocity(u);
         let mut p = s.solve(un - s.w * s.p);
         if omega != 1.0 {
             p = s.p + omega * (p - s.p);
@@ -160,5 +155,55 @@ impl Row for SpringRow {
             p * wp,
             dp != 0.0,
         );
+    }
+}
+
+/// The sublayer spring in the accelerated projected gradient: a term of the quadratic.
+impl AffineRow for SpringRow {
+    #[inline(always)]
+    fn impulse(&self) -> f64 {
+        self.p
+    }
+
+    #[inline(always)]
+    fn set_impulse(&mut self, p: f64) {
+        self.p = p;
+    }
+
+    #[inline(always)]
+    fn axial_velocity(&self, u: &[[f64; 3]]) -> f64 {
+        let mut un = dot3(&self.hn_a, &u[self.a as usize]);
+        if self.b != u32::MAX {
+            un -= dot3(&self.hn_b, &u[self.b as usize]);
+        }
+        un
+    }
+
+    fn h_alpha(&self) -> f64 {
+        self.h_alpha
+    }
+
+    fn h_beta(&self) -> f64 {
+        self.h_beta
+    }
+
+    fn w(&self) -> f64 {
+        self.w
+    }
+
+    fn compression_only(&self) -> bool {
+        self.compression_only
+    }
+
+    fn solve_affine(&self, u0: f64) -> f64 {
+        self.solve(u0)
+    }
+
+    #[inline(always)]
+    fn add_impulse_of(&self, u: &mut [[f64; 3]], inv_m: &[[f64; 3]], p: f64, sign: f64) {
+        apply(&mut u[self.a as usize], &inv_m[self.a as usize], &self.hn_a, p, &[0.0; 3], 0.0, sign);
+        if self.b != u32::MAX {
+            apply(&mut u[self.b as usize], &inv_m[self.b as usize], &self.hn_b, p, &[0.0; 3], 0.0, -sign);
+        }
     }
 }

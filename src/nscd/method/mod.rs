@@ -1,7 +1,7 @@
 //! The NSCD method of one step, for any dimension of contact (Saussine et al. 2006, §2.7; Jean 1999): the
 //! nonlinear block Gauss–Seidel over the rows of the step's problem ([`gauss_seidel`]), its convergence
-//! policies and LMGC90's check pass ([`criterion`]), its settings ([`settings`]) and the domain split that sweeps
-//! two halves of a sample on two threads ([`split`]).
+//! policies and LMGC90's check pass ([`criterion`]), its settings ([`settings`]), the domain split that sweeps
+//! two halves of a sample on two threads ([`split`]) and the accelerated projected gradient ([`apgd`]).
 //!
 //! Nothing here knows what a contact is: the method sees bodies as generalised velocities and inverse masses of
 //! the dimension's degrees of freedom ([`Row::Dofs`]: `[u_x, u_y, ω]` in 2D, six components in 3D) and rows as
@@ -11,10 +11,13 @@
 //! ([`super::sublayer::SpringRow`]) — and the method is the same code for each (a 3D engine adds its local law
 //! with a 3×3 block, not a second solver; `tests/nscd_method.rs` runs it on a 3D point contact).
 //!
-//! The finishers of the converged-solve work stay with the 2D law for now: [`super::apgd`] projects on the
-//! 2D friction cone (an interval), and `super::interior` solves the step as a linear complementarity problem,
-//! which only a polyhedral cone (2D) allows; a 3D cone needs a second-order-cone form of either.
+//! The accelerated projected gradient ([`apgd`]) is the same code for every dimension too, over two more traits
+//! of the rows ([`apgd::ConeRow`]: the contact's impulse vector and its projection on the law's set;
+//! [`apgd::AffineRow`]: the spring's affine law). The interior point (`super::interior`) stays with the 2D law:
+//! it solves the step as a linear complementarity problem, which only a polyhedral cone (2D) allows; a 3D cone
+//! needs a second-order-cone form.
 
+pub mod apgd;
 pub mod criterion;
 pub mod gauss_seidel;
 pub mod settings;
@@ -38,7 +41,7 @@ pub trait Row: Copy + Send + Sync {
     /// The generalised velocity (and inverse mass) of one body in this dimension: `[f64; 3]` in 2D
     /// (`u_x, u_y, ω`), six components in 3D. A body whose inverse mass is `Default::default()` (all zero: fixed,
     /// or every component imposed) is never changed by a row.
-    type Dofs: Copy + Default + PartialEq + Send + Sync + std::fmt::Debug;
+    type Dofs: Copy + Default + PartialEq + Send + Sync + std::fmt::Debug + AsRef<[f64]> + AsMut<[f64]>;
 
     /// The two bodies of the row, candidate first; the second is `u32::MAX` for a world anchor.
     fn bodies(&self) -> (u32, u32);
