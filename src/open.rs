@@ -54,7 +54,15 @@ pub enum Loaded {
 /// [`Error::File`] naming the file if it cannot be read; [`Error::Scene`] (one line naming the key) for an
 /// invalid scene or override.
 pub fn open(path: &Path, opts: &RunOptions) -> Result<Loaded> {
-    let text = crate::scene::read_text(path)?;
+    open_text(crate::scene::read_text(path)?, path, opts)
+}
+
+/// [`open`] of a scene given as its TOML `text`, recorded as read from `path` (the name syntax errors give, and
+/// the path the outputs' headers record; nothing is read from it).
+///
+/// # Errors
+/// [`Error::Scene`] (one line naming the key) for an invalid scene or override.
+pub fn open_text(text: String, path: &Path, opts: &RunOptions) -> Result<Loaded> {
     let name = path.display().to_string();
     match SceneKind::of(&text, &name, opts.engine.as_deref())? {
         SceneKind::Md => {

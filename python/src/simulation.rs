@@ -1,0 +1,259 @@
+//! `ballast.Simulation`: a scene opened on its engine, stepped from Python, its state read and written as numpy
+//! arrays through the engine contract (`ballast::engine::Engine`: the final state, the contact rows, the
+//! configuration write-back).
+
+use crate::errors::to_py;
+use ballast_core::engine::{Engine, StepSummary};
+use ballast_core::open::Loaded;
+use ballast_core::run::RunOptions;
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// The system of whichever engine `$loaded` holds, bound to `$s`, in `$body`.
+macro_rules! with_system {
+    ($loaded:expr, $s:ident => $body:expr) => {
+        match $loaded {
+            Loaded::Nscd(o) => {
+                let $s = &mut o.system;
+                $body
+            }
+            Loaded::PlanarMd(o, _) => {
+                let $s = &mut o.system;
+                $body
+            }
+            Loaded::Md(o) => {
+                let $s = &mut o.system;
+                $body
+            }
+        }
+    };
+}
+
+/// A scene opened on its engine: NSCD or planar MD (2D: positions `x, y, θ`) or 3D MD (positions `x, y, z`).
+#[pyclass(module = "ballast")]
+pub struct Simulation {
+    loaded: Loaded,
+}
+
+impl Simulation {
+    /// A simulation of what `open` opens with the run options of `engine`.
+    pub fn open(
+        open: impl FnOnce(&RunOptions) -> ballast_core::Result<Loaded>,
+        engine: Option<String>,
+    ) -> PyResult<Self> {
+        let opts = RunOptions { engine, ..RunOptions::default() };
+        Ok(Self { loaded: open(&opts).map_err(to_py)? })
+    }
+}
+
+/// A step's statistics as a dict (SI units).
+fn summary_dict<'py>(py: Python<'py>, s: &StepSummary) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("time", s.time)?;
+    d.set_item("kinetic_energy", s.kinetic_energy)?;
+    d.set_item("contacts", s.contacts)?;
+    d.set_item("mean_overlap", s.mean_overlap)?;
+    d.set_item("max_overlap", s.max_overlap)?;
+    d.set_item("iterations", s.iterations)?;
+    d.set_item("converged", s.converged)?;
+    d.set_item("criterion", s.criterion)?;
+    Ok(d)
+}
+
+/// An `(n, 3)` float64 array of the rows `rows`.
+fn matrix<'py>(py: Python<'py>, rows: Vec<[f64; 3]>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let n = rows.len();
+    PyArray1::from_vec(py, rows.into_iter().flatten().collect()).reshape([n, 3])
+}
+
+#[pymethods]
+impl Simulation {
+    /// The engine: `nscd`, `md2d` or `md`.
+    #[getter]
+    fn engine(&self) -> &'static str {
+        match &self.loaded {
+            Loaded::Nscd(_) => "nscd",
+            Loaded::PlanarMd(..) => "md2d",
+            Loaded::Md(_) => "md",
+        }
+    }
+
+    /// Time (s).
+    #[getter]
+    fn time(&mut self) -> f64 {
+        with_system!(&mut self.loaded, s => s.time())
+    }
+
+    /// Steps made.
+    #[getter]
+    fn steps_done(&mut self) -> u64 {
+        with_system!(&mut self.loaded, s => s.steps_done())
+    }
+
+    /// Time step (s).
+    #[getter]
+    fn dt(&mut self) -> f64 {
+        with_system!(&mut self.loaded, s => s.dt())
+    }
+
+    /// Makes `n` steps (the interpreter's lock released) and returns the last one's statistics: `time` (s),
+    /// `kinetic_energy` (J), `contacts`, `mean_overlap` and `max_overlap` (m), `iterations`, `converged` and
+    /// `criterion` (the NSCD solver's). A step that blows up raises `DivergedError`, the state being that of
+    /// the last good step.
+    #[pyo3(signature = (n = 1))]
+    fn step<'py>(&mut self, py: Python<'py>, n: u64) -> PyResult<Bound<'py, PyDict>> {
+        if n == 0 {
+            return Err(PyValueError::new_err("n: must be at least 1, got 0"));
+        }
+        let loaded = &mut self.loaded;
+        let summary = py.detach(|| {
+            with_system!(loaded, s => {
+                let mut last = None;
+                for _ in 0..n {
+                    last = Some(s.step()?);
+                }
+                Ok::<_, ballast_core::Error>(last.map(|stats| summary_of(s, &stats)))
+            })
+        });
+        match summary.map_err(to_py)? {
+            Some(s) => summary_dict(py, &s),
+            None => Err(PyValueError::new_err("n: must be at least 1")),
+        }
+    }
+
+    /// The bodies' names, in scene order.
+    #[getter]
+    fn names(&mut self) -> Vec<String> {
+        with_system!(&mut self.loaded, s => s.final_state().bodies.into_iter().map(|b| b.name).collect())
+    }
+
+    /// Which bodies are fixed (or have every velocity component imposed): a bool array, in scene order.
+    #[getter]
+    fn fixed<'py>(&mut self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
+        let mask = with_system!(&mut self.loaded, s => {
+            let mut fixed = vec![true; s.body_count()];
+            s.mobile_bodies().into_iter().for_each(|i| fixed[i] = false);
+            fixed
+        });
+        PyArray1::from_vec(py, mask)
+    }
+
+    /// Positions, `(n, 3)` float64 in scene order: `x, y` (m) and the angle `θ` (rad) in 2D; `x, y, z` (m) in
+    /// 3D.
+    #[getter]
+    fn positions<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let state = with_system!(&mut self.loaded, s => s.final_state());
+        let rows = state
+            .bodies
+            .iter()
+            .map(|b| match b.angle {
+                Some(theta) => [b.position[0], b.position[1], theta],
+                None => [b.position[0], b.position[1], b.position[2]],
+            })
+            .collect();
+        matrix(py, rows)
+    }
+
+    /// Velocities, `(n, 3)` float64 in scene order: `v_x, v_y` (m/s) and the spin `ω` (rad/s) in 2D;
+    /// `v_x, v_y, v_z` (m/s) in 3D.
+    #[getter]
+    fn velocities<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        use ballast_core::engine::final_state::Spin;
+        let state = with_system!(&mut self.loaded, s => s.final_state());
+        let rows = state
+            .bodies
+            .iter()
+            .map(|b| match b.spin {
+                Spin::Planar(w) => [b.velocity[0], b.velocity[1], w],
+                Spin::Spatial(_) => [b.velocity[0], b.velocity[1], b.velocity[2]],
+            })
+            .collect();
+        matrix(py, rows)
+    }
+
+    /// Writes the positions back (the engine contract's write-back: velocities zeroed, derived state rebuilt):
+    /// an `(n, 3)` float64 array as `positions` gives it; the rows of fixed bodies must be unchanged (3D: the
+    /// spheres keep their orientation).
+    fn set_positions(&mut self, positions: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        let current = with_system!(&mut self.loaded, s => s.final_state());
+        let array = positions.as_array();
+        let n = current.bodies.len();
+        if array.shape() != [n, 3] {
+            return Err(PyValueError::new_err(format!(
+                "positions: expected an array of shape ({n}, 3), got {:?}",
+                array.shape()
+            )));
+        }
+        if let Some((i, _)) = array.indexed_iter().find(|(_, x)| !x.is_finite()) {
+            return Err(PyValueError::new_err(format!("positions[{}, {}]: not finite", i.0, i.1)));
+        }
+        let planar = current.bodies.first().is_some_and(|b| b.angle.is_some());
+        with_system!(&mut self.loaded, s => {
+            let mut c = s.configuration();
+            let mobile = s.mobile_bodies();
+            for (i, b) in current.bodies.iter().enumerate() {
+                let now = match b.angle {
+                    Some(theta) => [b.position[0], b.position[1], theta],
+                    None => [b.position[0], b.position[1], b.position[2]],
+                };
+                let new = [array[[i, 0]], array[[i, 1]], array[[i, 2]]];
+                if !mobile.contains(&i) && new != now {
+                    return Err(PyValueError::new_err(format!(
+                        "positions[{i}]: body '{}' is fixed; its row must stay {now:?}",
+                        b.name
+                    )));
+                }
+            }
+            for k in 0..c.bodies.len() {
+                let i = c.bodies[k];
+                let q = c.body_mut(k);
+                q[..3].copy_from_slice(&[array[[i, 0]], array[[i, 1]], array[[i, 2]]]);
+                debug_assert!(planar == (q.len() == 3));
+            }
+            s.set_configuration(&c).map_err(to_py)
+        })
+    }
+
+    /// The contacts of the last step as a dict of arrays (SI units; `dim` = 2 or 3): `kind` (list of `pair`,
+    /// `wall`, `image`), `bodies` (`(m, 2)` int64: the body the force acts on and the other), `points` and
+    /// `normals` (`(m, dim)`, the normal from the other towards the first), `gaps` (m, negative when
+    /// overlapping), `normal_forces` (N, positive pushing apart), `tangential_forces` (`(m, dim)`, N).
+    fn contacts<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let dim = if matches!(self.loaded, Loaded::Md(_)) { 3 } else { 2 };
+        let rows = with_system!(&mut self.loaded, s => s.contact_rows());
+        let m = rows.len();
+        let pick = |v: [f64; 3]| v[..dim].to_vec();
+        let mut points = Vec::with_capacity(m * dim);
+        let mut normals = Vec::with_capacity(m * dim);
+        let mut tangential = Vec::with_capacity(m * dim);
+        for r in &rows {
+            points.extend(pick([r.point_x_m, r.point_y_m, r.point_z_m.unwrap_or(0.0)]));
+            normals.extend(pick([r.normal_x, r.normal_y, r.normal_z.unwrap_or(0.0)]));
+            tangential.extend(pick([r.f_t_x, r.f_t_y, r.f_t_z.unwrap_or(0.0)]));
+        }
+        let bodies: Vec<i64> = rows.iter().flat_map(|r| [r.a as i64, r.b as i64]).collect();
+        let d = PyDict::new(py);
+        let kinds: Vec<String> = rows.iter().map(|r| format!("{:?}", r.kind).to_lowercase()).collect();
+        d.set_item("kind", kinds)?;
+        d.set_item("bodies", PyArray1::from_vec(py, bodies).reshape([m, 2])?)?;
+        d.set_item("points", PyArray1::from_vec(py, points).reshape([m, dim])?)?;
+        d.set_item("normals", PyArray1::from_vec(py, normals).reshape([m, dim])?)?;
+        d.set_item("gaps", PyArray1::from_vec(py, rows.iter().map(|r| r.gap_m).collect()))?;
+        d.set_item("normal_forces", PyArray1::from_vec(py, rows.iter().map(|r| r.f_n).collect()))?;
+        d.set_item("tangential_forces", PyArray1::from_vec(py, tangential).reshape([m, dim])?)?;
+        Ok(d)
+    }
+
+    fn __repr__(&mut self) -> String {
+        let engine = self.engine();
+        let (n, t) = with_system!(&mut self.loaded, s => (s.body_count(), s.time()));
+        format!("<ballast.Simulation {engine}: {n} bodies, t = {t} s>")
+    }
+}
+
+/// The engine-neutral summary of a step's statistics.
+fn summary_of<E: Engine>(_sys: &E, stats: &E::Stats) -> StepSummary {
+    E::summary(stats)
+}
