@@ -3,7 +3,7 @@
 //! configuration write-back).
 
 use crate::errors::to_py;
-use ballast_core::engine::{Engine, StepSummary};
+use ballast_core::engine::{BodyState, Engine, Spin, StepSummary};
 use ballast_core::open::Loaded;
 use ballast_core::run::RunOptions;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
@@ -60,6 +60,22 @@ fn summary_dict<'py>(py: Python<'py>, s: &StepSummary) -> PyResult<Bound<'py, Py
     d.set_item("converged", s.converged)?;
     d.set_item("criterion", s.criterion)?;
     Ok(d)
+}
+
+/// A body's row of `positions`: `x, y, θ` in 2D, `x, y, z` in 3D.
+fn position_row(b: &BodyState) -> [f64; 3] {
+    match b.angle {
+        Some(theta) => [b.position[0], b.position[1], theta],
+        None => [b.position[0], b.position[1], b.position[2]],
+    }
+}
+
+/// A body's row of `velocities`: `v_x, v_y, ω` in 2D, `v_x, v_y, v_z` in 3D.
+fn velocity_row(b: &BodyState) -> [f64; 3] {
+    match b.spin {
+        Spin::Planar(w) => [b.velocity[0], b.velocity[1], w],
+        Spin::Spatial(_) => [b.velocity[0], b.velocity[1], b.velocity[2]],
+    }
 }
 
 /// An `(n, 3)` float64 array of the rows `rows`.
@@ -145,32 +161,15 @@ impl Simulation {
     #[getter]
     fn positions<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let state = with_system!(&mut self.loaded, s => s.final_state());
-        let rows = state
-            .bodies
-            .iter()
-            .map(|b| match b.angle {
-                Some(theta) => [b.position[0], b.position[1], theta],
-                None => [b.position[0], b.position[1], b.position[2]],
-            })
-            .collect();
-        matrix(py, rows)
+        matrix(py, state.bodies.iter().map(position_row).collect())
     }
 
     /// Velocities, `(n, 3)` float64 in scene order: `v_x, v_y` (m/s) and the spin `ω` (rad/s) in 2D;
     /// `v_x, v_y, v_z` (m/s) in 3D.
     #[getter]
     fn velocities<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        use ballast_core::engine::final_state::Spin;
         let state = with_system!(&mut self.loaded, s => s.final_state());
-        let rows = state
-            .bodies
-            .iter()
-            .map(|b| match b.spin {
-                Spin::Planar(w) => [b.velocity[0], b.velocity[1], w],
-                Spin::Spatial(_) => [b.velocity[0], b.velocity[1], b.velocity[2]],
-            })
-            .collect();
-        matrix(py, rows)
+        matrix(py, state.bodies.iter().map(velocity_row).collect())
     }
 
     /// Writes the positions back (the engine contract's write-back: velocities zeroed, derived state rebuilt):
@@ -194,10 +193,7 @@ impl Simulation {
             let mut c = s.configuration();
             let mobile = s.mobile_bodies();
             for (i, b) in current.bodies.iter().enumerate() {
-                let now = match b.angle {
-                    Some(theta) => [b.position[0], b.position[1], theta],
-                    None => [b.position[0], b.position[1], b.position[2]],
-                };
+                let now = position_row(b);
                 let new = [array[[i, 0]], array[[i, 1]], array[[i, 2]]];
                 if !mobile.contains(&i) && new != now {
                     return Err(PyValueError::new_err(format!(
