@@ -10,6 +10,7 @@ use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::time::{Duration, Instant};
 
 /// The system of whichever engine `$loaded` holds, bound to `$s`, in `$body`.
 macro_rules! with_system {
@@ -30,6 +31,10 @@ macro_rules! with_system {
         }
     };
 }
+
+/// Wall time between two looks at the interpreter's signals (Ctrl-C) while stepping: short beside a person's
+/// reaction, long beside the ~1 µs a look costs.
+const SIGNAL_CHECK: Duration = Duration::from_millis(20);
 
 /// A scene opened on its engine: NSCD or planar MD (2D: positions `x, y, θ`) or 3D MD (positions `x, y, z`).
 #[pyclass(module = "ballast")]
@@ -117,23 +122,46 @@ impl Simulation {
     /// Makes `n` steps (the interpreter's lock released) and returns the last one's statistics: `time` (s),
     /// `kinetic_energy` (J), `contacts`, `mean_overlap` and `max_overlap` (m), `iterations`, `converged` and
     /// `criterion` (the NSCD solver's). A step that blows up raises `DivergedError`, the state being that of
-    /// the last good step.
+    /// the last good step. Ctrl-C (SIGINT) raises `KeyboardInterrupt` between two steps, within about
+    /// [`SIGNAL_CHECK`] of wall time, the state being that of the last step made.
     #[pyo3(signature = (n = 1))]
     fn step<'py>(&mut self, py: Python<'py>, n: u64) -> PyResult<Bound<'py, PyDict>> {
         if n == 0 {
             return Err(PyValueError::new_err("n: must be at least 1, got 0"));
         }
-        let loaded = &mut self.loaded;
-        let summary = py.detach(|| {
-            with_system!(loaded, s => {
-                let mut last = None;
-                for _ in 0..n {
-                    last = Some(s.step()?);
-                }
-                Ok::<_, ballast_core::Error>(last.map(|stats| summary_of(s, &stats)))
-            })
+        let summary = with_system!(&mut self.loaded, s => {
+            let (mut done, mut last) = (0, None);
+            while done < n {
+                // Steps with the lock released for about SIGNAL_CHECK, then the signals are looked at.
+                let chunk = py.detach(|| {
+                    let (start, mut made, mut last) = (Instant::now(), 0, None);
+                    // The clock is read after steps 1, 2, … while a step is long beside SIGNAL_CHECK, at
+                    // doubling intervals while it is short (a step of a few spheres lasts less than a
+                    // microsecond: reading the clock after each would cost a few per cent of it).
+                    let (mut stride, mut next) = (1, 1);
+                    while done + made < n {
+                        last = Some(s.step()?);
+                        made += 1;
+                        if made == next {
+                            let elapsed = start.elapsed();
+                            if elapsed >= SIGNAL_CHECK {
+                                break;
+                            }
+                            if 4 * elapsed < SIGNAL_CHECK {
+                                stride *= 2;
+                            }
+                            next = made + stride;
+                        }
+                    }
+                    Ok::<_, ballast_core::Error>((made, last.map(|stats| summary_of(s, &stats))))
+                });
+                let (made, summary) = chunk.map_err(to_py)?;
+                (done, last) = (done + made, summary.or(last));
+                py.check_signals()?;
+            }
+            last
         });
-        match summary.map_err(to_py)? {
+        match summary {
             Some(s) => summary_dict(py, &s),
             None => Err(PyValueError::new_err("n: must be at least 1")),
         }

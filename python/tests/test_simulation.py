@@ -112,3 +112,28 @@ def test_a_run_that_blows_up_raises_diverged_error_with_step_and_body():
         sim.step(200)
     assert e.value.name in ("block", "press") and e.value.step >= 1
     assert sim.steps_done == e.value.step - 1, "the state is the last good step's"
+
+
+def test_ctrl_c_ends_stepping_between_two_steps_with_keyboard_interrupt():
+    """SIGINT while `step` runs a long way: KeyboardInterrupt within the signal check's period, the state that
+    of the last step made (finite, its clock consistent with its step count)."""
+    import signal
+    import threading
+    import time
+
+    sim = ballast.load(ROOT / "examples" / "md_two_spheres.toml")
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            sim.step(10**12)
+    finally:
+        timer.cancel()
+    elapsed = time.monotonic() - start
+    # 0.3 s until the signal, then at most one 20 ms chunk plus a step: 1 s leaves room for a loaded machine.
+    assert elapsed < 1.3, elapsed
+    assert 0 < sim.steps_done < 10**12
+    assert sim.time == pytest.approx(sim.steps_done * sim.dt, rel=1e-9)
+    assert np.isfinite(sim.positions).all()
+    sim.step(1)  # and it goes on
