@@ -93,12 +93,8 @@ fn matrix<'py>(py: Python<'py>, rows: Vec<[f64; 3]>) -> PyResult<Bound<'py, PyAr
 impl Simulation {
     /// The engine: `nscd`, `md2d` or `md`.
     #[getter]
-    fn engine(&self) -> &'static str {
-        match &self.loaded {
-            Loaded::Nscd(_) => "nscd",
-            Loaded::PlanarMd(..) => "md2d",
-            Loaded::Md(_) => "md",
-        }
+    fn engine(&mut self) -> &'static str {
+        with_system!(&mut self.loaded, s => name_of(s))
     }
 
     /// Time (s).
@@ -176,12 +172,7 @@ impl Simulation {
     /// Which bodies are fixed (or have every velocity component imposed): a bool array, in scene order.
     #[getter]
     fn fixed<'py>(&mut self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        let mask = with_system!(&mut self.loaded, s => {
-            let mut fixed = vec![true; s.body_count()];
-            s.mobile_bodies().into_iter().for_each(|i| fixed[i] = false);
-            fixed
-        });
-        PyArray1::from_vec(py, mask)
+        PyArray1::from_vec(py, with_system!(&mut self.loaded, s => fixed_mask(s)))
     }
 
     /// Positions, `(n, 3)` float64 in scene order: `x, y` (m) and the angle `θ` (rad) in 2D; `x, y, z` (m) in
@@ -216,14 +207,13 @@ impl Simulation {
         if let Some((i, _)) = array.indexed_iter().find(|(_, x)| !x.is_finite()) {
             return Err(PyValueError::new_err(format!("positions[{}, {}]: not finite", i.0, i.1)));
         }
-        let planar = current.bodies.first().is_some_and(|b| b.angle.is_some());
         with_system!(&mut self.loaded, s => {
             let mut c = s.configuration();
-            let mobile = s.mobile_bodies();
+            let fixed = fixed_mask(s);
             for (i, b) in current.bodies.iter().enumerate() {
                 let now = position_row(b);
                 let new = [array[[i, 0]], array[[i, 1]], array[[i, 2]]];
-                if !mobile.contains(&i) && new != now {
+                if fixed[i] && new != now {
                     return Err(PyValueError::new_err(format!(
                         "positions[{i}]: body '{}' is fixed; its row must stay {now:?}",
                         b.name
@@ -234,7 +224,6 @@ impl Simulation {
                 let i = c.bodies[k];
                 let q = c.body_mut(k);
                 q[..3].copy_from_slice(&[array[[i, 0]], array[[i, 1]], array[[i, 2]]]);
-                debug_assert!(planar == (q.len() == 3));
             }
             s.set_configuration(&c).map_err(to_py)
         })
@@ -245,8 +234,7 @@ impl Simulation {
     /// `normals` (`(m, dim)`, the normal from the other towards the first), `gaps` (m, negative when
     /// overlapping), `normal_forces` (N, positive pushing apart), `tangential_forces` (`(m, dim)`, N).
     fn contacts<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let dim = if matches!(self.loaded, Loaded::Md(_)) { 3 } else { 2 };
-        let rows = with_system!(&mut self.loaded, s => s.contact_rows());
+        let (dim, rows) = with_system!(&mut self.loaded, s => (dim_of(s), s.contact_rows()));
         let m = rows.len();
         let pick = |v: [f64; 3]| v[..dim].to_vec();
         let mut points = Vec::with_capacity(m * dim);
@@ -275,6 +263,23 @@ impl Simulation {
         let (n, t) = with_system!(&mut self.loaded, s => (s.body_count(), s.time()));
         format!("<ballast.Simulation {engine}: {n} bodies, t = {t} s>")
     }
+}
+
+/// The engine's name (`nscd`, `md2d`, `md`: the one its outputs record).
+fn name_of<E: Engine>(_sys: &E) -> &'static str {
+    E::NAME
+}
+
+/// The engine's space dimension (2 or 3).
+fn dim_of<E: Engine>(_sys: &E) -> usize {
+    E::DIM
+}
+
+/// Which bodies are fixed (or have every velocity component imposed): not among the engine's mobile bodies.
+fn fixed_mask<E: Engine>(sys: &E) -> Vec<bool> {
+    let mut fixed = vec![true; sys.body_count()];
+    sys.mobile_bodies().into_iter().for_each(|i| fixed[i] = false);
+    fixed
 }
 
 /// The engine-neutral summary of a step's statistics.

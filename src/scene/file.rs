@@ -17,9 +17,9 @@ use std::path::Path;
 /// # Ok::<(), ballast::Error>(())
 /// ```
 pub trait SceneFile: Sized + DeserializeOwned {
-    /// Checks a parsed scene as a file is checked (every field, the bodies, the laws…): the one-line
-    /// [`Error::Scene`] messages naming the key.
-    fn check(&self) -> Result<()>;
+    /// Validates the scene as a file is validated (every field, the bodies, the laws…), also a scene built as a
+    /// value (e.g. by a generator of [`crate::scenarios`]): the one-line [`Error::Scene`] messages naming the key.
+    fn validate(&self) -> Result<()>;
 
     /// The scene as TOML text, laid out like a hand-written scene (only the keys the scene has; floats in their
     /// shortest exact form), which [`SceneFile::from_toml_str`] reads back to an equal scene. It does not fail
@@ -56,7 +56,7 @@ pub trait SceneFile: Sized + DeserializeOwned {
     /// As [`SceneFile::from_toml_str`], with `name` in place of `scene.toml` in the messages of syntax errors.
     fn from_toml_str_named(text: &str, name: &str) -> Result<Self> {
         let scene: Self = toml::from_str(text).map_err(|e| Error::Scene(parse::one_line(name, text, &e)))?;
-        scene.check()?;
+        scene.validate()?;
         Ok(scene)
     }
 
@@ -65,12 +65,6 @@ pub trait SceneFile: Sized + DeserializeOwned {
     fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         Self::from_toml_str_named(&read_text(path)?, &path.display().to_string())
-    }
-
-    /// Validates a scene built as a value (e.g. by a generator of [`crate::scenarios`]) exactly as
-    /// [`SceneFile::from_toml_str`] validates a file: the same one-line [`Error::Scene`] messages.
-    fn validate(&self) -> Result<()> {
-        self.check()
     }
 
     /// Number of time steps of the run, `round(duration / dt)` (0 if `dt` is not positive).

@@ -93,7 +93,7 @@ pub fn engine_of_named(text: &str, name: &str) -> Result<String> {
 }
 
 impl SceneFile for Scene {
-    fn check(&self) -> Result<()> {
+    fn validate(&self) -> Result<()> {
         validate::check(self).map(|_| ())
     }
 

@@ -49,7 +49,7 @@ use crate::scene::common::Simulation;
 use crate::scene::{OutputSection, SceneFile};
 
 impl SceneFile for MdScene {
-    fn check(&self) -> Result<()> {
+    fn validate(&self) -> Result<()> {
         validate::check(self).map(|_| ())
     }
 
