@@ -18,6 +18,7 @@ use crate::scene::common::AccelerationPlan;
 use crate::scene::SceneFile;
 use crate::scene::{planar_length, scene_on, MdScene, Scene, SceneKind, SoftModelInfo};
 use crate::settlement::{Accelerated, AccelerationProgress, AccelerationSummary, FolderFigures};
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 /// A scene as read: its serde form, the text a run records (`scene.toml`: the file's text, or its serialised
@@ -106,37 +107,69 @@ impl Loaded {
     /// # Errors
     /// [`Error::Scene`] (one line naming the field) for invalid options or checkpoint; else as
     /// [`Runner::run`].
-    pub fn run(self, out: &Path, opts: &RunOptions, progress: &mut dyn FnMut(&Progress)) -> Result<RunOutcome> {
+    pub fn run(mut self, out: &Path, opts: &RunOptions, progress: &mut dyn FnMut(&Progress)) -> Result<RunOutcome> {
         let opts = RunOptions { length: None, engine: None, ..opts.clone() };
+        self.run_on(out, &opts, &mut |p| {
+            progress(p);
+            ControlFlow::Continue(())
+        })
+    }
+
+    /// Runs the system from the state it holds into the folder `out` through the run loop
+    /// ([`Runner::run_with`]: `control` after every step may stop the run, leaving a checkpoint) and keeps the
+    /// state the run left (its last step; the last good one if a step diverged). `opts.length` sets the steps
+    /// of this run (counted from the state held; `None`: the scene's `[simulation] duration`); `opts.engine`
+    /// is not read (the engine is chosen when the scene is opened). An MD scene's `md.threads` wins over
+    /// `opts.threads`.
+    ///
+    /// The run's record of its input is the scene's text (`scene.toml`) when the system holds the start the
+    /// scene builds (no step made, the same bodies, positions and velocities), and otherwise the state's serde
+    /// form (`initial_state.json`, as for a system built in code). `opts.resume` continues the run in `out`
+    /// from its checkpoint: a run that started from the scene's start, whatever state the system holds now.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] (one line naming the field) for invalid options or a refused length; else as
+    /// [`Runner::run`].
+    pub fn run_on(
+        &mut self,
+        out: &Path,
+        opts: &RunOptions,
+        control: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
+    ) -> Result<RunOutcome> {
+        // The length is applied to the scene here; the runner refuses one.
+        let (length, opts) = (opts.length, &RunOptions { length: None, engine: None, ..opts.clone() });
         match self {
             Loaded::Md(o) => {
-                let Opened { path, scene, text, system, .. } = *o;
-                let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts };
+                let mut scene = o.scene.clone();
+                let text = scene.text_with_length(o.text.clone(), length)?;
+                let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts.clone() };
                 let plan = scene.plan()?;
+                let fresh = o.scene.build()?;
                 let restart: Restart<MdSystem> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
                 let figures: Figures<MdSystem> = Box::new(|dir, _| crate::report::draw_run_figures(dir).map(drop));
-                Runner::from_scene(system, plan, &path, text, Some(restart))
-                    .with_figures(figures)
-                    .run(out, &opts, progress)
+                let runner = runner(&o.system, fresh, plan, (&o.path, text), restart, opts.resume)?;
+                keep(&mut o.system, runner.with_figures(figures).run_with(out, &opts, control))
             }
             Loaded::PlanarMd(o, info) => {
-                let Opened { path, scene, text, system, .. } = *o;
-                let plan = scene.plan_planar(system.params.dt)?;
-                let model = serde_json::to_value(info).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+                let mut scene = o.scene.clone();
+                let text = scene.text_with_length(o.text.clone(), planar_length(length, o.system.params.dt))?;
+                let plan = scene.plan_planar(o.system.params.dt)?;
+                let model = serde_json::to_value(*info).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+                let (fresh, _) = o.scene.build_planar()?;
                 let restart: Restart<PlanarSystem> =
                     Box::new(move |sys| scene.with_bodies(&sys.bodies).to_toml_string());
-                Runner::from_scene(system, plan, &path, text, Some(restart))
-                    .with_model(model)
-                    .with_figures(plane_figures::<PlanarSystem>())
-                    .run(out, &opts, progress)
+                let runner = runner(&o.system, fresh, plan, (&o.path, text), restart, opts.resume)?;
+                let runner = runner.with_model(model).with_figures(plane_figures::<PlanarSystem>());
+                keep(&mut o.system, runner.run_with(out, opts, control))
             }
             Loaded::Nscd(o) => {
-                let Opened { path, scene, text, system, .. } = *o;
+                let mut scene = o.scene.clone();
+                let text = scene.text_with_length(o.text.clone(), length)?;
                 let plan = scene.plan()?;
+                let fresh = o.scene.build()?;
                 let restart: Restart<System> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
-                Runner::from_scene(system, plan, &path, text, Some(restart))
-                    .with_figures(plane_figures::<System>())
-                    .run(out, &opts, progress)
+                let runner = runner(&o.system, fresh, plan, (&o.path, text), restart, opts.resume)?;
+                keep(&mut o.system, runner.with_figures(plane_figures::<System>()).run_with(out, opts, control))
             }
         }
     }
@@ -210,6 +243,38 @@ pub fn settle_file(
     progress: &mut dyn FnMut(&AccelerationProgress),
 ) -> Result<Option<AccelerationSummary>> {
     open(path, opts)?.settle(out, opts, progress)
+}
+
+/// The run of `current`, a system of the scene at `path` with the text `text` (`fresh`: the start that scene
+/// builds), with `restart` writing its final state as a scene: recorded as the scene when `current` holds
+/// that start or the run is `resume`d (a resumed run starts where its checkpoint's run started: the scene's
+/// start), else as the state's serde form.
+///
+/// # Errors
+/// [`Error::Io`] if the state cannot be serialised.
+fn runner<E: crate::engine::Engine>(
+    current: &E,
+    fresh: E,
+    plan: crate::run::RunPlan,
+    (path, text): (&Path, String),
+    restart: Restart<E>,
+    resume: bool,
+) -> Result<Runner<E>> {
+    let at_start = current.steps_done() == 0 && current.final_state() == fresh.final_state();
+    if resume || at_start {
+        let system = if resume { fresh } else { current.clone() };
+        Ok(Runner::from_scene(system, plan, path, text, Some(restart)))
+    } else {
+        Ok(Runner::from_system(current.clone(), plan)?.with_restart(path, restart))
+    }
+}
+
+/// The outcome of a run, its final system kept in `system`.
+fn keep<E>(system: &mut E, (outcome, end): (Result<RunOutcome>, Option<E>)) -> Result<RunOutcome> {
+    if let Some(end) = end {
+        *system = end;
+    }
+    outcome
 }
 
 /// The figures of a run of either 2D engine: from its folder, with the positions at the end of the first

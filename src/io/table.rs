@@ -118,6 +118,11 @@ impl TableWriter {
 
     /// Flushes the file.
     pub fn finish(mut self) -> Result<()> {
+        self.flush()
+    }
+
+    /// Flushes the file, keeping the writer.
+    pub fn flush(&mut self) -> Result<()> {
         self.out.flush().map_err(|e| io_error(&self.path, "write", e))
     }
 }

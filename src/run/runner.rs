@@ -27,6 +27,7 @@ use crate::io::{self, RunInfo};
 use crate::run::checkpoint::Checkpoint;
 use crate::run::positions::PositionsWriter;
 use crate::run::summary::{RunEnd, RunReport, RunSummary};
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -104,7 +105,6 @@ pub struct Runner<E: Engine> {
     figures: Option<Figures<E>>,
 }
 
-/// The state of a run in progress.
 /// How the loop ended: the last step's statistics and whether its series row was written, the failure that
 /// stopped it, whether it stopped at equilibrium.
 struct Ending<S> {
@@ -113,6 +113,7 @@ struct Ending<S> {
     at_equilibrium: bool,
 }
 
+/// The state of a run in progress.
 struct Live<E: Engine> {
     sys: E,
     summary: RunSummary,
@@ -154,6 +155,14 @@ impl<E: Engine> Runner<E> {
         self
     }
 
+    /// The same run, writing its final state as a scene with `restart` (`final_scene.toml`, its header
+    /// naming the scene file at `path`).
+    pub fn with_restart(mut self, path: &Path, restart: Restart<E>) -> Self {
+        self.scene_path = Some(path.to_path_buf());
+        self.restart = Some(restart);
+        self
+    }
+
     /// A run of a system built in code. Its serde form and the plan's are written
     /// to the output folder (`initial_state.json`) as the record of the run's input.
     pub fn from_system(system: E, plan: RunPlan) -> Result<Self> {
@@ -189,6 +198,42 @@ impl<E: Engine> Runner<E> {
     /// written; [`Error::Diverged`] if a step diverges, after the last good
     /// state has been written (`series.csv` row, `final.json`, `summary.json`).
     pub fn run(&self, out: &Path, opts: &RunOptions, progress: &mut dyn FnMut(&Progress)) -> Result<RunOutcome> {
+        let mut control = |p: &Progress| {
+            progress(p);
+            ControlFlow::Continue(())
+        };
+        self.run_with(out, opts, &mut control).0
+    }
+
+    /// [`Runner::run`] with a `control` callback after every step that may stop the run: its
+    /// [`ControlFlow::Break`] ends the call as [`RunOptions::stop_after`] does (a checkpoint to resume from,
+    /// [`Status::Stopped`]) unless that step was the run's last. Returns the outcome and the system as the run
+    /// left it (its last step, the last good one if a step diverged; `None` if the run did not start: invalid
+    /// options, a refused checkpoint, an output folder that cannot be prepared). A caller that steps the
+    /// system on after the run (the Python binding) keeps it.
+    ///
+    /// # Errors
+    /// As [`Runner::run`].
+    pub fn run_with(
+        &self,
+        out: &Path,
+        opts: &RunOptions,
+        control: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
+    ) -> (Result<RunOutcome>, Option<E>) {
+        let mut live = match self.begin(out, opts) {
+            Ok(live) => live,
+            Err(e) => return (Err(e), None),
+        };
+        let started = Instant::now();
+        let end_step = live.first_step.saturating_add(self.plan.steps);
+        let result = self
+            .steps(out, opts, &mut live, control, (end_step, &started))
+            .and_then(|ending| self.finish(out, opts, &mut live, ending, (end_step, &started)));
+        (result, Some(live.sys))
+    }
+
+    /// The checks of the options and the run in progress, started or resumed.
+    fn begin(&self, out: &Path, opts: &RunOptions) -> Result<Live<E>> {
         check_options(opts)?;
         check_built(opts)?;
         if opts.figures && self.figures.is_none() {
@@ -198,13 +243,25 @@ impl<E: Engine> Runner<E> {
                     .into(),
             ));
         }
-        let plan = &self.plan;
-        if plan.output_every == 0 {
+        if self.plan.output_every == 0 {
             return Err(Error::Scene("output.every: must be at least 1, got 0".into()));
         }
         let mut live = if opts.resume { self.resume(out)? } else { self.start(out, opts)? };
-        let end_step = live.first_step.saturating_add(plan.steps);
         live.sys.set_threads(opts.threads.max(1));
+        Ok(live)
+    }
+
+    /// The steps of the run up to `end_step` (or `opts.stop_after`, a stop asked by `control`, equilibrium, a
+    /// step that fails), with their outputs and checkpoints; the wall time counted from `started`.
+    fn steps(
+        &self,
+        out: &Path,
+        opts: &RunOptions,
+        live: &mut Live<E>,
+        control: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
+        (end_step, started): (u64, &Instant),
+    ) -> Result<Ending<E::Stats>> {
+        let plan = &self.plan;
         let last = opts.stop_after.map_or(end_step, |n| end_step.min(live.sys.steps_done().saturating_add(n)));
         let cycles_total = plan.cycles.map(|c| {
             let total = end_step.saturating_sub(live.first_step) as f64 * self.system.dt();
@@ -212,7 +269,6 @@ impl<E: Engine> Runner<E> {
         });
         let (vtk_dir, pvd_path) = (out.join(layout::VTK_DIR), out.join(layout::PVD));
         let wall0 = live.summary.wall_time_s;
-        let started = Instant::now();
         let mut checkpointed = Instant::now();
         let mut last_stats: Option<(E::Stats, bool)> = None;
         let mut diverged = None;
@@ -233,10 +289,10 @@ impl<E: Engine> Runner<E> {
                 let en = live.sys.energies(&stats, potential);
                 at_equilibrium = live.summary.equilibrium.observe(rule, rule.holds(en.kinetic, en.potential));
             }
-            let written = k % plan.output_every == 0 || k == end_step || at_equilibrium;
-            self.record_step(&mut live, &stats, written, opts.vtk_every, (&vtk_dir, &pvd_path))?;
+            let written = k.is_multiple_of(plan.output_every) || k == end_step || at_equilibrium;
+            self.record_step(live, &stats, written, opts.vtk_every, (&vtk_dir, &pvd_path))?;
             last_stats = Some((stats, written));
-            progress(&Progress {
+            let flow = control(&Progress {
                 step: k,
                 end_step,
                 time: common.time,
@@ -247,15 +303,15 @@ impl<E: Engine> Runner<E> {
             });
             if opts.checkpoint_every_s > 0.0 && checkpointed.elapsed().as_secs_f64() >= opts.checkpoint_every_s {
                 live.summary.wall_time_s = wall0 + started.elapsed().as_secs_f64();
-                self.checkpoint(out, &mut live)?;
+                self.checkpoint(out, live)?;
                 checkpointed = Instant::now();
             }
-            if at_equilibrium {
+            if at_equilibrium || flow.is_break() {
                 break;
             }
         }
         live.summary.wall_time_s = wall0 + started.elapsed().as_secs_f64();
-        self.finish(out, opts, live, Ending { last_stats, diverged, at_equilibrium }, (end_step, &started))
+        Ok(Ending { last_stats, diverged, at_equilibrium })
     }
 
     /// The outputs of step `k` (made, with its statistics `stats`): its series row when `written`, the cycle
@@ -300,7 +356,7 @@ impl<E: Engine> Runner<E> {
         &self,
         out: &Path,
         opts: &RunOptions,
-        mut live: Live<E>,
+        live: &mut Live<E>,
         Ending { last_stats, diverged, at_equilibrium }: Ending<E::Stats>,
         (end_step, started): (u64, &Instant),
     ) -> Result<RunOutcome> {
@@ -336,15 +392,15 @@ impl<E: Engine> Runner<E> {
         };
         if diverged.is_none() && !at_equilibrium && step < end_step {
             // Stopped on request: a checkpoint and nothing that looks final.
-            self.checkpoint(out, &mut live)?;
-            live.series.finish()?;
+            self.checkpoint(out, live)?;
+            live.series.flush()?;
             return Ok(outcome(Status::Stopped));
         }
         if let Some((stats, false)) = last_stats {
             // The run stopped off the output grid: its last good step gets a row.
             live.series.write(&live.sys.series_row(&stats))?;
         }
-        live.series.finish()?;
+        live.series.flush()?;
         let state = live.cycles.take().map(|(state, table)| (state, table.finish()));
         if let Some((_, Err(e))) = state {
             return Err(e);
