@@ -6,6 +6,7 @@
 //! the interpreter's lock released.
 
 mod errors;
+mod running;
 mod simulation;
 
 use pyo3::prelude::*;

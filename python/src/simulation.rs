@@ -3,14 +3,16 @@
 //! configuration write-back).
 
 use crate::errors::to_py;
+use crate::running::{to_python, OutFolder, Watch, LOOK_EVERY};
 use ballast_core::engine::{BodyState, Engine, Spin, StepSummary};
 use ballast_core::open::Loaded;
-use ballast_core::run::RunOptions;
+use ballast_core::run::{RunEnd, RunLength, RunOptions, Status};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::time::{Duration, Instant};
+use std::path::PathBuf;
+use std::time::Instant;
 
 /// The system of whichever engine `$loaded` holds, bound to `$s`, in `$body`.
 macro_rules! with_system {
@@ -31,10 +33,6 @@ macro_rules! with_system {
         }
     };
 }
-
-/// Wall time between two looks at the interpreter's signals (Ctrl-C) while stepping: short beside a person's
-/// reaction, long beside the ~1 µs a look costs.
-const SIGNAL_CHECK: Duration = Duration::from_millis(20);
 
 /// A scene opened on its engine: NSCD or planar MD (2D: positions `x, y, θ`) or 3D MD (positions `x, y, z`).
 #[pyclass(module = "ballast")]
@@ -119,7 +117,7 @@ impl Simulation {
     /// `kinetic_energy` (J), `contacts`, `mean_overlap` and `max_overlap` (m), `iterations`, `converged` and
     /// `criterion` (the NSCD solver's). A step that blows up raises `DivergedError`, the state being that of
     /// the last good step. Ctrl-C (SIGINT) raises `KeyboardInterrupt` between two steps, within about
-    /// [`SIGNAL_CHECK`] of wall time, the state being that of the last step made.
+    /// 20 ms of wall time, the state being that of the last step made.
     #[pyo3(signature = (n = 1))]
     fn step<'py>(&mut self, py: Python<'py>, n: u64) -> PyResult<Bound<'py, PyDict>> {
         if n == 0 {
@@ -128,10 +126,10 @@ impl Simulation {
         let summary = with_system!(&mut self.loaded, s => {
             let (mut done, mut last) = (0, None);
             while done < n {
-                // Steps with the lock released for about SIGNAL_CHECK, then the signals are looked at.
+                // Steps with the lock released for about LOOK_EVERY, then the signals are looked at.
                 let chunk = py.detach(|| {
                     let (start, mut made, mut last) = (Instant::now(), 0, None);
-                    // The clock is read after steps 1, 2, … while a step is long beside SIGNAL_CHECK, at
+                    // The clock is read after steps 1, 2, … while a step is long beside LOOK_EVERY, at
                     // doubling intervals while it is short (a step of a few spheres lasts less than a
                     // microsecond: reading the clock after each would cost a few per cent of it).
                     let (mut stride, mut next) = (1, 1);
@@ -140,10 +138,10 @@ impl Simulation {
                         made += 1;
                         if made == next {
                             let elapsed = start.elapsed();
-                            if elapsed >= SIGNAL_CHECK {
+                            if elapsed >= LOOK_EVERY {
                                 break;
                             }
-                            if 4 * elapsed < SIGNAL_CHECK {
+                            if 4 * elapsed < LOOK_EVERY {
                                 stride *= 2;
                             }
                             next = made + stride;
@@ -161,6 +159,96 @@ impl Simulation {
             Some(s) => summary_dict(py, &s),
             None => Err(PyValueError::new_err("n: must be at least 1")),
         }
+    }
+
+    /// Runs the simulation through the library's run loop into the folder `out` (the outputs of `ballast run`:
+    /// `series.csv`, `final.json`, `contacts.csv`, `summary.json`, checkpoints; `None`: a temporary folder,
+    /// removed on return) from the state it holds, and keeps the state the run reached.
+    ///
+    /// `steps`: steps to make (`None`: the scene's `[simulation] duration`; the run may end earlier at the
+    /// scene's equilibrium rule). `checkpoint_every`: wall-clock seconds between checkpoints (`None`: 300 with
+    /// `out`, none without). `resume`: continue the run in `out` from its checkpoint (a run started from the
+    /// scene's start; the simulation's state before the call does not matter). `progress`: called with a dict
+    /// (`step`, `end_step`, `time` in s, `kinetic_energy` in J, `contacts`, `cycles` and `settlement` in m when
+    /// the scene follows cycles) at most every 20 ms of wall time and after the last step; returning `False`
+    /// stops the run as Ctrl-C does, without an exception. `stop_after`: stop after this many steps of this
+    /// call. `vtk_every`: a VTK snapshot every this many steps (0: none). `figures`: draw the run's figures.
+    /// `threads`: threads of a step (1 or 2; `None`: 2 on a machine with 2 cores; the numbers do not depend on
+    /// it).
+    ///
+    /// Returns a dict: `status` (`finished`, `equilibrium` or `stopped`), `step`, `end_step`, `time` (s),
+    /// `kinetic_energy` (J), `elapsed_s`, `out` (`None` for a temporary folder) and `report` (the contents of
+    /// `summary.json`). The interpreter's lock is released while stepping. Ctrl-C (SIGINT) stops the run
+    /// between two steps, leaves a checkpoint in `out` (resume with `resume=True`) and raises
+    /// `KeyboardInterrupt`; an exception of `progress` does the same and is raised. A step that blows up
+    /// raises `DivergedError` (the outputs and the simulation hold the last good step).
+    #[pyo3(signature = (
+        out = None, steps = None, checkpoint_every = None, resume = false, progress = None, stop_after = None,
+        vtk_every = 0, figures = false, threads = None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn run<'py>(
+        &mut self,
+        py: Python<'py>,
+        out: Option<PathBuf>,
+        steps: Option<u64>,
+        checkpoint_every: Option<f64>,
+        resume: bool,
+        progress: Option<Py<PyAny>>,
+        stop_after: Option<u64>,
+        vtk_every: u64,
+        figures: bool,
+        threads: Option<usize>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        if resume && out.is_none() {
+            return Err(PyValueError::new_err("resume: needs the folder `out` of the run to continue"));
+        }
+        let folder = OutFolder::new(out);
+        let default_every = if folder.is_temporary() { 0.0 } else { RunOptions::default().checkpoint_every_s };
+        let opts = RunOptions {
+            checkpoint_every_s: checkpoint_every.unwrap_or(default_every),
+            resume,
+            stop_after,
+            vtk_every,
+            threads: threads.unwrap_or_else(ballast_core::run::default_threads),
+            figures,
+            length: steps.map(RunLength::Steps),
+            engine: None,
+        };
+        let mut watch = Watch::new(progress);
+        let loaded = &mut self.loaded;
+        let outcome = py.detach(|| {
+            loaded.run_on(folder.path(), &opts, &mut |p| {
+                watch.look(p.step == p.end_step, |d| {
+                    d.set_item("step", p.step)?;
+                    d.set_item("end_step", p.end_step)?;
+                    d.set_item("time", p.time)?;
+                    d.set_item("kinetic_energy", p.kinetic_energy)?;
+                    d.set_item("contacts", p.contacts)?;
+                    d.set_item("cycles", p.cycles)?;
+                    d.set_item("settlement", p.settlement)
+                })
+            })
+        });
+        if let Some(e) = watch.failure {
+            return Err(e);
+        }
+        let outcome = outcome.map_err(to_py)?;
+        let d = PyDict::new(py);
+        let status = match outcome.status {
+            Status::Stopped => "stopped",
+            Status::Ended(RunEnd::Equilibrium) => "equilibrium",
+            Status::Ended(_) => "finished",
+        };
+        d.set_item("status", status)?;
+        d.set_item("step", outcome.step)?;
+        d.set_item("end_step", outcome.end_step)?;
+        d.set_item("time", outcome.time)?;
+        d.set_item("kinetic_energy", outcome.kinetic_energy)?;
+        d.set_item("elapsed_s", outcome.elapsed_s)?;
+        d.set_item("out", folder.shown())?;
+        d.set_item("report", to_python(py, &outcome.report)?)?;
+        Ok(d)
     }
 
     /// The bodies' names, in scene order.
