@@ -14,10 +14,10 @@ use crate::md::planar::PlanarSystem;
 use crate::md::MdSystem;
 use crate::nscd::System;
 use crate::run::{Figures, Progress, Restart, RunOptions, RunOutcome, Runner};
-use crate::scene::common::AccelerationPlan;
+use crate::scene::common::{AccelerationPlan, SettlementSection};
 use crate::scene::SceneFile;
 use crate::scene::{planar_length, scene_on, MdScene, Scene, SceneKind, SoftModelInfo};
-use crate::settlement::{Accelerated, AccelerationProgress, AccelerationSummary, FolderFigures};
+use crate::settlement::{Accelerated, AccelerationOutcome, AccelerationProgress, AccelerationSummary, FolderFigures};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
@@ -182,39 +182,153 @@ impl Loaded {
     /// # Errors
     /// [`Error::Scene`] (one line naming the key) for invalid options; else as [`Accelerated::run`].
     pub fn settle(
-        self,
+        mut self,
         out: &Path,
         opts: &RunOptions,
         progress: &mut dyn FnMut(&AccelerationProgress),
     ) -> Result<Option<AccelerationSummary>> {
+        if !self.settles() {
+            return Ok(None);
+        }
         let opts = RunOptions { length: None, engine: None, ..opts.clone() };
+        let request = SettleRequest::default();
+        let summary = self.settle_on(out, &opts, &request, &mut |p| {
+            progress(p);
+            ControlFlow::Continue(())
+        })?;
+        Ok(Some(summary))
+    }
+
+    /// Runs the settlement-acceleration procedure ([`Accelerated::run_with`]: `control` after each cycle may
+    /// stop it, leaving a checkpoint) from the state the system holds into `out`, with the scene's
+    /// `[settlement]` table or `request`'s, to the cycles the scene's duration holds or `request.cycles`; the
+    /// system then holds the state reached (unchanged if the run fails). The record of the input, `resume` and
+    /// `opts.length` (not read: the cycles are `request`'s) are as in [`Loaded::run_on`]; an MD scene's
+    /// `md.threads` wins over `opts.threads`.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming the key for a scene without a `[settlement]` table and no
+    /// `request.settlement`, a table or cycle count the scene refuses; else as [`Accelerated::run`].
+    pub fn settle_on(
+        &mut self,
+        out: &Path,
+        opts: &RunOptions,
+        request: &SettleRequest,
+        control: &mut dyn FnMut(&AccelerationProgress) -> ControlFlow<()>,
+    ) -> Result<AccelerationSummary> {
+        let opts = &RunOptions { length: None, engine: None, ..opts.clone() };
         match self {
             Loaded::Md(o) => {
-                let Opened { scene, text, system, acceleration, .. } = *o;
-                let Some(plan) = acceleration else { return Ok(None) };
-                let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts };
-                let run = Accelerated::from_scene(system, plan.spec, plan.frequency, plan.cycles, scene.seed(), text)
-                    .with_figures(settlement_figures());
-                Ok(Some(run.run(out, &opts, progress)?.summary))
+                let mut scene = o.scene.clone();
+                let text = request.apply(&mut scene, &o.text, |s| &mut s.settlement)?;
+                let opts = RunOptions { threads: scene.threads().unwrap_or(opts.threads), ..opts.clone() };
+                let plan = settlement_plan(&scene)?;
+                let fresh = o.scene.build()?;
+                let run = accelerated(&o.system, fresh, plan, (scene.seed(), text), opts.resume)?;
+                keep_settled(&mut o.system, run.with_figures(settlement_figures()).run_with(out, &opts, control))
             }
             Loaded::PlanarMd(o, info) => {
-                let Opened { scene, text, system, acceleration, .. } = *o;
-                let Some(plan) = acceleration else { return Ok(None) };
-                let model = serde_json::to_value(info).map_err(|e| Error::Io(std::io::Error::other(e)))?;
-                let run = Accelerated::from_scene(system, plan.spec, plan.frequency, plan.cycles, scene.seed(), text)
-                    .with_model(model)
-                    .with_figures(settlement_figures());
-                Ok(Some(run.run(out, &opts, progress)?.summary))
+                let mut scene = o.scene.clone();
+                let text = request.apply(&mut scene, &o.text, |s| &mut s.settlement)?;
+                let plan = settlement_plan(&scene)?;
+                let model = serde_json::to_value(*info).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+                let (fresh, _) = o.scene.build_planar()?;
+                let run = accelerated(&o.system, fresh, plan, (scene.seed(), text), opts.resume)?;
+                let run = run.with_model(model).with_figures(settlement_figures());
+                keep_settled(&mut o.system, run.run_with(out, opts, control))
             }
             Loaded::Nscd(o) => {
-                let Opened { scene, text, system, acceleration, .. } = *o;
-                let Some(plan) = acceleration else { return Ok(None) };
-                let run = Accelerated::from_scene(system, plan.spec, plan.frequency, plan.cycles, scene.seed(), text)
-                    .with_figures(settlement_figures());
-                Ok(Some(run.run(out, &opts, progress)?.summary))
+                let mut scene = o.scene.clone();
+                let text = request.apply(&mut scene, &o.text, |s| &mut s.settlement)?;
+                let plan = settlement_plan(&scene)?;
+                let fresh = o.scene.build()?;
+                let run = accelerated(&o.system, fresh, plan, (scene.seed(), text), opts.resume)?;
+                keep_settled(&mut o.system, run.with_figures(settlement_figures()).run_with(out, opts, control))
             }
         }
     }
+}
+
+/// What [`Loaded::settle_on`] changes in the scene for its run.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SettleRequest {
+    /// The `[settlement]` table to run with instead of the scene's (`None`: the scene's).
+    pub settlement: Option<SettlementSection>,
+    /// Loading cycles to reach, ≥ 1 (the scene's duration set to `cycles / frequency`; `None`: the scene's).
+    pub cycles: Option<u64>,
+}
+
+impl SettleRequest {
+    /// Applies the request to `scene` (its `[settlement]` table at `table`) whose text is `text`; the text to
+    /// record: `text` itself when nothing changes, else the scene's serialised form.
+    fn apply<S: SceneFile>(
+        &self,
+        scene: &mut S,
+        text: &str,
+        table: impl Fn(&mut S) -> &mut Option<SettlementSection>,
+    ) -> Result<String> {
+        if let Some(section) = &self.settlement {
+            *table(scene) = Some(section.clone());
+        }
+        if let Some(cycles) = self.cycles {
+            let frequency = scene.plan()?.cycles.map(|c| c.frequency).ok_or_else(|| {
+                Error::Scene(
+                    "output.cycles: the scene has no loading cycles to count (give [output] cycles = { frequency \
+                     = … })"
+                        .into(),
+                )
+            })?;
+            if cycles == 0 {
+                return Err(Error::Scene("cycles: must be at least 1, got 0".into()));
+            }
+            scene.simulation_mut().set_length(crate::run::RunLength::Duration(cycles as f64 / frequency))?;
+        }
+        if self.settlement.is_none() && self.cycles.is_none() {
+            return Ok(text.to_string());
+        }
+        scene.validate()?;
+        scene.to_toml_string()
+    }
+}
+
+/// The settlement plan of `scene`, or the error that it has none.
+fn settlement_plan<S: SceneFile>(scene: &S) -> Result<AccelerationPlan> {
+    scene.acceleration()?.ok_or_else(|| {
+        Error::Scene(
+            "settlement: the scene has no [settlement] table (add one, or give the acceleration settings)".into(),
+        )
+    })
+}
+
+/// The accelerated run of `current`, as [`runner`] chooses its record (`fresh`: the start the scene builds;
+/// the scene's seed and text).
+fn accelerated<E: crate::engine::Engine>(
+    current: &E,
+    fresh: E,
+    plan: AccelerationPlan,
+    (seed, text): (u64, String),
+    resume: bool,
+) -> Result<Accelerated<E>> {
+    let AccelerationPlan { spec, frequency, cycles } = plan;
+    if resume || at_start(current, &fresh) {
+        let system = if resume { fresh } else { current.clone() };
+        Ok(Accelerated::from_scene(system, spec, frequency, cycles, seed, text))
+    } else {
+        Accelerated::from_system(current.clone(), spec, frequency, cycles)
+    }
+}
+
+/// The summary of an accelerated run, its final system kept in `system`.
+fn keep_settled<E>(system: &mut E, outcome: Result<AccelerationOutcome<E>>) -> Result<AccelerationSummary> {
+    let outcome = outcome?;
+    *system = outcome.system;
+    Ok(outcome.summary)
+}
+
+/// Whether `current` holds the start `fresh` of its scene: no step made, the same bodies, positions and
+/// velocities.
+fn at_start<E: crate::engine::Engine>(current: &E, fresh: &E) -> bool {
+    current.steps_done() == 0 && current.final_state() == fresh.final_state()
 }
 
 /// Runs the scene file at `scene_path` (either engine: `[simulation] engine`) into the folder `out` through
@@ -260,8 +374,7 @@ fn runner<E: crate::engine::Engine>(
     restart: Restart<E>,
     resume: bool,
 ) -> Result<Runner<E>> {
-    let at_start = current.steps_done() == 0 && current.final_state() == fresh.final_state();
-    if resume || at_start {
+    if resume || at_start(current, &fresh) {
         let system = if resume { fresh } else { current.clone() };
         Ok(Runner::from_scene(system, plan, path, text, Some(restart)))
     } else {

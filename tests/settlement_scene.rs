@@ -424,3 +424,64 @@ fn hold_anchored_keeps_the_sprung_bodies_where_the_computed_cycle_left_them() {
     let (_, default_jumps) = positions("hold-default", &text);
     assert_eq!(default_jumps, free_jumps);
 }
+
+/// `Loaded::settle_on`, the accelerated run of an opened scene that the Python binding drives: the table and
+/// the cycles of a request replace the scene's (the loaded sleeper without `[settlement]`, given the example's
+/// table, runs as the example does); a stop asked by the control callback leaves a checkpoint and the system at
+/// the cycle reached, and the scene opened afresh and resumed ends with the uninterrupted run's numbers; a
+/// scene without a table and no request's is refused naming the key.
+#[test]
+fn an_opened_scene_settles_with_a_request_stops_and_resumes() {
+    use ballast::engine::Engine;
+    use ballast::open::{open, Loaded, SettleRequest};
+    use ballast::scene::Scene;
+    use std::ops::ControlFlow;
+    let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
+    let go = &mut |_: &ballast::settlement::AccelerationProgress| ControlFlow::Continue(());
+    let steps = |l: &Loaded| match l {
+        Loaded::Nscd(o) => o.system.steps_done(),
+        _ => unreachable!("an NSCD scene"),
+    };
+    let cycles = Some(14);
+    let own = SettleRequest { settlement: None, cycles };
+    let whole = scratch::path("settle_on_whole");
+    let mut sim = open(SCENE.as_ref(), &opts).unwrap();
+    let s = sim.settle_on(&whole, &opts, &own, go).unwrap();
+    // 2 initial + 4 computed, a jump of 4, 4 computed: 10 computed cycles of 250 steps.
+    assert_eq!((s.total_cycles, s.computed_cycles, s.end.as_str()), (14, 10, "finished"));
+    assert_eq!(steps(&sim), s.steps);
+    let table = Scene::load(SCENE).unwrap().settlement;
+    let given = SettleRequest { settlement: table, cycles };
+    let plain = scratch::path("settle_on_given");
+    let mut other = open("examples/sleeper_load.toml".as_ref(), &opts).unwrap();
+    let t = other.settle_on(&plain, &opts, &given, go).unwrap();
+    assert_eq!(tables(&whole), tables(&plain));
+    assert_eq!((t.settlement_m, t.jumps), (s.settlement_m, s.jumps));
+    // Stopped after cycle 11 (past the jump, inside the second window), resumed by a fresh opening.
+    let cut = scratch::path("settle_on_cut");
+    let mut sim = open(SCENE.as_ref(), &opts).unwrap();
+    let mut stop = |p: &ballast::settlement::AccelerationProgress| {
+        if p.cycle == 11 {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    };
+    let first = sim.settle_on(&cut, &opts, &own, &mut stop).unwrap();
+    assert_eq!((first.end.as_str(), first.total_cycles), ("stopped", 11));
+    assert_eq!(steps(&sim), first.steps, "the system holds the cycle reached");
+    assert!(cut.join("checkpoint.json").is_file());
+    let resume = RunOptions { resume: true, ..opts.clone() };
+    let end = open(SCENE.as_ref(), &opts).unwrap().settle_on(&cut, &resume, &own, go).unwrap();
+    assert_eq!((end.settlement_m, end.total_cycles), (s.settlement_m, 14));
+    assert_eq!(tables(&whole), tables(&cut));
+    let e = open("examples/sleeper_load.toml".as_ref(), &opts)
+        .unwrap()
+        .settle_on(&scratch::path("settle_on_none"), &opts, &SettleRequest::default(), go)
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("settlement: the scene has no [settlement] table"), "{e}");
+    for dir in [whole, plain, cut] {
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}

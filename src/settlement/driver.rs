@@ -68,6 +68,7 @@ use jump::check_domain;
 use rollback::Landing;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -223,6 +224,24 @@ impl<E: Engine> Accelerated<E> {
         opts: &RunOptions,
         progress: &mut dyn FnMut(&AccelerationProgress),
     ) -> Result<AccelerationOutcome<E>> {
+        self.run_with(out, opts, &mut |p| {
+            progress(p);
+            ControlFlow::Continue(())
+        })
+    }
+
+    /// [`Accelerated::run`] with a `control` callback after each cycle that may stop the run: its
+    /// [`ControlFlow::Break`] stops it as `opts.stop_after` does (a checkpoint to resume from, `end`
+    /// `"stopped"`) unless the target is reached.
+    ///
+    /// # Errors
+    /// As [`Accelerated::run`].
+    pub fn run_with(
+        &self,
+        out: &Path,
+        opts: &RunOptions,
+        control: &mut dyn FnMut(&AccelerationProgress) -> ControlFlow<()>,
+    ) -> Result<AccelerationOutcome<E>> {
         self.check_run(opts)?;
         let (mut st, mut files) = if opts.resume { self.resume(out)? } else { self.start(out)? };
         st.sys.set_threads(opts.threads.max(1));
@@ -254,13 +273,13 @@ impl<E: Engine> Accelerated<E> {
                 end = "diverged";
                 break;
             }
-            progress(&AccelerationProgress {
+            let flow = control(&AccelerationProgress {
                 cycle: st.cycle,
                 target: self.target,
                 computed: st.computed,
                 settlement: st.last_settlement,
             });
-            let stop = opts.stop_after.is_some_and(|n| stepped >= n);
+            let stop = flow.is_break() || opts.stop_after.is_some_and(|n| stepped >= n);
             if st.cycle < self.target
                 && (stop
                     || (opts.checkpoint_every_s > 0.0
