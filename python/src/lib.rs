@@ -7,6 +7,7 @@
 
 mod errors;
 mod running;
+mod settle;
 mod simulation;
 
 use pyo3::prelude::*;

@@ -4,6 +4,7 @@
 
 use crate::errors::to_py;
 use crate::running::{to_python, OutFolder, Watch, LOOK_EVERY};
+use crate::settle::Asked;
 use ballast_core::engine::{BodyState, Engine, Spin, StepSummary};
 use ballast_core::open::Loaded;
 use ballast_core::run::{RunEnd, RunLength, RunOptions, Status};
@@ -204,16 +205,10 @@ impl Simulation {
             return Err(PyValueError::new_err("resume: needs the folder `out` of the run to continue"));
         }
         let folder = OutFolder::new(out);
-        let default_every = if folder.is_temporary() { 0.0 } else { RunOptions::default().checkpoint_every_s };
         let opts = RunOptions {
-            checkpoint_every_s: checkpoint_every.unwrap_or(default_every),
-            resume,
-            stop_after,
             vtk_every,
-            threads: threads.unwrap_or_else(ballast_core::run::default_threads),
-            figures,
             length: steps.map(RunLength::Steps),
-            engine: None,
+            ..options(&folder, checkpoint_every, resume, stop_after, figures, threads)
         };
         let mut watch = Watch::new(progress);
         let loaded = &mut self.loaded;
@@ -249,6 +244,74 @@ impl Simulation {
         d.set_item("out", folder.shown())?;
         d.set_item("report", to_python(py, &outcome.report)?)?;
         Ok(d)
+    }
+
+    /// Runs the settlement-acceleration procedure of Karrech et al. (2007, Fig. 10: cycles computed, the
+    /// settlement per body fitted to its law, extrapolated by a jump of cycles, the overlaps relaxed, repeated)
+    /// into the folder `out` (`settlement.csv`, `jumps.csv`, `summary.json`, checkpoints; `None`: a temporary
+    /// folder, removed on return) from the state the simulation holds, and keeps the state reached. The scene
+    /// must follow loading cycles (`[output] cycles`).
+    ///
+    /// `cycles`: the cycles to reach (`None`: those of the scene's duration). The scene's `[settlement]`
+    /// table, with in place of its keys: `accelerate = (k_i, k, h)` (cycles computed before the first fit,
+    /// computed per fit, extrapolated by the first jump), `law` (`"shenton"` or `"linear"`), `body` (the
+    /// settlement body's name; default the mean over the mobile bodies) and `settings` (a dict of any other
+    /// keys of the table, e.g. `{"relax_tolerance": 1e-5}`); a scene without a table needs `accelerate`.
+    /// `progress`: called with a dict (`cycle`, `target`, `computed`, `settlement` in m, positive downwards)
+    /// after the first cycle, then at most every 20 ms and after the last; returning `False` stops the run
+    /// (checkpoint, `end` `"stopped"`). `resume`, `checkpoint_every`, `stop_after` (steps), `figures`,
+    /// `threads`: as in `run`.
+    ///
+    /// Returns the run's summary (the contents of `summary.json`: `end`, `total_cycles`, `computed_cycles`,
+    /// `gained`, `jumps`, `settlement_m`, …) with `out` added. Ctrl-C stops the run at the end of the cycle in
+    /// progress, leaves a checkpoint and raises `KeyboardInterrupt`. A failed run raises (`DivergedError`, …)
+    /// and leaves the simulation as it was before the call.
+    #[pyo3(signature = (
+        cycles = None, accelerate = None, law = None, body = None, settings = None, out = None, progress = None,
+        resume = false, checkpoint_every = None, stop_after = None, figures = false, threads = None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn settle<'py>(
+        &mut self,
+        py: Python<'py>,
+        cycles: Option<u64>,
+        accelerate: Option<(u64, u64, u64)>,
+        law: Option<String>,
+        body: Option<String>,
+        settings: Option<Bound<'py, PyDict>>,
+        out: Option<PathBuf>,
+        progress: Option<Py<PyAny>>,
+        resume: bool,
+        checkpoint_every: Option<f64>,
+        stop_after: Option<u64>,
+        figures: bool,
+        threads: Option<usize>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if resume && out.is_none() {
+            return Err(PyValueError::new_err("resume: needs the folder `out` of the run to continue"));
+        }
+        let asked = Asked { accelerate, law, body, settings: settings.as_ref(), cycles };
+        let request = crate::settle::request(py, &self.loaded, asked)?;
+        let folder = OutFolder::new(out);
+        let opts = options(&folder, checkpoint_every, resume, stop_after, figures, threads);
+        let mut watch = Watch::new(progress);
+        let loaded = &mut self.loaded;
+        let summary = py.detach(|| {
+            loaded.settle_on(folder.path(), &opts, &request, &mut |p| {
+                watch.look(p.cycle >= p.target, |d| {
+                    d.set_item("cycle", p.cycle)?;
+                    d.set_item("target", p.target)?;
+                    d.set_item("computed", p.computed)?;
+                    d.set_item("settlement", p.settlement)
+                })
+            })
+        });
+        if let Some(e) = watch.failure {
+            return Err(e);
+        }
+        let summary = to_python(py, &summary.map_err(to_py)?)?;
+        summary.set_item("out", folder.shown())?;
+        Ok(summary)
     }
 
     /// The bodies' names, in scene order.
@@ -350,6 +413,27 @@ impl Simulation {
         let engine = self.engine();
         let (n, t) = with_system!(&mut self.loaded, s => (s.body_count(), s.time()));
         format!("<ballast.Simulation {engine}: {n} bodies, t = {t} s>")
+    }
+}
+
+/// The run options of `run` and `settle` into `folder` (checkpoints every 300 s by default, none into a
+/// temporary folder).
+fn options(
+    folder: &OutFolder,
+    checkpoint_every: Option<f64>,
+    resume: bool,
+    stop_after: Option<u64>,
+    figures: bool,
+    threads: Option<usize>,
+) -> RunOptions {
+    let default_every = if folder.is_temporary() { 0.0 } else { RunOptions::default().checkpoint_every_s };
+    RunOptions {
+        checkpoint_every_s: checkpoint_every.unwrap_or(default_every),
+        resume,
+        stop_after,
+        threads: threads.unwrap_or_else(ballast_core::run::default_threads),
+        figures,
+        ..RunOptions::default()
     }
 }
 
