@@ -66,5 +66,6 @@ pub fn settle_accelerated_replicas(
     });
     let seating = replicas.seating_cycles.min(loading.cycles);
     let read = |path: &Path| io::read_csv::<SettlementRow>(path);
-    finish_replicas(out, results, "settlement.csv", read, seating, "Settlement of the sleeper, accelerated")
+    let failures = super::saussine::failures(results)?;
+    finish_replicas(out, &failures, "settlement.csv", read, seating, "Settlement of the sleeper, accelerated")
 }

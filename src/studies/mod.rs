@@ -46,6 +46,7 @@ mod display;
 pub mod karrech;
 pub mod luding;
 pub mod md_stage;
+pub mod replica_tasks;
 pub mod replicas;
 pub mod saussine;
 

@@ -159,14 +159,15 @@ pub fn settle(
 ) -> Result<RunOutcome> {
     let (scene, spec) = loaded(sample, loading)?;
     let path = write_start(sample, scene, start, out, opts.resume, false, "")?;
-    run_settle(&path, out, &spec, opts, default_threads(), opts.resume, display, "settle")
+    let per_cycle = steps_per_cycle(spec.frequency, spec.dt);
+    run_settle(&path, out, per_cycle, opts, default_threads(), opts.resume, display, "settle")
 }
 
 /// Writes the loaded `scene` of `sample` as `out/loaded.toml` from `start`,
 /// unless `resume` keeps the one there; `what` is added to the file's note. A
 /// perturbed start, or any start of an ensemble (`in_ensemble`, replica 0
 /// too), is named in the note and recorded as [`REPLICA_FILE`]. Its path.
-fn write_start(
+pub(crate) fn write_start(
     sample: &Path,
     mut scene: Scene,
     start: &Start,
@@ -240,19 +241,24 @@ pub fn settle_accelerated(
     accelerate.run_scene(&path, out, &run, progress)
 }
 
-/// Runs the loaded scene at `path` into `out` as [`settle`] does.
+/// Steps of a loading cycle at `frequency` (Hz) with the time step `dt` (s), at least 1.
+pub(crate) fn steps_per_cycle(frequency: f64, dt: f64) -> u64 {
+    (1.0 / (frequency * dt)).round().max(1.0) as u64
+}
+
+/// Runs the loaded scene at `path` into `out` as [`settle`] does (`steps_per_cycle`: of its loading, for the
+/// snapshots' period).
 #[allow(clippy::too_many_arguments)]
-fn run_settle(
+pub(crate) fn run_settle(
     path: &Path,
     out: &Path,
-    spec: &LoadingSpec,
+    steps_per_cycle: u64,
     opts: &SettleOptions,
     threads: usize,
     resume: bool,
     display: &dyn RunDisplay,
     label: &str,
 ) -> Result<RunOutcome> {
-    let steps_per_cycle = (1.0 / (spec.frequency * spec.dt)).round().max(1.0) as u64;
     let run = RunOptions {
         checkpoint_every_s: opts.checkpoint_every_s,
         resume,
@@ -314,40 +320,37 @@ pub fn settle_replicas(
     crate::io::figures::require()?; // the runs end with their figures
     replicas.check()?;
     let threads = replica_jobs(jobs, replicas.count)?;
-    let (scene, spec) = loaded(sample, loading)?;
-    io::create_output_dir(&out.join("runs"))?;
+    let (scene, _) = loaded(sample, loading)?;
     // Every replica's scene first, so that an invalid one stops before any run.
-    let mut priors = Vec::new();
-    for r in 0..replicas.count {
-        let dir = replica_dir(out, r);
-        let prior = Prior::of(&dir, layout::SUMMARY, opts.resume);
-        let start = Start { replica: r, perturbation: replicas.perturbation };
-        write_start(sample, scene.clone(), &start, &dir, prior != Prior::Nothing, true, "")?;
-        priors.push(prior);
-    }
+    let tasks = super::replica_tasks::write_starts(&scene, sample, out, replicas, opts.resume)?;
     let pool = super::campaigns::pool(threads)?;
     let results: Vec<Result<()>> = pool.install(|| {
         use rayon::prelude::*;
         (0..replicas.count)
             .into_par_iter()
             .map(|r| {
-                let dir = replica_dir(out, r);
-                match priors[r as usize] {
-                    Prior::Finished => Ok(()),
-                    prior => {
-                        let threads = super::campaigns::run_threads(threads);
-                        let resume = prior == Prior::Checkpointed;
-                        let label = format!("replica-{r}");
-                        run_settle(&dir.join("loaded.toml"), &dir, &spec, opts, threads, resume, display, &label)
-                            .map(|_| ())
-                    }
-                }
+                let threads = super::campaigns::run_threads(threads);
+                super::replica_tasks::run_replica(out, r, opts, threads, display)
             })
             .collect()
     });
-    let seating = replicas.seating_cycles.min(loading.cycles);
-    let read = |path: &Path| crate::plane::rows::read_cycles(path).map_err(output_error);
-    finish_replicas(out, results, layout::CYCLES, read, seating, "Settlement of the sleeper")
+    super::replica_tasks::finish(out, &failures(results)?, tasks.seating)
+}
+
+/// The failure of each replica of `results` (`None`: it ran), or the first input error ([`Error::is_input`]:
+/// an invalid scene or checkpoint, which stops the study).
+///
+/// # Errors
+/// That input error.
+pub(crate) fn failures(results: Vec<Result<()>>) -> Result<Vec<Option<String>>> {
+    results
+        .into_iter()
+        .map(|r| match r {
+            Ok(()) => Ok(None),
+            Err(e) if e.is_input() => Err(e),
+            Err(e) => Ok(Some(e.one_line())),
+        })
+        .collect()
 }
 
 /// The runs of a replica study at once: `jobs` (`None`: one per core), at most
@@ -362,16 +365,15 @@ pub(crate) fn replica_jobs(jobs: Option<usize>, count: u64) -> Result<usize> {
     }
 }
 
-/// The end of a replica study in `out`: the failed replicas of `results` (one
-/// per replica; an input error, [`Error::is_input`], is returned as it is), each replica's table
-/// `file` read by `read` (empty when absent), `OUT/settlement_ensemble.csv`
-/// with the seating cycle `seating` and its figure titled `title`.
+/// The end of a replica study in `out`: the failures of its replicas (`failures[r]`: the one-line error of
+/// replica `r`, `None` if it ran), each replica's table `file` read by `read` (empty when absent),
+/// `OUT/settlement_ensemble.csv` with the seating cycle `seating` and its figure titled `title`.
 ///
 /// # Errors
-/// A replica's input error ([`Error::is_input`]); a table that cannot be read or written.
+/// A table that cannot be read or written.
 pub(crate) fn finish_replicas<T: CycleSettlement>(
     out: &Path,
-    results: Vec<Result<()>>,
+    failures: &[Option<String>],
     file: &str,
     read: impl Fn(&Path) -> Result<Vec<T>>,
     seating: u64,
@@ -379,11 +381,9 @@ pub(crate) fn finish_replicas<T: CycleSettlement>(
 ) -> Result<SettleReplicas> {
     let mut failed = Vec::new();
     let mut tables = Vec::new();
-    for (r, result) in results.into_iter().enumerate() {
-        match result {
-            Ok(()) => {}
-            Err(e) if e.is_input() => return Err(e),
-            Err(e) => failed.push((format!("replica-{r}"), e.one_line())),
+    for (r, failure) in failures.iter().enumerate() {
+        if let Some(e) = failure {
+            failed.push((format!("replica-{r}"), e.clone()));
         }
         let path = replica_dir(out, r as u64).join(file);
         tables.push(if path.exists() { read(&path)? } else { vec![] });
