@@ -1,4 +1,4 @@
-//! The Python module `ballast`: scene files opened on their engine ([`load`], [`from_toml`]) as a
+//! The extension module of the Python package `ballast` (`ballast._ballast`): scene files opened on their engine ([`load`], [`from_toml`]) as a
 //! [`Simulation`] that steps and exposes its state as numpy arrays, and the library's errors as Python
 //! exceptions ([`errors`]). SI units throughout (m, s, kg, rad, N).
 //!
@@ -6,6 +6,7 @@
 //! the interpreter's lock released.
 
 mod errors;
+mod experiments;
 mod running;
 mod settle;
 mod simulation;
@@ -32,12 +33,24 @@ fn from_toml(text: String, engine: Option<String>, name: &str) -> PyResult<Simul
     Simulation::open(|opts| ballast_core::open::open_text(text, name.as_ref(), opts), engine)
 }
 
-/// The module.
+/// The extension module `ballast._ballast`, which the package `ballast` (python/ballast/) re-exports and builds
+/// its experiment modules and ensembles on.
 #[pymodule]
-fn ballast(m: &Bound<'_, PyModule>) -> PyResult<()> {
+fn _ballast(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(from_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(experiments::table, m)?)?;
+    m.add("DEFAULT_PERTURBATION_M", ballast_core::studies::replicas::DEFAULT_PERTURBATION_M)?;
+    m.add("DEFAULT_PERTURB_SEED", ballast_core::studies::replicas::DEFAULT_PERTURB_SEED)?;
+    m.add("DEFAULT_SEATING_CYCLES", ballast_core::studies::replicas::DEFAULT_SEATING_CYCLES)?;
+    m.add_function(wrap_pyfunction!(experiments::saussine_sample, m)?)?;
+    m.add_function(wrap_pyfunction!(experiments::saussine_loaded, m)?)?;
+    m.add_function(wrap_pyfunction!(experiments::karrech_deposit, m)?)?;
+    m.add_function(wrap_pyfunction!(experiments::luding_box, m)?)?;
+    m.add_function(wrap_pyfunction!(experiments::replica_starts, m)?)?;
+    m.add_function(wrap_pyfunction!(experiments::replica_run, m)?)?;
+    m.add_function(wrap_pyfunction!(experiments::replica_finish, m)?)?;
     m.add_class::<Simulation>()?;
     errors::register(m)?;
     Ok(())

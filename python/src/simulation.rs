@@ -8,6 +8,7 @@ use crate::settle::Asked;
 use ballast_core::engine::{BodyState, Engine, Spin, StepSummary};
 use ballast_core::open::Loaded;
 use ballast_core::run::{RunEnd, RunLength, RunOptions, Status};
+use ballast_core::scene::SceneFile;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -407,6 +408,18 @@ impl Simulation {
         d.set_item("normal_forces", PyArray1::from_vec(py, rows.iter().map(|r| r.f_n).collect()))?;
         d.set_item("tangential_forces", PyArray1::from_vec(py, tangential).reshape([m, dim])?)?;
         Ok(d)
+    }
+
+    /// The state the simulation holds as a scene (TOML text): its scene with the bodies where they are now,
+    /// at rest or moving as they are (NSCD, 3D MD; the planar MD engine writes positions and velocities), to
+    /// save, edit, or open again with `from_toml` (its time restarts at 0).
+    fn to_toml(&self) -> PyResult<String> {
+        let text = match &self.loaded {
+            Loaded::Nscd(o) => o.scene.with_state(&o.system).to_toml_string(),
+            Loaded::PlanarMd(o, _) => o.scene.with_bodies(&o.system.bodies).to_toml_string(),
+            Loaded::Md(o) => o.scene.with_state(&o.system).to_toml_string(),
+        };
+        text.map_err(to_py)
     }
 
     fn __repr__(&mut self) -> String {

@@ -1,0 +1,117 @@
+"""The papers' experiments from Python against the command line: a Saussine sample deposited from Python is
+the CLI's byte for byte, its loaded scene runs the CLI's cycles, and an ensemble of replicas gives the summary
+of `ballast saussine settle --replicas` byte for byte through a local process pool and through a Dask
+`LocalCluster`; the Karrech deposit and the Luding box open and step; bad loading arguments name the key."""
+
+import subprocess
+
+import numpy as np
+import pytest
+
+import ballast
+from test_simulation import cli
+
+SHORT = {"cycles": 4, "dt": 1e-3, "bars": 0}
+SHORT_FLAGS = ["--cycles", "4", "--dt", "1e-3", "--bars", "0"]
+
+
+@pytest.fixture(scope="module")
+def sample(tmp_path_factory):
+    """A 50-grain sample deposited from Python, and the same deposited by the command line."""
+    root = tmp_path_factory.mktemp("sample")
+    sim = ballast.saussine.sample(root / "py", grains=50, dt=5e-4)
+    args = [cli(), "saussine", "sample", "--grains", "50", "--dt", "5e-4", "--out", str(root / "cli"), "--quiet"]
+    subprocess.run(args, check=True, capture_output=True)
+    return root, sim
+
+
+def test_a_sample_deposited_from_python_is_the_command_lines(sample):
+    root, sim = sample
+    for name in ("sample.toml", "sample.json"):
+        assert (root / "py" / name).read_bytes() == (root / "cli" / name).read_bytes(), name
+    assert sim.engine == "nscd" and len(sim.names) == sim.positions.shape[0]
+
+
+def test_the_loaded_sample_runs_the_command_lines_cycles(sample, tmp_path):
+    root, sim = sample
+    args = [cli(), "saussine", "settle", "--sample", str(root / "cli" / "sample.toml"), *SHORT_FLAGS]
+    subprocess.run([*args, "--out", str(tmp_path / "cli"), "--quiet"], check=True, capture_output=True)
+    # The sample as a path, and as the Simulation that holds it: the same loaded scene.
+    loaded = ballast.saussine.load(root / "py" / "sample.toml", **SHORT)
+    assert loaded.to_toml() == ballast.saussine.load(sim, **SHORT).to_toml()
+    result = loaded.run(tmp_path / "py")
+    assert result["status"] == "finished"
+    assert (tmp_path / "py" / "cycles.csv").read_bytes() == (tmp_path / "cli" / "cycles.csv").read_bytes()
+    cycles = ballast.table(tmp_path / "py" / "cycles.csv")
+    assert cycles["cycle"].dtype == np.int64 and list(cycles["cycle"]) == [1, 2, 3, 4]
+    assert cycles["settlement_mean_m"].dtype == np.float64 and np.isfinite(cycles["settlement_mean_m"]).all()
+
+
+@pytest.fixture(scope="module")
+def reference(sample, tmp_path_factory):
+    """`ballast saussine settle --replicas 4` on the CLI's sample (the same bytes as the Python one)."""
+    root, _ = sample
+    out = tmp_path_factory.mktemp("cli-replicas")
+    args = [cli(), "saussine", "settle", "--sample", str(root / "cli" / "sample.toml"), *SHORT_FLAGS]
+    subprocess.run([*args, "--replicas", "4", "--out", str(out), "--quiet"], check=True, capture_output=True)
+    return out / "settlement_ensemble.csv"
+
+
+def test_an_ensemble_on_a_process_pool_is_the_command_lines(sample, reference, tmp_path):
+    root, _ = sample
+    result = ballast.ensemble(root / "cli" / "sample.toml", replicas=4, out=tmp_path / "pool", **SHORT)
+    assert result["failed"] == []
+    assert (tmp_path / "pool" / "settlement_ensemble.csv").read_bytes() == reference.read_bytes()
+    table = result["table"]
+    assert list(table["replicas"]) == [4] * 4 and table["settlement_mean_m"].shape == (4,)
+
+
+def test_an_ensemble_on_a_dask_cluster_is_the_command_lines(sample, reference, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    root, _ = sample
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as client:
+            result = ballast.ensemble(
+                root / "cli" / "sample.toml", replicas=4, out=tmp_path / "dask", executor=client, **SHORT
+            )
+    assert result["failed"] == []
+    assert (tmp_path / "dask" / "settlement_ensemble.csv").read_bytes() == reference.read_bytes()
+
+
+def test_settings_are_replicated_each_in_its_folder(sample, tmp_path):
+    root, _ = sample
+    from concurrent.futures import ThreadPoolExecutor
+
+    settings = [{"name": "soft"}, {"name": "stiff", "stiffness_factor": 100.0}]
+    with ThreadPoolExecutor(2) as pool:
+        results = ballast.ensemble(
+            root / "cli" / "sample.toml", replicas=2, settings=settings, out=tmp_path, executor=pool, **SHORT
+        )
+    assert set(results) == {"soft", "stiff"}
+    for name in ("soft", "stiff"):
+        assert (tmp_path / name / "runs" / "replica-1" / "cycles.csv").is_file()
+    soft, stiff = (results[n]["table"]["settlement_mean_m"] for n in ("soft", "stiff"))
+    # A sublayer 100 times stiffer: the sleeper settles less (Saussine §4.2, Fig. 12).
+    assert stiff[-1] < soft[-1]
+
+
+def test_bad_loading_arguments_name_the_key(sample):
+    root, _ = sample
+    with pytest.raises(ballast.SceneError) as e:
+        ballast.saussine.load(root / "cli" / "sample.toml", cycles=4, stiffnes_factor=100.0)
+    assert e.value.key == "stiffnes_factor"
+    with pytest.raises(ballast.SceneError) as e:
+        ballast.saussine.load(root / "cli" / "sample.toml", guide="sideways")
+    assert e.value.key == "guide"
+    with pytest.raises(ValueError, match="out: the replicas"):
+        ballast.ensemble(root / "cli" / "sample.toml", replicas=2)
+
+
+def test_the_karrech_deposit_and_the_luding_box_open_and_step(tmp_path):
+    sim = ballast.karrech.deposit(tmp_path / "karrech", spheres=20, dt=1e-6, duration=2e-3, every=100)
+    assert sim.engine == "md" and sim.positions.shape[1] == 3
+    assert (tmp_path / "karrech" / "final.json").is_file()
+    box = ballast.luding.box(spheres=27, duration=1e-3, every=10)
+    assert box.engine == "md"
+    box.step(5)
+    assert np.isfinite(box.positions).all()
