@@ -141,3 +141,13 @@ def replica_finish(out: str, failures: list[Optional[str]], seating: int) -> tup
 DEFAULT_PERTURBATION_M: float
 DEFAULT_PERTURB_SEED: int
 DEFAULT_SEATING_CYCLES: int
+def saussine_convergence(
+    sample: str, out: str, policies: list[tuple[str, float]], reference: Optional[tuple[str, float]],
+    replicas: tuple[int, float, int, int], jobs: Optional[int], resume: bool, checkpoint_every: float,
+    loading: Optional[dict[str, Any]] = None,
+) -> tuple[str, list[tuple[str, str]]]: ...
+def compare(
+    sample: str, out: str, overlaps: list[float], model: str, dt_fraction: Optional[float],
+    replicas: tuple[int, float, int, int], jobs: Optional[int], resume: bool, checkpoint_every: float,
+    loading: Optional[dict[str, Any]] = None,
+) -> tuple[str, list[tuple[str, str]]]: ...

@@ -11,14 +11,27 @@ width and load scaled alike (the same pressure).
 """
 
 import os
-from typing import Any, Dict, Optional, Union
+from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 from . import _ballast
 from ._ballast import Simulation
 from ._ensemble import ensemble
 from ._sample import Sample, text_of
+from ._table import table
 
-__all__ = ["sample", "load", "settle"]
+__all__ = ["sample", "load", "settle", "convergence", "compare", "PAPER_POLICIES"]
+
+#: The convergence policies and tolerances of the table of §3.2.
+PAPER_POLICIES = [
+    ("energy", 1.66e-3),
+    ("energy", 1.66e-4),
+    ("energy", 1.66e-5),
+    ("strict", 1e-3),
+    ("strict", 1e-4),
+    ("quad", 1e-5),
+    ("quad", 1e-6),
+    ("quad", 1e-7),
+]
 
 
 def sample(
@@ -77,3 +90,78 @@ def settle(
         cycles=cycles,
         **loading,
     )
+
+
+def _sample_path(sample: Sample, out: Union[str, "os.PathLike[str]"]) -> str:
+    """The path of ``sample``'s scene file: a Simulation's state is written to ``out/sample.toml``."""
+    if isinstance(sample, Simulation):
+        os.makedirs(out, exist_ok=True)
+        path = os.path.join(os.fspath(out), "sample.toml")
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(sample.to_toml())
+        return path
+    return os.fspath(sample)
+
+
+def _study_result(path: str, failed: Any, out: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
+    return {"table": table(path), "path": path, "failed": failed, "out": os.fspath(out)}
+
+
+def convergence(
+    sample: Sample,
+    out: Union[str, "os.PathLike[str]"],
+    policies: Optional[Sequence[Tuple[str, float]]] = None,
+    reference: Optional[Tuple[str, float]] = None,
+    replicas: int = 1,
+    perturbation: float = _ballast.DEFAULT_PERTURBATION_M,
+    perturbation_seed: int = _ballast.DEFAULT_PERTURB_SEED,
+    seating_cycles: int = _ballast.DEFAULT_SEATING_CYCLES,
+    jobs: Optional[int] = None,
+    resume: bool = False,
+    checkpoint_every: float = 300.0,
+    cycles: int = 100,
+    **loading: Any,
+) -> Dict[str, Any]:
+    """§3.2 (``ballast saussine convergence``): the loaded sample under each ``(policy, tolerance)`` of
+    ``policies`` (``None``: the paper's table, ``PAPER_POLICIES``), ``replicas`` runs each, ``jobs`` at a time
+    on this machine, compared with ``reference`` (``None``: the tightest ``strict`` run). Writes
+    ``out/convergence.csv`` and the figures (cumulated interpenetration, iterations against tolerance, the
+    settlement ensembles). Returns ``table`` (``convergence.csv`` as ``ballast.table`` reads it), ``path``,
+    ``failed`` and ``out``."""
+    path = _sample_path(sample, out)
+    reps = (replicas, perturbation, perturbation_seed, seating_cycles)
+    args = {"cycles": cycles, **loading}
+    done, failed = _ballast.saussine_convergence(
+        path, os.fspath(out), list(policies or []), reference, reps, jobs, resume, checkpoint_every, args
+    )
+    return _study_result(done, failed, out)
+
+
+def compare(
+    sample: Sample,
+    out: Union[str, "os.PathLike[str]"],
+    overlaps: Sequence[float] = (1e-2, 1e-3, 1e-4),
+    model: str = "linear",
+    dt_fraction: Optional[float] = None,
+    replicas: int = 1,
+    perturbation: float = _ballast.DEFAULT_PERTURBATION_M,
+    perturbation_seed: int = _ballast.DEFAULT_PERTURB_SEED,
+    seating_cycles: int = _ballast.DEFAULT_SEATING_CYCLES,
+    jobs: Optional[int] = None,
+    resume: bool = False,
+    checkpoint_every: float = 300.0,
+    cycles: int = 100,
+    **loading: Any,
+) -> Dict[str, Any]:
+    """``ballast compare``: the loaded sample (or a loaded 2D scene with a followed body) on NSCD and on the
+    planar MD engine at each ``[soft] max_overlap_ratio`` of ``overlaps`` (contact ``model`` ``linear`` or
+    ``hertz``), ``replicas`` runs each, ``jobs`` at a time. Writes ``out/compare.csv`` (one row per run and
+    cycle: settlement, overlaps, coordination, wall time) and its figure. Returns ``table``, ``path``,
+    ``failed`` and ``out``."""
+    path = _sample_path(sample, out)
+    reps = (replicas, perturbation, perturbation_seed, seating_cycles)
+    args = {"cycles": cycles, **loading}
+    done, failed = _ballast.compare(
+        path, os.fspath(out), list(overlaps), model, dt_fraction, reps, jobs, resume, checkpoint_every, args
+    )
+    return _study_result(done, failed, out)

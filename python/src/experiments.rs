@@ -7,6 +7,8 @@
 use crate::errors::to_py;
 use ballast_core::scenarios::saussine::{loaded_scene, Guide, LoadingSpec, SampleSpec};
 use ballast_core::scene::{Scene, SceneFile};
+use ballast_core::studies::campaigns::{convergence, ConvergenceSpec, StudyOptions};
+use ballast_core::studies::compare::CompareSpec;
 use ballast_core::studies::replicas::{Perturbation, Replicas};
 use ballast_core::studies::saussine::SettleOptions;
 use ballast_core::studies::{replica_tasks, Quiet};
@@ -265,4 +267,76 @@ pub fn table<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>
         }
     }
     Ok(d)
+}
+
+/// The replicas of a study's settings.
+fn replicas(count: u64, perturbation: f64, seed: u64, seating_cycles: u64) -> Replicas {
+    Replicas { count, perturbation: Perturbation { distance_m: perturbation, seed }, seating_cycles }
+}
+
+/// The options of a study run into `out` on the local pool.
+fn study(out: PathBuf, jobs: Option<usize>, resume: bool, checkpoint_every: f64) -> StudyOptions {
+    StudyOptions { out, jobs, resume, checkpoint_every_s: checkpoint_every }
+}
+
+/// Saussine §3.2 (`ballast saussine convergence`) into `out`; the path of `convergence.csv` and the failed
+/// runs as `(label, error)`.
+#[pyfunction]
+#[pyo3(signature = (sample, out, policies, reference, replicas, jobs, resume, checkpoint_every, loading = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn saussine_convergence(
+    py: Python<'_>,
+    sample: PathBuf,
+    out: PathBuf,
+    policies: Vec<(String, f64)>,
+    reference: Option<(String, f64)>,
+    replicas: (u64, f64, u64, u64),
+    jobs: Option<usize>,
+    resume: bool,
+    checkpoint_every: f64,
+    loading: Option<Bound<'_, PyDict>>,
+) -> PyResult<(String, Vec<(String, String)>)> {
+    let (count, distance, seed, seating) = replicas;
+    let spec = ConvergenceSpec {
+        sample,
+        policies,
+        reference,
+        replicas: self::replicas(count, distance, seed, seating),
+        loading: self::loading(py, loading.as_ref())?,
+    };
+    let study = study(out, jobs, resume, checkpoint_every);
+    let report = py.detach(|| convergence(&spec, &study, &Quiet)).map_err(to_py)?;
+    Ok((report.table.path.display().to_string(), report.failed))
+}
+
+/// `ballast compare` (the loaded sample on NSCD and on planar MD at each overlap ratio) into `out`; the path of
+/// `compare.csv` and the failed runs as `(label, error)`.
+#[pyfunction]
+#[pyo3(signature = (sample, out, overlaps, model, dt_fraction, replicas, jobs, resume, checkpoint_every, loading = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn compare(
+    py: Python<'_>,
+    sample: PathBuf,
+    out: PathBuf,
+    overlaps: Vec<f64>,
+    model: String,
+    dt_fraction: Option<f64>,
+    replicas: (u64, f64, u64, u64),
+    jobs: Option<usize>,
+    resume: bool,
+    checkpoint_every: f64,
+    loading: Option<Bound<'_, PyDict>>,
+) -> PyResult<(String, Vec<(String, String)>)> {
+    let (count, distance, seed, seating) = replicas;
+    let spec = CompareSpec {
+        sample,
+        overlaps,
+        model,
+        dt_fraction,
+        replicas: self::replicas(count, distance, seed, seating),
+        loading: self::loading(py, loading.as_ref())?,
+    };
+    let study = study(out, jobs, resume, checkpoint_every);
+    let report = py.detach(|| ballast_core::studies::compare::compare(&spec, &study, &Quiet)).map_err(to_py)?;
+    Ok((report.study.table.path.display().to_string(), report.study.failed))
 }

@@ -51,6 +51,8 @@ fn _ballast(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(experiments::replica_starts, m)?)?;
     m.add_function(wrap_pyfunction!(experiments::replica_run, m)?)?;
     m.add_function(wrap_pyfunction!(experiments::replica_finish, m)?)?;
+    m.add_function(wrap_pyfunction!(experiments::saussine_convergence, m)?)?;
+    m.add_function(wrap_pyfunction!(experiments::compare, m)?)?;
     m.add_class::<Simulation>()?;
     errors::register(m)?;
     Ok(())

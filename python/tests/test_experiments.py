@@ -115,3 +115,30 @@ def test_the_karrech_deposit_and_the_luding_box_open_and_step(tmp_path):
     assert box.engine == "md"
     box.step(5)
     assert np.isfinite(box.positions).all()
+
+
+def strip_wall_times(path):
+    """A CSV's text without the columns of wall-clock time (the one thing two runs of a study differ in)."""
+    lines = path.read_text().splitlines()
+    keep = [i for i, name in enumerate(lines[0].split(",")) if "wall" not in name]
+    return [[line.split(",")[i] for i in keep] for line in lines]
+
+
+def test_the_convergence_and_compare_studies_are_the_command_lines(sample, tmp_path):
+    root, sim = sample
+    path = str(root / "cli" / "sample.toml")
+    flags = ["--cycles", "2", "--dt", "1e-3", "--bars", "0", "--quiet"]
+    policies = [("energy", 1.66e-3), ("strict", 1e-3)]
+    cli_conv = tmp_path / "cli-conv"
+    args = [cli(), "saussine", "convergence", "--sample", path, "--policies", "energy:1.66e-3,strict:1e-3"]
+    subprocess.run([*args, *flags, "--out", str(cli_conv)], check=True, capture_output=True)
+    # The sample as the Simulation that holds it (written to the study's folder).
+    conv = ballast.saussine.convergence(sim, tmp_path / "py-conv", policies=policies, cycles=2, dt=1e-3, bars=0)
+    assert conv["failed"] == [] and list(conv["table"]["policy"]) == ["energy", "strict"]
+    assert strip_wall_times(tmp_path / "py-conv" / "convergence.csv") == strip_wall_times(cli_conv / "convergence.csv")
+    cli_cmp = tmp_path / "cli-cmp"
+    args = [cli(), "compare", "--sample", path, "--overlaps", "1e-2"]
+    subprocess.run([*args, *flags, "--out", str(cli_cmp)], check=True, capture_output=True)
+    cmp = ballast.saussine.compare(path, tmp_path / "py-cmp", overlaps=[1e-2], cycles=2, dt=1e-3, bars=0)
+    assert cmp["failed"] == [] and set(cmp["table"]["engine"]) == {"nscd", "md2d"}
+    assert strip_wall_times(tmp_path / "py-cmp" / "compare.csv") == strip_wall_times(cli_cmp / "compare.csv")
