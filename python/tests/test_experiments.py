@@ -142,3 +142,22 @@ def test_the_convergence_and_compare_studies_are_the_command_lines(sample, tmp_p
     cmp = ballast.saussine.compare(path, tmp_path / "py-cmp", overlaps=[1e-2], cycles=2, dt=1e-3, bars=0)
     assert cmp["failed"] == [] and set(cmp["table"]["engine"]) == {"nscd", "md2d"}
     assert strip_wall_times(tmp_path / "py-cmp" / "compare.csv") == strip_wall_times(cli_cmp / "compare.csv")
+
+
+def test_an_ensemble_of_a_cyclic_scene_replicates_it_as_it_is(tmp_path):
+    """A loaded scene (it has [output] cycles) is replicated as it is: replica 0 runs the scene's own cycles,
+    as `ballast run` does; loading arguments are refused for it."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from test_simulation import ROOT
+
+    scene = ROOT / "tests" / "data" / "loaded50.toml"
+    subprocess.run([cli(), "run", str(scene), "--out", str(tmp_path / "cli"), "--quiet"], check=True, capture_output=True)
+    with ThreadPoolExecutor(2) as pool:
+        result = ballast.ensemble(scene, replicas=2, out=tmp_path / "ens", executor=pool, seating_cycles=1)
+    assert result["failed"] == [] and list(result["table"]["cycle"]) == [1, 2]
+    replica0 = tmp_path / "ens" / "runs" / "replica-0" / "cycles.csv"
+    assert replica0.read_bytes() == (tmp_path / "cli" / "cycles.csv").read_bytes()
+    with pytest.raises(ballast.SceneError) as e:
+        ballast.ensemble(scene, replicas=2, out=tmp_path / "bad", cycles=3)
+    assert e.value.key == "loading"
