@@ -50,9 +50,9 @@ def ensemble(
     Results are written as ``ballast saussine settle --replicas`` writes them: with ``settings=None`` into
     ``out`` (``out/runs/replica-<r>/``, ``out/settlement_ensemble.csv`` and its figure), else into
     ``out/<name>/`` per setting. ``executor``: any object with ``submit`` returning futures with ``result()``
-    (tested: ``concurrent.futures`` process and thread pools, a Dask ``Client``; mpi4py's ``MPIPoolExecutor``
-    and submitit's executors have that interface, untried); ``None``: a local process pool, one process per
-    core. Each run
+    (tested: ``concurrent.futures`` process and thread pools, a Dask ``Client``, mpi4py's ``MPIPoolExecutor``;
+    submitit's executors have that interface, untried); ``None``: a local process pool, one process per core.
+    Each run
     steps on ``threads`` threads (the numbers do not depend on them) and checkpoints every ``checkpoint_every``
     s; ``resume`` skips the finished replicas and resumes the checkpointed ones.
 

@@ -161,3 +161,31 @@ def test_an_ensemble_of_a_cyclic_scene_replicates_it_as_it_is(tmp_path):
     with pytest.raises(ballast.SceneError) as e:
         ballast.ensemble(scene, replicas=2, out=tmp_path / "bad", cycles=3)
     assert e.value.key == "loading"
+
+
+def test_an_ensemble_on_mpi4pys_pool_is_the_command_lines(sample, reference, tmp_path):
+    """mpi4py's `MPIPoolExecutor` under `mpiexec -n 3 python -m mpi4py.futures` (a manager and two workers)."""
+    import os
+    import shutil
+    import sys
+
+    pytest.importorskip("mpi4py")
+    mpiexec = shutil.which("mpiexec")
+    if mpiexec is None:
+        pytest.skip("no mpiexec")
+    root, _ = sample
+    script = tmp_path / "ensemble.py"
+    script.write_text(
+        "import ballast\nfrom mpi4py.futures import MPIPoolExecutor\n"
+        "if __name__ == '__main__':\n"
+        "    with MPIPoolExecutor() as ex:\n"
+        f"        r = ballast.ensemble({str(root / 'cli' / 'sample.toml')!r}, replicas=4, out={str(tmp_path / 'mpi')!r},"
+        " executor=ex, cycles=4, dt=1e-3, bars=0)\n"
+        "    assert r['failed'] == [], r['failed']\n"
+    )
+    # OpenMPI refuses root unless told (CI runs as root); more ranks than cores on a 2-core machine.
+    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"}
+    args = [mpiexec, "--oversubscribe", "-n", "3", sys.executable, "-m", "mpi4py.futures", str(script)]
+    done = subprocess.run(args, env=env, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert (tmp_path / "mpi" / "settlement_ensemble.csv").read_bytes() == reference.read_bytes()
