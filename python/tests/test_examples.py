@@ -48,3 +48,13 @@ def test_the_readme_api_block_runs(tmp_path):
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "out" / "run" / "final.json").is_file()
     assert (tmp_path / "out" / "settle" / "settlement.csv").is_file()
+
+
+def test_the_readme_first_python_line_runs():
+    """The `python -c` line after `pip install ./python` in README's "Use from Python", from the repository's
+    root as a new user runs it."""
+    readme = (ROOT / "README.md").read_text()
+    line = re.search(r'^python -c "(.*)"$', readme.split("## Use from Python")[1], re.M).group(1)
+    done = subprocess.run([sys.executable, "-c", line], cwd=ROOT, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "(727, 3)"

@@ -189,3 +189,15 @@ def test_an_ensemble_on_mpi4pys_pool_is_the_command_lines(sample, reference, tmp
     done = subprocess.run(args, env=env, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout + done.stderr
     assert (tmp_path / "mpi" / "settlement_ensemble.csv").read_bytes() == reference.read_bytes()
+
+
+def test_a_table_reads_as_numpy_columns_or_a_pandas_frame(tmp_path):
+    path = tmp_path / "t.csv"
+    path.write_text("cycle,settlement_m,accrued_m,engine\n1,0.5,,nscd\n2,0.25,1e-3,md2d\n")
+    t = ballast.table(path)
+    assert list(t) == ["cycle", "settlement_m", "accrued_m", "engine"]
+    assert t["cycle"].dtype == np.int64 and t["settlement_m"].dtype == np.float64
+    assert np.isnan(t["accrued_m"][0]) and t["accrued_m"][1] == 1e-3 and t["engine"] == ["nscd", "md2d"]
+    pandas = pytest.importorskip("pandas")
+    frame = ballast.table(path, frame=True)
+    assert isinstance(frame, pandas.DataFrame) and frame.shape == (2, 4) and frame["settlement_m"].sum() == 0.75
