@@ -141,6 +141,7 @@ def replica_finish(out: str, failures: list[Optional[str]], seating: int) -> tup
 DEFAULT_PERTURBATION_M: float
 DEFAULT_PERTURB_SEED: int
 DEFAULT_SEATING_CYCLES: int
+PAPER_POLICIES: list[tuple[str, float]]
 def saussine_convergence(
     sample: str, out: str, policies: list[tuple[str, float]], reference: Optional[tuple[str, float]],
     replicas: tuple[int, float, int, int], jobs: Optional[int], resume: bool, checkpoint_every: float,

@@ -44,6 +44,7 @@ fn _ballast(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_PERTURBATION_M", ballast_core::studies::replicas::DEFAULT_PERTURBATION_M)?;
     m.add("DEFAULT_PERTURB_SEED", ballast_core::studies::replicas::DEFAULT_PERTURB_SEED)?;
     m.add("DEFAULT_SEATING_CYCLES", ballast_core::studies::replicas::DEFAULT_SEATING_CYCLES)?;
+    m.add("PAPER_POLICIES", ballast_core::studies::campaigns::PAPER_POLICIES.to_vec())?;
     m.add_function(wrap_pyfunction!(experiments::saussine_sample, m)?)?;
     m.add_function(wrap_pyfunction!(experiments::saussine_loaded, m)?)?;
     m.add_function(wrap_pyfunction!(experiments::karrech_deposit, m)?)?;

@@ -104,6 +104,21 @@ impl Watch {
     }
 }
 
+/// Runs `f` with the interpreter's lock released and a [`Watch`] calling `progress`: the exception that
+/// stopped the loop, if one did, else `f`'s result (its error as the Python exception, `crate::errors`).
+pub fn watched<T: Send>(
+    py: Python<'_>,
+    progress: Option<Py<PyAny>>,
+    f: impl FnOnce(&mut Watch) -> ballast_core::Result<T> + Send,
+) -> PyResult<T> {
+    let mut watch = Watch::new(progress);
+    let result = py.detach(|| f(&mut watch));
+    if let Some(e) = watch.failure {
+        return Err(e);
+    }
+    result.map_err(crate::errors::to_py)
+}
+
 /// A serde value as a Python object (through `json`).
 pub fn to_python<'py, T: serde::Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyAny>> {
     let text = serde_json::to_string(value).map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;

@@ -3,7 +3,7 @@
 //! configuration write-back).
 
 use crate::errors::to_py;
-use crate::running::{to_python, OutFolder, Watch, LOOK_EVERY};
+use crate::running::{to_python, watched, OutFolder, LOOK_EVERY};
 use crate::settle::Asked;
 use ballast_core::engine::{BodyState, Engine, Spin, StepSummary};
 use ballast_core::open::Loaded;
@@ -211,9 +211,8 @@ impl Simulation {
             length: steps.map(RunLength::Steps),
             ..options(&folder, checkpoint_every, resume, stop_after, figures, threads)
         };
-        let mut watch = Watch::new(progress);
         let loaded = &mut self.loaded;
-        let outcome = py.detach(|| {
+        let outcome = watched(py, progress, |watch| {
             loaded.run_on(folder.path(), &opts, &mut |p| {
                 watch.look(p.step == p.end_step, |d| {
                     d.set_item("step", p.step)?;
@@ -225,11 +224,7 @@ impl Simulation {
                     d.set_item("settlement", p.settlement)
                 })
             })
-        });
-        if let Some(e) = watch.failure {
-            return Err(e);
-        }
-        let outcome = outcome.map_err(to_py)?;
+        })?;
         let d = PyDict::new(py);
         let status = match outcome.status {
             Status::Stopped => "stopped",
@@ -295,9 +290,8 @@ impl Simulation {
         let request = crate::settle::request(py, &self.loaded, asked)?;
         let folder = OutFolder::new(out);
         let opts = options(&folder, checkpoint_every, resume, stop_after, figures, threads);
-        let mut watch = Watch::new(progress);
         let loaded = &mut self.loaded;
-        let summary = py.detach(|| {
+        let summary = watched(py, progress, |watch| {
             loaded.settle_on(folder.path(), &opts, &request, &mut |p| {
                 watch.look(p.cycle >= p.target, |d| {
                     d.set_item("cycle", p.cycle)?;
@@ -306,11 +300,8 @@ impl Simulation {
                     d.set_item("settlement", p.settlement)
                 })
             })
-        });
-        if let Some(e) = watch.failure {
-            return Err(e);
-        }
-        let summary = to_python(py, &summary.map_err(to_py)?)?;
+        })?;
+        let summary = to_python(py, &summary)?;
         summary.set_item("out", folder.shown())?;
         Ok(summary)
     }
