@@ -172,8 +172,8 @@ impl Simulation {
     /// `out`, none without). `resume`: continue the run in `out` from its checkpoint (a run started from the
     /// scene's start; the simulation's state before the call does not matter). `progress`: called with a dict
     /// (`step`, `end_step`, `time` in s, `kinetic_energy` in J, `contacts`, `cycles` and `settlement` in m when
-    /// the scene follows cycles) after the first step, then at most every 20 ms and after the last; returning `False`
-    /// stops the run as Ctrl-C does, without an exception. `stop_after`: stop after this many steps of this
+    /// the scene follows cycles) after the first step, then at most every 20 ms and after the last; returning
+    /// `False` stops the run as Ctrl-C does, without an exception. `stop_after`: stop after this many steps of this
     /// call. `vtk_every`: a VTK snapshot every this many steps (0: none). `figures`: draw the run's figures.
     /// `threads`: threads of a step (1 or 2; `None`: 2 on a machine with 2 cores; the numbers do not depend on
     /// it).
