@@ -7,7 +7,9 @@ from ._ballast import Simulation
 __all__ = ["box"]
 
 
-def box(spheres: int = 1728, friction: float = 0.1, seed: int = 1, duration: float = 10.0, every: int = 1000) -> Simulation:
+def box(
+    spheres: int = 1728, friction: float = 0.1, seed: int = 1, duration: float = 10.0, every: int = 1000
+) -> Simulation:
     """The box's isotropic compression (the scene of ``ballast luding compress``): ``spheres`` spheres (343,
     1000, 1728, 3375 in the paper) with radii from ``seed``, friction coefficient ``friction``, the walls
     servo-controlled to the paper's pressure; it runs until equilibrium or ``duration`` (s), a row of

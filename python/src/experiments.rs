@@ -178,7 +178,9 @@ pub fn luding_box(spheres: usize, friction: f64, seed: u64, duration: f64, every
 /// `sample` loaded under `loading`, or of a cyclic 2D scene as it is; the replica count and the ensemble's
 /// seating cycle.
 #[pyfunction]
-#[pyo3(signature = (sample, name, out, replicas, perturbation, perturbation_seed, seating_cycles, resume, loading = None))]
+#[pyo3(signature = (
+    sample, name, out, replicas, perturbation, perturbation_seed, seating_cycles, resume, loading = None
+))]
 #[allow(clippy::too_many_arguments)]
 pub fn replica_starts(
     py: Python<'_>,
@@ -312,7 +314,9 @@ pub fn saussine_convergence(
 /// `ballast compare` (the loaded sample on NSCD and on planar MD at each overlap ratio) into `out`; the path of
 /// `compare.csv` and the failed runs as `(label, error)`.
 #[pyfunction]
-#[pyo3(signature = (sample, out, overlaps, model, dt_fraction, replicas, jobs, resume, checkpoint_every, loading = None))]
+#[pyo3(signature = (
+    sample, out, overlaps, model, dt_fraction, replicas, jobs, resume, checkpoint_every, loading = None
+))]
 #[allow(clippy::too_many_arguments)]
 pub fn compare(
     py: Python<'_>,

@@ -58,8 +58,8 @@ impl Drop for OutFolder {
     }
 }
 
-/// The callback of a library loop: at its first step, then every [`LOOK_EVERY`] and at its last step (`last`), with the lock
-/// taken, the signals looked at and `progress` called with the dict `dict` makes of the loop's report. A
+/// The callback of a library loop: at its first step, then every [`LOOK_EVERY`] and at its last step (`last`),
+/// with the lock taken, the signals looked at and `progress` called with a dict of the loop's report. A
 /// signal's exception, or `progress`'s, is kept in `failure` and stops the loop; so does `progress` returning
 /// `False`.
 pub struct Watch {
