@@ -1,8 +1,8 @@
 //! The extension module of the Python package `ballast` (`ballast._ballast`): scene files opened on their
-//! engine ([`load`], [`from_toml`]) as a [`Simulation`] that steps, runs through the run loop and the
+//! engine ([`load`], [`from_toml`]) as a `Simulation` that steps, runs through the run loop and the
 //! settlement driver and exposes its state as numpy arrays; the experiments' building blocks
-//! ([`experiments`]: scenarios, studies, replica tasks, tables); the library's errors as Python exceptions
-//! ([`errors`]). SI units throughout (m, s, kg, rad, N). The package's Python code (python/ballast/) builds
+//! (`experiments`: scenarios, studies, replica tasks, tables); the library's errors as Python exceptions
+//! (`errors`). SI units throughout (m, s, kg, rad, N). The package's Python code (python/ballast/) builds
 //! `ballast.saussine`, `ballast.karrech`, `ballast.luding` and `ballast.ensemble` on these.
 //!
 //! The binding holds the library's own values (`ballast::open::Loaded`); stepping runs the engines' code with
