@@ -1,5 +1,5 @@
 //! The extension module of the Python package `ballast` (`ballast._ballast`): scene files opened on their
-//! engine ([`load`], [`from_toml`]) as a `Simulation` that steps, runs through the run loop and the
+//! engine (`load`, `from_toml`) as a `Simulation` that steps, runs through the run loop and the
 //! settlement driver and exposes its state as numpy arrays; the experiments' building blocks
 //! (`experiments`: scenarios, studies, replica tasks, tables); the library's errors as Python exceptions
 //! (`errors`). SI units throughout (m, s, kg, rad, N). The package's Python code (python/ballast/) builds
