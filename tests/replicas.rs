@@ -380,3 +380,54 @@ fn the_default_setting_settles_like_the_reference_within_its_stated_error() {
     assert!((0.3..=1.2).contains(&ratio), "accrued settlement {ratio:.2} × the reference's");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A job array: `saussine settle --replicas 4` as four `--task K` processes (in a scrambled order) and a
+/// `--summarize-only`, the summary byte for byte that of the run of all four side by side; `--tasks` says 4;
+/// a summary asked for before every task has run names the missing ones; a task that is not the study's is
+/// refused naming `--task`. The same with `--accelerate`.
+#[test]
+fn replica_tasks_run_one_by_one_summarize_to_the_whole_studys_bytes() {
+    let dir = scratch::dir("tasks");
+    let sample = sample(&dir);
+    for accelerated in [false, true] {
+        let base = |out: &Path| {
+            let mut a: Vec<String> = ["saussine", "settle", "--sample", &sample, "--replicas", "4"]
+                .iter()
+                .chain(&["--snapshot-every", "0", "--out", out.to_str().unwrap()])
+                .chain(&SHORT)
+                .map(|s| s.to_string())
+                .collect();
+            if accelerated {
+                // 2 cycles: 1 initial, a window of 2 computed cycles would exceed them; k_i = 0 is refused for
+                // Shenton's law: a linear law over 2 computed cycles, no jump (the tasks' machinery is tested).
+                a.extend(["--accelerate", "0,2,1", "--law", "linear"].map(String::from));
+            }
+            a
+        };
+        let whole = dir.join(format!("whole-{accelerated}"));
+        let args = base(&whole);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        run(&args);
+        let parts = dir.join(format!("parts-{accelerated}"));
+        let parts_args = base(&parts);
+        let with = |extra: &[&'static str]| -> Vec<String> {
+            parts_args.iter().cloned().chain(extra.iter().map(|s| s.to_string())).collect()
+        };
+        let run = |a: Vec<String>| run(&a.iter().map(String::as_str).collect::<Vec<_>>());
+        assert_eq!(run(with(&["--tasks"])).trim(), "4");
+        for k in ["2", "0", "3"] {
+            let out = run(with(&["--task", k]));
+            assert!(out.contains("--summarize-only"), "{out}");
+        }
+        let r = Command::new(env!("CARGO_BIN_EXE_ballast")).args(with(&["--summarize-only", "--quiet"])).output();
+        let e = String::from_utf8_lossy(&r.unwrap().stderr).into_owned();
+        assert!(e.contains("--summarize-only: 1 of 4 tasks have no finished run: replica-1"), "{e}");
+        run(with(&["--task", "1"]));
+        run(with(&["--summarize-only"]));
+        let summary = |d: &Path| std::fs::read(d.join("settlement_ensemble.csv")).unwrap();
+        assert_eq!(summary(&whole), summary(&parts), "accelerated: {accelerated}");
+        let r = Command::new(env!("CARGO_BIN_EXE_ballast")).args(with(&["--task", "4", "--quiet"])).output();
+        let e = String::from_utf8_lossy(&r.unwrap().stderr).into_owned();
+        assert!(e.contains("--task: the study has 4 tasks, 0 to 3; got 4"), "{e}");
+    }
+}

@@ -11,6 +11,7 @@ use ballast_core::studies::campaigns::{convergence, ConvergenceSpec, StudyOption
 use ballast_core::studies::compare::CompareSpec;
 use ballast_core::studies::replicas::{Perturbation, Replicas};
 use ballast_core::studies::saussine::SettleOptions;
+use ballast_core::studies::tasks::Tasks;
 use ballast_core::studies::{replica_tasks, Quiet};
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -210,7 +211,8 @@ pub fn replica_starts(
     };
     let perturbation = Perturbation { distance_m: perturbation, seed: perturbation_seed };
     let replicas = Replicas { count: replicas, perturbation, seating_cycles };
-    let tasks = replica_tasks::write_starts(&scene, name.as_ref(), &out, &replicas, resume).map_err(to_py)?;
+    let tasks =
+        replica_tasks::write_starts(&scene, name.as_ref(), &out, &replicas, resume, Tasks::All).map_err(to_py)?;
     Ok((tasks.count, tasks.seating))
 }
 
@@ -227,7 +229,7 @@ pub fn replica_run(
     checkpoint_every: f64,
     snapshot_every: u64,
 ) -> PyResult<Option<String>> {
-    let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume };
+    let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume, tasks: Tasks::All };
     match py.detach(|| replica_tasks::run_replica(&out, r, &opts, threads, &Quiet)) {
         Ok(()) => Ok(None),
         Err(e) if e.is_input() => Err(to_py(e)),

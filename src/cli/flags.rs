@@ -3,7 +3,7 @@
 //! second for the one line an input error prints.
 
 /// A library message's leading field, and the flag of the command line that sets it.
-const FLAGS: [(&str, &str); 28] = [
+const FLAGS: [(&str, &str); 30] = [
     ("threads", "--threads"),
     ("checkpoint_every_s", "--checkpoint-every"),
     ("resume", "--resume"),
@@ -32,6 +32,8 @@ const FLAGS: [(&str, &str); 28] = [
     ("samples", "--samples"),
     ("factors", "--factors"),
     ("dts", "--dts"),
+    ("task", "--task"),
+    ("summarize", "--summarize-only"),
 ];
 
 /// `msg` with its leading `field:` replaced by the flag that sets the field, if it is one of the command

@@ -28,6 +28,7 @@ use ballast::studies::replicas::{
     Perturbation, Replicas, Start, DEFAULT_PERTURBATION_M, DEFAULT_PERTURB_SEED, DEFAULT_SEATING_CYCLES,
 };
 use ballast::studies::saussine::{self, SettleOptions, SettleReplicas};
+use ballast::studies::tasks::Tasks;
 use clap::Subcommand;
 use std::path::PathBuf;
 
@@ -105,6 +106,8 @@ pub enum SaussineCommand {
         jobs: Option<usize>,
         #[command(flatten)]
         accelerate: AccelerateArgs,
+        #[command(flatten)]
+        tasks: TaskArgs,
         #[arg(long)]
         quiet: bool,
     },
@@ -268,6 +271,34 @@ impl ReplicaArgs {
     }
 }
 
+/// Which of a study's tasks an invocation runs (`ballast::studies::tasks`): a scheduler's job array runs one
+/// task per element, then `--summarize-only` writes the summary.
+#[derive(Debug, Clone, clap::Args)]
+pub struct TaskArgs {
+    /// Run task K of the study alone (numbered 0 … N−1, --tasks), in the folder the whole study gives it,
+    /// without the summary: a job array's element (`--task $SLURM_ARRAY_TASK_ID`).
+    #[arg(long, value_name = "K", conflicts_with = "summarize_only")]
+    pub task: Option<u64>,
+    /// Print the number of tasks of the study and exit.
+    #[arg(long)]
+    pub tasks: bool,
+    /// Run nothing: write the summary from the tasks' folders (every task must have finished; the
+    /// others are named).
+    #[arg(long)]
+    pub summarize_only: bool,
+}
+
+impl TaskArgs {
+    /// The library's selection.
+    pub fn selection(&self) -> Tasks {
+        match (self.task, self.summarize_only) {
+            (Some(k), _) => Tasks::One(k),
+            (None, true) => Tasks::Summarize,
+            (None, false) => Tasks::All,
+        }
+    }
+}
+
 /// Settings shared by the studies.
 #[derive(Debug, Clone, clap::Args)]
 pub struct StudyArgs {
@@ -426,6 +457,10 @@ fn print_replicas(r: &SettleReplicas) {
     for (label, e) in &r.failed {
         eprintln!("run {label} failed: {e}");
     }
+    if !r.summarized {
+        println!("task done in {}; the summary: --summarize-only once every task is", r.runs.display());
+        return;
+    }
     let mm = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{:.3}", 1e3 * x));
     if let Some(last) = r.rows.last() {
         let s = r.rows.iter().find(|row| row.cycle == last.seating_cycle);
@@ -477,10 +512,21 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
             replica,
             jobs,
             accelerate,
+            tasks,
             quiet,
         } => {
-            let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume };
+            let selection = tasks.selection();
+            let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume, tasks: selection };
             let replicas = replicas.replicas();
+            if tasks.tasks {
+                // One task per replica (a single run is one task).
+                println!("{}", replicas.count);
+                return Ok(());
+            }
+            if selection != Tasks::All && replicas.count == 1 {
+                let flag = if tasks.summarize_only { "--summarize-only" } else { "--task" };
+                return Err(input(format!("{flag}: for a study of --replicas R > 1 (a single run is its one task)")));
+            }
             let start = Start { replica, perturbation: replicas.perturbation };
             if let Some(acc) = accelerate.accelerate()? {
                 if replicas.count > 1 {

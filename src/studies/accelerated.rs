@@ -7,8 +7,11 @@
 //! cent: BENCHMARKS.md, "Settlement acceleration"), so its error is an ensemble's.
 
 use super::replicas::{Replicas, Start};
-use super::saussine::{finish_replicas, replica_dir, replica_jobs, settle_accelerated};
+use super::saussine::{
+    finish_replicas, not_summarized, replica_dir, replica_folders, replica_jobs, settle_accelerated,
+};
 use super::saussine::{Accelerate, SettleOptions, SettleReplicas};
+use super::tasks::{failures_from_folders, Tasks};
 use crate::error::Result;
 use crate::io;
 use crate::io::layout;
@@ -26,7 +29,8 @@ use std::path::Path;
 /// and resumes the checkpointed ones. Then `OUT/settlement_ensemble.csv` over
 /// the replicas' `settlement.csv` (the settlement at each cycle's end: measured
 /// on computed cycles, the fitted law's on extrapolated ones) with the seating
-/// cycle `replicas.seating_cycles`, and its figure. The runs report no progress.
+/// cycle `replicas.seating_cycles`, and its figure. The runs report no progress. `opts.tasks` runs one
+/// replica alone (no summary) or none (the summary from the replicas' folders).
 ///
 /// # Errors
 /// As [`super::saussine::settle_replicas`]; a replica that fails is reported in
@@ -42,10 +46,16 @@ pub fn settle_accelerated_replicas(
 ) -> Result<SettleReplicas> {
     crate::io::figures::require()?; // the runs end with their figures
     replicas.check()?;
+    opts.tasks.check(replicas.count)?;
     let threads = replica_jobs(jobs, replicas.count)?;
     io::create_output_dir(&out.join("runs"))?;
-    let priors: Vec<Prior> =
-        (0..replicas.count).map(|r| Prior::of(&replica_dir(out, r), layout::SUMMARY, opts.resume)).collect();
+    let priors: Vec<Prior> = (0..replicas.count)
+        .map(|r| match opts.tasks.runs(r) {
+            true => Prior::of(&replica_dir(out, r), layout::SUMMARY, opts.resume),
+            // Not this invocation's: as if finished.
+            false => Prior::Finished,
+        })
+        .collect();
     let pool = super::campaigns::pool(threads)?;
     let results: Vec<Result<()>> = pool.install(|| {
         use rayon::prelude::*;
@@ -57,7 +67,7 @@ pub fn settle_accelerated_replicas(
                     let start = Start { replica: r, perturbation: replicas.perturbation };
                     let opts = SettleOptions { resume: prior == Prior::Checkpointed, ..opts.clone() };
                     let dir = replica_dir(out, r);
-                    let threads = super::campaigns::run_threads(threads);
+                    let threads = super::campaigns::run_threads(if opts.tasks == Tasks::All { threads } else { 1 });
                     settle_accelerated(sample, loading, &start, accelerate, &dir, &opts, threads, &mut |_| {})
                         .map(|_| ())
                 }
@@ -66,6 +76,12 @@ pub fn settle_accelerated_replicas(
     });
     let seating = replicas.seating_cycles.min(loading.cycles);
     let read = |path: &Path| io::read_csv::<SettlementRow>(path);
-    let failures = super::saussine::failures(results)?;
+    let failures = match opts.tasks {
+        Tasks::Summarize => failures_from_folders(&replica_folders(out, replicas.count))?,
+        _ => super::saussine::failures(results)?,
+    };
+    if !opts.tasks.summarizes() {
+        return Ok(not_summarized(out, &failures));
+    }
     finish_replicas(out, &failures, "settlement.csv", read, seating, "Settlement of the sleeper, accelerated")
 }

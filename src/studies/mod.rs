@@ -49,6 +49,7 @@ pub mod md_stage;
 pub mod replica_tasks;
 pub mod replicas;
 pub mod saussine;
+pub mod tasks;
 
 pub use display::{run_loaded, run_scene, Quiet, RunDisplay};
 

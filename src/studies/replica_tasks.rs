@@ -11,6 +11,7 @@
 use super::replicas::{Replicas, Start};
 use super::saussine::SettleReplicas;
 use super::saussine::{finish_replicas, replica_dir, run_settle, steps_per_cycle, write_start, SettleOptions};
+use super::tasks::Tasks;
 use super::{output_error, RunDisplay};
 use crate::error::{Error, Result};
 use crate::io::{self, layout};
@@ -30,7 +31,8 @@ pub struct ReplicaTasks {
 /// Writes the start of every replica of the loaded `scene` (a cyclic NSCD scene: the sleeper on a sample,
 /// [`crate::scenarios::saussine::loaded_scene`]; `source` is named in the scenes' notes) into
 /// `OUT/runs/replica-<r>/loaded.toml`, replica `r` perturbed as [`Start`] `r` says, with its
-/// [`super::replicas::REPLICA_FILE`]. With `resume`, the folders that hold a run already keep their start.
+/// [`super::replicas::REPLICA_FILE`]: of the replicas `tasks` runs (every one, one alone, none). With
+/// `resume`, the folders that hold a run already keep their start.
 ///
 /// # Errors
 /// [`Error::Scene`] naming the key for invalid replicas or a scene without loading cycles; an output that
@@ -41,14 +43,16 @@ pub fn write_starts(
     out: &Path,
     replicas: &Replicas,
     resume: bool,
+    tasks: Tasks,
 ) -> Result<ReplicaTasks> {
     replicas.check()?;
+    tasks.check(replicas.count)?;
     let cycles = scene.plan()?.cycles.ok_or_else(|| {
         Error::Scene("output.cycles: the replicas' scene has no loading cycles (give [output] cycles)".into())
     })?;
     let total = (scene.simulation.duration * cycles.frequency).round() as u64;
     io::create_output_dir(&out.join("runs"))?;
-    for r in 0..replicas.count {
+    for r in (0..replicas.count).filter(|&r| tasks.runs(r)) {
         let dir = replica_dir(out, r);
         let prior = Prior::of(&dir, layout::SUMMARY, resume);
         let start = Start { replica: r, perturbation: replicas.perturbation };

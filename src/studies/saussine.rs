@@ -22,6 +22,7 @@
 use super::replicas::{
     perturb_scene, settlement_ensemble, CycleSettlement, Replicas, SettlementEnsembleRow, Start, REPLICA_FILE,
 };
+use super::tasks::{failures_from_folders, Tasks};
 use super::{output_error, run_scene, write_file, RunDisplay};
 use crate::error::{Error, Result};
 use crate::io;
@@ -137,6 +138,9 @@ pub struct SettleOptions {
     pub checkpoint_every_s: f64,
     /// Continue a killed run from its checkpoint.
     pub resume: bool,
+    /// Of a replica study ([`settle_replicas`], [`super::accelerated::settle_accelerated_replicas`]): which
+    /// replicas this invocation runs, and whether it writes the summary ([`Tasks`]; a single run ignores it).
+    pub tasks: Tasks,
 }
 
 /// §4: loads the sample at `sample` and runs its cycles in `out` (the loaded
@@ -281,8 +285,11 @@ pub struct SettleReplicas {
     pub rows: Vec<SettlementEnsembleRow>,
     /// `(label, error)` of each replica that failed in this invocation (its
     /// cycles, if any, are still in the ensemble, which stops at the last
-    /// cycle every replica reached).
+    /// cycle every replica reached); with [`Tasks::Summarize`], those whose
+    /// `summary.json` says they diverged or stalled.
     pub failed: Vec<(String, String)>,
+    /// Whether the summary was written (not by a [`Tasks::One`] invocation, whose `rows` are empty).
+    pub summarized: bool,
 }
 
 /// The folder of replica `r` of a settlement run in `out`.
@@ -301,11 +308,13 @@ pub fn replica_dir(out: &Path, r: u64) -> PathBuf {
 /// interval of the settlement at the load minimum, and of the settlement
 /// accrued since cycle `replicas.seating_cycles`) and the figure
 /// `settlement_ensemble` (the replicas thin, their mean with its interval). The
-/// runs are labelled `replica-<r>`.
+/// runs are labelled `replica-<r>`. `opts.tasks` runs one replica alone (its start
+/// written, no summary) or none (the summary from the replicas' folders).
 ///
 /// # Errors
 /// [`Error::Scene`] for an unreadable sample, an invalid loading, replicas,
-/// `jobs` or checkpoint (before any run); a replica that fails is reported in
+/// `jobs`, task or checkpoint (before any run), or a summary asked for while a
+/// replica has no finished run (named); a replica that fails is reported in
 /// [`SettleReplicas::failed`]; an output that cannot be written is an
 /// [`Error::Io`].
 pub fn settle_replicas(
@@ -319,22 +328,50 @@ pub fn settle_replicas(
 ) -> Result<SettleReplicas> {
     crate::io::figures::require()?; // the runs end with their figures
     replicas.check()?;
+    opts.tasks.check(replicas.count)?;
     let threads = replica_jobs(jobs, replicas.count)?;
     let (scene, _) = loaded(sample, loading)?;
     // Every replica's scene first, so that an invalid one stops before any run.
-    let tasks = super::replica_tasks::write_starts(&scene, sample, out, replicas, opts.resume)?;
+    let tasks = super::replica_tasks::write_starts(&scene, sample, out, replicas, opts.resume, opts.tasks)?;
     let pool = super::campaigns::pool(threads)?;
     let results: Vec<Result<()>> = pool.install(|| {
         use rayon::prelude::*;
         (0..replicas.count)
             .into_par_iter()
-            .map(|r| {
-                let threads = super::campaigns::run_threads(threads);
-                super::replica_tasks::run_replica(out, r, opts, threads, display)
+            .map(|r| match opts.tasks.runs(r) {
+                true => {
+                    let threads = super::campaigns::run_threads(if opts.tasks == Tasks::All { threads } else { 1 });
+                    super::replica_tasks::run_replica(out, r, opts, threads, display)
+                }
+                false => Ok(()),
             })
             .collect()
     });
-    super::replica_tasks::finish(out, &failures(results)?, tasks.seating)
+    let failures = match opts.tasks {
+        Tasks::Summarize => failures_from_folders(&replica_folders(out, replicas.count))?,
+        _ => failures(results)?,
+    };
+    if !opts.tasks.summarizes() {
+        return Ok(not_summarized(out, &failures));
+    }
+    super::replica_tasks::finish(out, &failures, tasks.seating)
+}
+
+/// The `(label, folder)` of each of the `count` replicas in `out`.
+pub(crate) fn replica_folders(out: &Path, count: u64) -> Vec<(String, PathBuf)> {
+    (0..count).map(|r| (format!("replica-{r}"), replica_dir(out, r))).collect()
+}
+
+/// What a replica study in `out` that ran a task without its summary reports: the failures of this invocation.
+pub(crate) fn not_summarized(out: &Path, failures: &[Option<String>]) -> SettleReplicas {
+    let failed = failures.iter().enumerate().filter_map(|(r, f)| Some((format!("replica-{r}"), f.clone()?))).collect();
+    SettleReplicas {
+        runs: out.join("runs"),
+        table: out.join("settlement_ensemble.csv"),
+        rows: Vec::new(),
+        failed,
+        summarized: false,
+    }
 }
 
 /// The failure of each replica of `results` (`None`: it ran), or the first input error ([`Error::is_input`]:
@@ -393,7 +430,7 @@ pub(crate) fn finish_replicas<T: CycleSettlement>(
     let table = out.join("settlement_ensemble.csv");
     io::table::write_all(&table, &rows)?;
     ensemble_figure(&out.join("settlement_ensemble"), title, &runs, &rows)?;
-    Ok(SettleReplicas { runs: out.join("runs"), table, rows, failed })
+    Ok(SettleReplicas { runs: out.join("runs"), table, rows, failed, summarized: true })
 }
 
 /// The figure of an ensemble of settlement runs at `stem`: each replica's

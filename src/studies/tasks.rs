@@ -1,0 +1,85 @@
+//! Which of a study's tasks an invocation runs: all of them side by side on the local pool (the default), one
+//! alone (an element of a scheduler's job array: `--task K`, `SLURM_ARRAY_TASK_ID`), or none, the summary
+//! then written from the tasks' folders (`--summarize-only`). A task's start depends on its index alone and
+//! its numbers not on the threads of its steps, so the summary of tasks run one by one in separate
+//! processes, in any order, is the summary of the local run, byte for byte.
+
+use crate::error::{Error, Result};
+use crate::io::layout;
+use std::path::PathBuf;
+
+/// Which of a study's tasks (`0..count`, in the study's fixed order) this invocation runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Tasks {
+    /// Every task, side by side on the local pool, then the summary.
+    #[default]
+    All,
+    /// Task `k` alone, without the summary.
+    One(u64),
+    /// No task: the summary from the tasks' folders, every one of which must hold a finished run.
+    Summarize,
+}
+
+impl Tasks {
+    /// Checks the selection against the study's `count` tasks.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming `task` for a task that the study does not have.
+    pub fn check(&self, count: u64) -> Result<()> {
+        match *self {
+            Tasks::One(k) if k >= count => Err(Error::Scene(format!(
+                "task: the study has {count} tasks, 0 to {}; got {k}",
+                count.saturating_sub(1)
+            ))),
+            _ => Ok(()),
+        }
+    }
+
+    /// Whether this invocation runs task `k`.
+    pub fn runs(&self, k: u64) -> bool {
+        match *self {
+            Tasks::All => true,
+            Tasks::One(j) => j == k,
+            Tasks::Summarize => false,
+        }
+    }
+
+    /// Whether this invocation writes the study's summary.
+    pub fn summarizes(&self) -> bool {
+        !matches!(self, Tasks::One(_))
+    }
+}
+
+/// The failures of the tasks in `folders` (`(label, folder)`, in task order), read from the folders for a
+/// summary written apart from the runs: `None` for a run that ended, `Some` with how it ended for one that
+/// diverged or stalled (its `summary.json`'s `end`).
+///
+/// # Errors
+/// [`Error::Scene`] naming the tasks whose folder holds no finished run (no `summary.json`, or a
+/// checkpoint still to resume), or whose `summary.json` cannot be read.
+pub fn failures_from_folders(folders: &[(String, PathBuf)]) -> Result<Vec<Option<String>>> {
+    let mut missing = Vec::new();
+    let mut failures = Vec::with_capacity(folders.len());
+    for (label, dir) in folders {
+        let summary = dir.join(layout::SUMMARY);
+        if !summary.is_file() || dir.join(layout::CHECKPOINT).exists() {
+            missing.push(label.as_str());
+            failures.push(None);
+            continue;
+        }
+        let text = std::fs::read_to_string(&summary).map_err(|e| crate::io::io_error(&summary, "read", e))?;
+        let value: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| Error::Scene(format!("{}: not a run's summary: {e}", summary.display())))?;
+        let end = value.get("end").and_then(|e| e.as_str()).unwrap_or("");
+        failures.push(matches!(end, "diverged" | "stalled").then(|| format!("the run {end} (its summary.json)")));
+    }
+    if !missing.is_empty() {
+        return Err(Error::Scene(format!(
+            "summarize: {} of {} tasks have no finished run: {} (run each alone, or resume the study)",
+            missing.len(),
+            folders.len(),
+            missing.join(", ")
+        )));
+    }
+    Ok(failures)
+}
