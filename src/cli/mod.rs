@@ -10,6 +10,7 @@
 //! - `compare`: NSCD versus MD on the same loaded sample ([`compare`]);
 //! - `karrech …`, `luding …`: the ready-made MD tests ([`md_tests`]).
 
+mod cluster;
 mod compare;
 mod deposit;
 mod figures;
@@ -85,6 +86,7 @@ pub(crate) fn input(msg: String) -> Failure {
 /// Runs the command line.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    let _mpi = cluster::init();
     let result = match cli.command {
         Command::Run(args) => run::main(args),
         Command::Figures(args) => figures::main(args),
@@ -94,17 +96,21 @@ pub fn main() -> ExitCode {
         Command::Karrech(cmd) => md_tests::karrech_main(cmd),
         Command::Luding(cmd) => md_tests::luding_main(cmd),
     };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
+    let code = match result {
+        Ok(()) => 0,
         Err(Failure::Input(e)) => {
             eprintln!("error: {}", flags::as_flags(&e.one_line()));
-            ExitCode::from(2)
+            2
         }
         Err(Failure::Run(e)) => {
             eprintln!("error: {}", e.one_line());
-            ExitCode::from(1)
+            1
         }
+    };
+    if code != 0 {
+        cluster::abort_others(code);
     }
+    ExitCode::from(code)
 }
 
 /// How the runs of a command show their progress on the terminal (the

@@ -515,31 +515,33 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
             tasks,
             quiet,
         } => {
-            let selection = tasks.selection();
-            let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume, tasks: selection };
             let replicas = replicas.replicas();
             if tasks.tasks {
                 // One task per replica (a single run is one task).
                 println!("{}", replicas.count);
                 return Ok(());
             }
-            if selection != Tasks::All && replicas.count == 1 {
+            if tasks.selection() != Tasks::All && replicas.count == 1 {
                 let flag = if tasks.summarize_only { "--summarize-only" } else { "--task" };
                 return Err(input(format!("{flag}: for a study of --replicas R > 1 (a single run is its one task)")));
             }
+            if replicas.count == 1 && super::cluster::ranks().0 > 0 {
+                return Ok(()); // one run: rank 0's
+            }
+            let selection = super::cluster::share(tasks.selection());
+            let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume, tasks: selection };
             let start = Start { replica, perturbation: replicas.perturbation };
             if let Some(acc) = accelerate.accelerate()? {
                 if replicas.count > 1 {
-                    let r = ballast::studies::accelerated::settle_accelerated_replicas(
-                        &sample,
-                        &loading.loading()?,
-                        &acc,
-                        &out,
-                        &opts,
-                        &replicas,
-                        jobs,
-                    )?;
-                    print_replicas(&r);
+                    let loading = loading.loading()?;
+                    let study = |opts: &SettleOptions| {
+                        ballast::studies::accelerated::settle_accelerated_replicas(
+                            &sample, &loading, &acc, &out, opts, &replicas, jobs,
+                        )
+                    };
+                    if let Some(r) = super::cluster::shared(&opts, study)? {
+                        print_replicas(&r);
+                    }
                     return Ok(());
                 }
                 let bar = super::cycle_bar(quiet);
@@ -563,9 +565,13 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                 replicas.check()?;
                 saussine::settle(&sample, &loading.loading()?, &start, &out, &opts, &Bars::single(quiet))?;
             } else {
-                let bars = Bars::group(quiet);
-                let r = saussine::settle_replicas(&sample, &loading.loading()?, &out, &opts, &replicas, jobs, &bars)?;
-                print_replicas(&r);
+                let (bars, loading) = (Bars::group(quiet), loading.loading()?);
+                let study = |opts: &SettleOptions| {
+                    saussine::settle_replicas(&sample, &loading, &out, opts, &replicas, jobs, &bars)
+                };
+                if let Some(r) = super::cluster::shared(&opts, study)? {
+                    print_replicas(&r);
+                }
             }
         }
         SaussineCommand::Convergence { sample, policies: given, reference, replicas, loading, study } => {

@@ -67,7 +67,7 @@ pub fn settle_accelerated_replicas(
                     let start = Start { replica: r, perturbation: replicas.perturbation };
                     let opts = SettleOptions { resume: prior == Prior::Checkpointed, ..opts.clone() };
                     let dir = replica_dir(out, r);
-                    let threads = super::campaigns::run_threads(if opts.tasks == Tasks::All { threads } else { 1 });
+                    let threads = super::campaigns::run_threads(if opts.tasks.side_by_side() { threads } else { 1 });
                     settle_accelerated(sample, loading, &start, accelerate, &dir, &opts, threads, &mut |_| {})
                         .map(|_| ())
                 }

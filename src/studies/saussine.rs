@@ -340,7 +340,7 @@ pub fn settle_replicas(
             .into_par_iter()
             .map(|r| match opts.tasks.runs(r) {
                 true => {
-                    let threads = super::campaigns::run_threads(if opts.tasks == Tasks::All { threads } else { 1 });
+                    let threads = super::campaigns::run_threads(if opts.tasks.side_by_side() { threads } else { 1 });
                     super::replica_tasks::run_replica(out, r, opts, threads, display)
                 }
                 false => Ok(()),

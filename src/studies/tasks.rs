@@ -1,6 +1,7 @@
 //! Which of a study's tasks an invocation runs: all of them side by side on the local pool (the default), one
-//! alone (an element of a scheduler's job array: `--task K`, `SLURM_ARRAY_TASK_ID`), or none, the summary
-//! then written from the tasks' folders (`--summarize-only`). A task's start depends on its index alone and
+//! alone (an element of a scheduler's job array: `--task K`, `SLURM_ARRAY_TASK_ID`), a share of them (one MPI
+//! rank's: task `k` on rank `k mod N`), or none, the summary then written from the tasks' folders
+//! (`--summarize-only`, or rank 0 once every rank is done). A task's start depends on its index alone and
 //! its numbers not on the threads of its steps, so the summary of tasks run one by one in separate
 //! processes, in any order, is the summary of the local run, byte for byte.
 
@@ -16,6 +17,14 @@ pub enum Tasks {
     All,
     /// Task `k` alone, without the summary.
     One(u64),
+    /// The tasks `k` with `k mod size == rank`, side by side on the local pool, without the summary (one of
+    /// `size` processes, e.g. MPI ranks, each with its own `rank` in `0..size`).
+    Share {
+        /// This process's index, in `0..size`.
+        rank: u64,
+        /// The processes sharing the tasks, ≥ 1.
+        size: u64,
+    },
     /// No task: the summary from the tasks' folders, every one of which must hold a finished run.
     Summarize,
 }
@@ -31,6 +40,9 @@ impl Tasks {
                 "task: the study has {count} tasks, 0 to {}; got {k}",
                 count.saturating_sub(1)
             ))),
+            Tasks::Share { rank, size } if rank >= size => {
+                Err(Error::Scene(format!("task: rank {rank} of {size} processes (ranks are 0 to size − 1)")))
+            }
             _ => Ok(()),
         }
     }
@@ -40,13 +52,19 @@ impl Tasks {
         match *self {
             Tasks::All => true,
             Tasks::One(j) => j == k,
+            Tasks::Share { rank, size } => k % size == rank,
             Tasks::Summarize => false,
         }
     }
 
     /// Whether this invocation writes the study's summary.
     pub fn summarizes(&self) -> bool {
-        !matches!(self, Tasks::One(_))
+        matches!(self, Tasks::All | Tasks::Summarize)
+    }
+
+    /// Whether the tasks it runs go side by side on the local pool (all, or a share), rather than one alone.
+    pub fn side_by_side(&self) -> bool {
+        matches!(self, Tasks::All | Tasks::Share { .. })
     }
 }
 

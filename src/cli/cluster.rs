@@ -1,0 +1,88 @@
+//! MPI ranks for the studies' tasks (feature `mpi`): under `mpirun -np N ballast …` every rank runs its share
+//! of the study's tasks (task `k` on rank `k mod N`, `ballast::studies::tasks::Tasks::Share`), waits for the
+//! others, and rank 0 writes the summary from the tasks' folders. Without the feature, or on one rank, a study
+//! runs as it always does.
+
+use ballast::studies::saussine::{SettleOptions, SettleReplicas};
+use ballast::studies::tasks::Tasks;
+use std::sync::OnceLock;
+
+/// `(rank, size)` of this process, set by [`init`] when MPI runs more than one rank.
+static RANKS: OnceLock<(u64, u64)> = OnceLock::new();
+
+/// The MPI environment while the command runs (finalised when dropped, at the end of `main`).
+pub(crate) struct Session {
+    #[cfg(feature = "mpi")]
+    _universe: Option<mpi::environment::Universe>,
+}
+
+/// Initialises MPI (feature `mpi`; nothing without it) for the command's life.
+pub(crate) fn init() -> Session {
+    #[cfg(feature = "mpi")]
+    {
+        use mpi::traits::Communicator;
+        let universe = mpi::initialize();
+        if let Some(u) = &universe {
+            let world = u.world();
+            let _ = RANKS.set((world.rank() as u64, world.size() as u64));
+        }
+        Session { _universe: universe }
+    }
+    #[cfg(not(feature = "mpi"))]
+    Session {}
+}
+
+/// This process's rank and the number of ranks, `(rank, size)`: `(0, 1)` without MPI.
+pub(crate) fn ranks() -> (u64, u64) {
+    RANKS.get().copied().unwrap_or((0, 1))
+}
+
+/// Waits for every rank (nothing on one).
+pub(crate) fn barrier() {
+    #[cfg(feature = "mpi")]
+    if ranks().1 > 1 {
+        use mpi::traits::CommunicatorCollectives;
+        mpi::topology::SimpleCommunicator::world().barrier();
+    }
+}
+
+/// Ends every rank with `code` when one of several fails (the others would wait for it at the barrier);
+/// returns on one rank.
+pub(crate) fn abort_others(code: u8) {
+    #[cfg(feature = "mpi")]
+    if ranks().1 > 1 {
+        use mpi::traits::Communicator;
+        mpi::topology::SimpleCommunicator::world().abort(i32::from(code));
+    }
+    let _ = code;
+}
+
+/// `selection` on this rank: the whole study (`Tasks::All`) becomes this rank's share when MPI runs several
+/// ranks; a task or a summary asked for stays as it is.
+pub(crate) fn share(selection: Tasks) -> Tasks {
+    match (selection, ranks()) {
+        (Tasks::All, (rank, size)) if size > 1 => Tasks::Share { rank, size },
+        (s, _) => s,
+    }
+}
+
+/// Runs a replica study with `opts` (`study`); on a rank's share, waits for every rank, and rank 0 writes the
+/// summary from the folders: what to print (`None` on the other ranks, which print their own failures).
+///
+/// # Errors
+/// The study's.
+pub(crate) fn shared(
+    opts: &SettleOptions,
+    study: impl Fn(&SettleOptions) -> ballast::Result<SettleReplicas>,
+) -> ballast::Result<Option<SettleReplicas>> {
+    let r = study(opts)?;
+    let Tasks::Share { rank, .. } = opts.tasks else { return Ok(Some(r)) };
+    barrier();
+    if rank > 0 {
+        for (label, e) in &r.failed {
+            eprintln!("run {label} failed: {e}");
+        }
+        return Ok(None);
+    }
+    study(&SettleOptions { tasks: Tasks::Summarize, ..opts.clone() }).map(Some)
+}
