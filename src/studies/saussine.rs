@@ -288,7 +288,8 @@ pub struct SettleReplicas {
     /// cycle every replica reached); with [`Tasks::Summarize`], those whose
     /// `summary.json` says they diverged or stalled.
     pub failed: Vec<(String, String)>,
-    /// Whether the summary was written (not by a [`Tasks::One`] invocation, whose `rows` are empty).
+    /// Whether the summary was written (not by a [`Tasks::One`] or [`Tasks::Share`] invocation, whose `rows`
+    /// are empty).
     pub summarized: bool,
 }
 
@@ -308,8 +309,9 @@ pub fn replica_dir(out: &Path, r: u64) -> PathBuf {
 /// interval of the settlement at the load minimum, and of the settlement
 /// accrued since cycle `replicas.seating_cycles`) and the figure
 /// `settlement_ensemble` (the replicas thin, their mean with its interval). The
-/// runs are labelled `replica-<r>`. `opts.tasks` runs one replica alone (its start
-/// written, no summary) or none (the summary from the replicas' folders).
+/// runs are labelled `replica-<r>`. `opts.tasks` runs one replica alone or a share
+/// of them (their starts written, no summary), or none (the summary from the
+/// replicas' folders).
 ///
 /// # Errors
 /// [`Error::Scene`] for an unreadable sample, an invalid loading, replicas,
