@@ -458,7 +458,10 @@ fn print_replicas(r: &SettleReplicas) {
         eprintln!("run {label} failed: {e}");
     }
     if !r.summarized {
-        println!("task done in {}; the summary: --summarize-only once every task is", r.runs.display());
+        println!(
+            "task done (runs in {}); --summarize-only writes the summary once every task has run",
+            r.runs.display()
+        );
         return;
     }
     let mm = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{:.3}", 1e3 * x));
