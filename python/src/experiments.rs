@@ -7,7 +7,7 @@
 use crate::errors::to_py;
 use ballast_core::scenarios::saussine::{loaded_scene, Guide, LoadingSpec, SampleSpec};
 use ballast_core::scene::{Scene, SceneFile};
-use ballast_core::studies::campaigns::{convergence, ConvergenceSpec, StudyOptions};
+use ballast_core::studies::campaigns::{convergence, ConvergenceSpec, StudyOptions, StudyReport};
 use ballast_core::studies::compare::CompareSpec;
 use ballast_core::studies::replicas::{Perturbation, Replicas};
 use ballast_core::studies::saussine::SettleOptions;
@@ -65,13 +65,7 @@ fn loading(py: Python<'_>, args: Option<&Bound<'_, PyDict>>) -> PyResult<Loading
         None => LoadingArgs::default(),
     };
     let d = LoadingSpec::default();
-    let guide = match given.guide.as_deref() {
-        None => None,
-        Some("vertical") => Some(Guide::Vertical),
-        Some("level") => Some(Guide::Level),
-        Some("free") => Some(Guide::Free),
-        Some(g) => return Err(scene_error(format!("guide: expected vertical, level or free, got '{g}'"))),
-    };
+    let guide = given.guide.as_deref().map(Guide::from_name).transpose().map_err(to_py)?;
     Ok(LoadingSpec {
         cycles: given.cycles.unwrap_or(d.cycles),
         sleeper_width: given.sleeper_width.or(d.sleeper_width),
@@ -209,8 +203,7 @@ pub fn replica_starts(
         }
         (true, _) => scene,
     };
-    let perturbation = Perturbation { distance_m: perturbation, seed: perturbation_seed };
-    let replicas = Replicas { count: replicas, perturbation, seating_cycles };
+    let replicas = self::replicas((replicas, perturbation, perturbation_seed, seating_cycles));
     let tasks =
         replica_tasks::write_starts(&scene, name.as_ref(), &out, &replicas, resume, Tasks::All).map_err(to_py)?;
     Ok((tasks.count, tasks.seating))
@@ -273,14 +266,21 @@ pub fn table<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>
     Ok(d)
 }
 
-/// The replicas of a study's settings.
-fn replicas(count: u64, perturbation: f64, seed: u64, seating_cycles: u64) -> Replicas {
-    Replicas { count, perturbation: Perturbation { distance_m: perturbation, seed }, seating_cycles }
+/// The replicas of a study's settings: `(count, perturbation distance (m), perturbation seed, seating cycles)`.
+fn replicas((count, distance_m, seed, seating_cycles): (u64, f64, u64, u64)) -> Replicas {
+    Replicas { count, perturbation: Perturbation { distance_m, seed }, seating_cycles }
 }
 
-/// The options of a study run into `out` on the local pool.
-fn study(out: PathBuf, jobs: Option<usize>, resume: bool, checkpoint_every: f64) -> StudyOptions {
-    StudyOptions { out, jobs, resume, checkpoint_every_s: checkpoint_every }
+/// Runs a study (`run`, with the interpreter's lock released) into `out` on the local pool, `jobs` runs at a
+/// time: the path of its summary table and its failed runs as `(label, error)`.
+fn run_study(
+    py: Python<'_>,
+    (out, jobs, resume, checkpoint_every): (PathBuf, Option<usize>, bool, f64),
+    run: impl FnOnce(&StudyOptions) -> ballast_core::Result<StudyReport> + Send,
+) -> PyResult<(String, Vec<(String, String)>)> {
+    let study = StudyOptions { out, jobs, resume, checkpoint_every_s: checkpoint_every };
+    let report = py.detach(|| run(&study)).map_err(to_py)?;
+    Ok((report.table.path.display().to_string(), report.failed))
 }
 
 /// Saussine §3.2 (`ballast saussine convergence`) into `out`; the path of `convergence.csv` and the failed
@@ -300,17 +300,14 @@ pub fn saussine_convergence(
     checkpoint_every: f64,
     loading: Option<Bound<'_, PyDict>>,
 ) -> PyResult<(String, Vec<(String, String)>)> {
-    let (count, distance, seed, seating) = replicas;
     let spec = ConvergenceSpec {
         sample,
         policies,
         reference,
-        replicas: self::replicas(count, distance, seed, seating),
+        replicas: self::replicas(replicas),
         loading: self::loading(py, loading.as_ref())?,
     };
-    let study = study(out, jobs, resume, checkpoint_every);
-    let report = py.detach(|| convergence(&spec, &study, &Quiet)).map_err(to_py)?;
-    Ok((report.table.path.display().to_string(), report.failed))
+    run_study(py, (out, jobs, resume, checkpoint_every), |study| convergence(&spec, study, &Quiet))
 }
 
 /// `ballast compare` (the loaded sample on NSCD and on planar MD at each overlap ratio) into `out`; the path of
@@ -333,16 +330,14 @@ pub fn compare(
     checkpoint_every: f64,
     loading: Option<Bound<'_, PyDict>>,
 ) -> PyResult<(String, Vec<(String, String)>)> {
-    let (count, distance, seed, seating) = replicas;
     let spec = CompareSpec {
         sample,
         overlaps,
         model,
         dt_fraction,
-        replicas: self::replicas(count, distance, seed, seating),
+        replicas: self::replicas(replicas),
         loading: self::loading(py, loading.as_ref())?,
     };
-    let study = study(out, jobs, resume, checkpoint_every);
-    let report = py.detach(|| ballast_core::studies::compare::compare(&spec, &study, &Quiet)).map_err(to_py)?;
-    Ok((report.study.table.path.display().to_string(), report.study.failed))
+    let run = |study: &StudyOptions| ballast_core::studies::compare::compare(&spec, study, &Quiet).map(|r| r.study);
+    run_study(py, (out, jobs, resume, checkpoint_every), run)
 }

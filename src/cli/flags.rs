@@ -3,7 +3,7 @@
 //! second for the one line an input error prints.
 
 /// A library message's leading field, and the flag of the command line that sets it.
-const FLAGS: [(&str, &str); 30] = [
+const FLAGS: [(&str, &str); 31] = [
     ("threads", "--threads"),
     ("checkpoint_every_s", "--checkpoint-every"),
     ("resume", "--resume"),
@@ -34,6 +34,7 @@ const FLAGS: [(&str, &str); 30] = [
     ("dts", "--dts"),
     ("task", "--task"),
     ("summarize", "--summarize-only"),
+    ("guide", "--guide"),
 ];
 
 /// `msg` with its leading `field:` replaced by the flag that sets the field, if it is one of the command

@@ -217,13 +217,7 @@ pub struct LoadingArgs {
 impl LoadingArgs {
     /// The library's loading (checked by it when a scene is made from it).
     pub fn loading(&self) -> Result<LoadingSpec, Failure> {
-        let guide = match self.guide.as_deref() {
-            None => None,
-            Some("vertical") => Some(Guide::Vertical),
-            Some("level") => Some(Guide::Level),
-            Some("free") => Some(Guide::Free),
-            Some(g) => return Err(input(format!("--guide: expected vertical, level or free, got '{g}'"))),
-        };
+        let guide = self.guide.as_deref().map(Guide::from_name).transpose()?;
         Ok(LoadingSpec {
             cycles: self.cycles,
             inclination_deg: self.inclination,

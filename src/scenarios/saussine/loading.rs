@@ -16,6 +16,21 @@ pub enum Guide {
     Free,
 }
 
+impl Guide {
+    /// The guide named `name`: `vertical`, `level` or `free`.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming `guide` for another name.
+    pub fn from_name(name: &str) -> Result<Guide> {
+        match name {
+            "vertical" => Ok(Guide::Vertical),
+            "level" => Ok(Guide::Level),
+            "free" => Ok(Guide::Free),
+            g => Err(Error::Scene(format!("guide: expected vertical, level or free, got '{g}'"))),
+        }
+    }
+}
+
 /// The width of the paper's sleeper (m): 250 mm.
 pub const SLEEPER_WIDTH: f64 = 0.25;
 
