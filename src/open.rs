@@ -310,11 +310,9 @@ fn accelerated<E: crate::engine::Engine>(
     resume: bool,
 ) -> Result<Accelerated<E>> {
     let AccelerationPlan { spec, frequency, cycles } = plan;
-    if resume || at_start(current, &fresh) {
-        let system = if resume { fresh } else { current.clone() };
-        Ok(Accelerated::from_scene(system, spec, frequency, cycles, seed, text))
-    } else {
-        Accelerated::from_system(current.clone(), spec, frequency, cycles)
+    match scene_start(current, fresh, resume) {
+        Some(system) => Ok(Accelerated::from_scene(system, spec, frequency, cycles, seed, text)),
+        None => Accelerated::from_system(current.clone(), spec, frequency, cycles),
     }
 }
 
@@ -325,10 +323,17 @@ fn keep_settled<E>(system: &mut E, outcome: Result<AccelerationOutcome<E>>) -> R
     Ok(outcome.summary)
 }
 
-/// Whether `current` holds the start `fresh` of its scene: no step made, the same bodies, positions and
-/// velocities.
-fn at_start<E: crate::engine::Engine>(current: &E, fresh: &E) -> bool {
-    current.steps_done() == 0 && current.final_state() == fresh.final_state()
+/// The system a run of `current` starts from when it is recorded as its scene: the scene's start `fresh` for a
+/// resumed run (its checkpoint's run started there), `current` itself when it holds that start (no step made,
+/// the same bodies, positions and velocities); `None` when the run is to record the state instead.
+fn scene_start<E: crate::engine::Engine>(current: &E, fresh: E, resume: bool) -> Option<E> {
+    if resume {
+        Some(fresh)
+    } else if current.steps_done() == 0 && current.final_state() == fresh.final_state() {
+        Some(current.clone())
+    } else {
+        None
+    }
 }
 
 /// Runs the scene file at `scene_path` (either engine: `[simulation] engine`) into the folder `out` through
@@ -374,11 +379,9 @@ fn runner<E: crate::engine::Engine>(
     restart: Restart<E>,
     resume: bool,
 ) -> Result<Runner<E>> {
-    if resume || at_start(current, &fresh) {
-        let system = if resume { fresh } else { current.clone() };
-        Ok(Runner::from_scene(system, plan, path, text, Some(restart)))
-    } else {
-        Ok(Runner::from_system(current.clone(), plan)?.with_restart(path, restart))
+    match scene_start(current, fresh, resume) {
+        Some(system) => Ok(Runner::from_scene(system, plan, path, text, Some(restart))),
+        None => Ok(Runner::from_system(current.clone(), plan)?.with_restart(path, restart)),
     }
 }
 
