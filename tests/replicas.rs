@@ -431,3 +431,68 @@ fn replica_tasks_run_one_by_one_summarize_to_the_whole_studys_bytes() {
         assert!(e.contains("--task: the study has 4 tasks, 0 to 3; got 4"), "{e}");
     }
 }
+
+/// A study's summary table without the columns of wall-clock time (which differ between any two runs).
+fn without_times(path: &Path) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines().map(|l| l.split(',').map(String::from).collect::<Vec<_>>());
+    let header = lines.next().unwrap();
+    let keep: Vec<usize> = (0..header.len()).filter(|&i| !header[i].starts_with("wall_time")).collect();
+    assert!(keep.len() < header.len(), "no wall time column in {}", path.display());
+    std::iter::once(header).chain(lines).map(|row| keep.iter().map(|&i| row[i].clone()).collect()).collect()
+}
+
+/// `saussine steps` with a time step that diverges (3e-2 s: a runaway overlap at step 2) and one that does
+/// not, two replicas each, run as four `--task` processes in a shuffled order and summarized: `steps.csv` is
+/// the whole study's (but for its wall times), the failed runs' status naming their step and body in both
+/// (recorded in their folders, `failed.txt`), and a summary asked for before every task ran names the
+/// missing one.
+#[test]
+fn campaign_tasks_one_by_one_summarize_to_the_whole_studys_table_failures_included() {
+    let dir = scratch::dir("campaign-tasks");
+    let sample = sample(&dir);
+    let base = |out: &Path| -> Vec<String> {
+        [&["saussine", "steps", "--sample", &sample, "--out", out.to_str().unwrap()][..]]
+            .concat()
+            .iter()
+            .chain(&["--dts", "1e-3,3e-2", "--inclinations", "0", "--replicas", "2", "--cycles", "1", "--bars", "0"])
+            .map(|s| s.to_string())
+            .collect()
+    };
+    let call = |args: Vec<String>| Command::new(env!("CARGO_BIN_EXE_ballast")).args(args).arg("--quiet").output();
+    let whole = dir.join("whole");
+    let r = call(base(&whole)).unwrap();
+    let stderr = String::from_utf8_lossy(&r.stderr).into_owned();
+    assert!(r.status.success() && stderr.contains("run incl_0e0_dt_3e-2/replica-1 failed: step "), "{stderr}");
+    let parts = dir.join("parts");
+    let with = |extra: &[&str]| -> Vec<String> {
+        base(&parts).into_iter().chain(extra.iter().map(|s| s.to_string())).collect()
+    };
+    assert_eq!(run(&with(&["--tasks"]).iter().map(String::as_str).collect::<Vec<_>>()).trim(), "4");
+    for k in ["3", "0", "2"] {
+        let r = call(with(&["--task", k])).unwrap();
+        assert!(r.status.success() && String::from_utf8_lossy(&r.stdout).contains("--summarize-only"));
+    }
+    let r = call(with(&["--summarize-only"])).unwrap();
+    let e = String::from_utf8_lossy(&r.stderr).into_owned();
+    assert!(!r.status.success() && e.contains("1 of 4 tasks have no finished run: incl_0e0_dt_1e-3/replica-1"), "{e}");
+    assert!(call(with(&["--task", "1"])).unwrap().status.success());
+    let r = call(with(&["--summarize-only"])).unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let (a, b) = (without_times(&whole.join("steps.csv")), without_times(&parts.join("steps.csv")));
+    assert_eq!(a, b);
+    let status = a[0].iter().position(|h| h == "status").unwrap();
+    let statuses: Vec<&str> = a[1..].iter().map(|row| row[status].as_str()).collect();
+    assert_eq!(&statuses[..2], ["ok", "ok"]);
+    for s in &statuses[2..] {
+        assert!(s.starts_with("failed: step ") && s.contains("runaway overlap"), "{s}");
+    }
+    let recorded = std::fs::read_to_string(parts.join("runs/incl_0e0_dt_3e-2/replica-0/failed.txt")).unwrap();
+    assert_eq!(format!("failed: {}", recorded.trim_end()), statuses[2]);
+    // Every run's own outputs are the whole study's.
+    for run in ["incl_0e0_dt_1e-3/replica-1", "incl_0e0_dt_3e-2/replica-0"] {
+        let f = |d: &Path| std::fs::read(d.join("runs").join(run).join("series.csv")).unwrap();
+        assert_eq!(f(&whole), f(&parts), "{run}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -16,6 +16,7 @@ use ballast::studies::luding::{self, CompareRow, Compression, LoopRow, StrainRow
 use ballast::studies::md_stage::{Stage, TestSpec};
 use ballast::studies::replicas::Replicas;
 use ballast::studies::saussine::{self, Sample};
+use ballast::studies::tasks::Tasks;
 use ballast::studies::{karrech, Quiet, RunDisplay};
 use ballast::Error;
 use std::path::{Path, PathBuf};
@@ -98,13 +99,14 @@ fn saussine_sample_load_and_convergence_study() {
     };
     let record = Record::default();
     let report = campaigns::convergence(&conv, &study, &record).unwrap();
-    assert_eq!(report.table.path, dir.join("conv/convergence.csv"));
+    let table = report.table.as_ref().unwrap();
+    assert_eq!(table.path, dir.join("conv/convergence.csv"));
     assert_eq!(report.runs, dir.join("conv/runs"));
     assert!(report.failed.is_empty(), "{:?}", report.failed);
-    assert_eq!(&report.table.header[..4], ["policy", "tolerance", "min_iterations", "max_iterations"]);
-    let col = |name: &str| report.table.header.iter().position(|h| h == name).unwrap();
-    assert_eq!(report.table.rows.len(), 2);
-    for (row, tol) in report.table.rows.iter().zip([1e-2, 1e-5]) {
+    assert_eq!(&table.header[..4], ["policy", "tolerance", "min_iterations", "max_iterations"]);
+    let col = |name: &str| table.header.iter().position(|h| h == name).unwrap();
+    assert_eq!(table.rows.len(), 2);
+    for (row, tol) in table.rows.iter().zip([1e-2, 1e-5]) {
         assert_eq!(row[col("policy")], "quad");
         assert_eq!(row[col("tolerance")].parse::<f64>().unwrap(), tol);
         assert_eq!((row[col("status")].as_str(), row[col("cycles")].as_str()), ("ok", "1"));
@@ -158,12 +160,13 @@ fn saussine_ensemble_of_two_samples() {
 
     let record = Record::default();
     let report = campaigns::ensemble(&spec, &study, &record).unwrap();
+    let table = report.table.as_ref().unwrap();
     let mut seeds = record.samples.lock().unwrap().clone();
     seeds.sort();
     assert_eq!(seeds, [3, 4]);
-    assert_eq!(report.table.path, dir.join("ens/runs.csv"));
-    assert_eq!(&report.table.header[..2], ["seed", "stiffness_factor"]);
-    assert_eq!(report.table.rows.len(), 2);
+    assert_eq!(table.path, dir.join("ens/runs.csv"));
+    assert_eq!(&table.header[..2], ["seed", "stiffness_factor"]);
+    assert_eq!(table.rows.len(), 2);
     let rows: Vec<EnsembleRow> = ballast::io::read_csv(&dir.join("ens/ensemble.csv")).unwrap();
     assert_eq!(rows.len(), 1);
     let settled: Vec<f64> = [3, 4]
@@ -177,6 +180,41 @@ fn saussine_ensemble_of_two_samples() {
     assert_eq!((rows[0].samples, rows[0].cycle), (2, 1));
     assert!((rows[0].settlement_mean_m - 0.5 * (settled[0] + settled[1])).abs() <= 1e-12 * settled[0].abs().max(1e-9));
     figures_exist(&dir.join("ens"), &["settlement_ensemble"]);
+
+    // The same study as tasks (2 deposits, then 2 loaded runs). A loaded run asked for before its sample is
+    // deposited is refused, naming the deposit's task.
+    let tasks = |t: Tasks| StudyOptions { tasks: t, jobs: Some(1), ..StudyOptions::new(dir.join("tasks")) };
+    assert_eq!(spec.task_count(), 4);
+    assert!(input_error(campaigns::ensemble(&spec, &tasks(Tasks::One(3)), &Quiet)).contains("seed_3 is not (task 0"));
+    // Two processes sharing them (threads here; an MPI barrier there) meet between the deposits and the runs
+    // that need them: each rank's loaded run is on the sample the other rank deposited.
+    static BARRIER: std::sync::OnceLock<std::sync::Barrier> = std::sync::OnceLock::new();
+    BARRIER.get_or_init(|| std::sync::Barrier::new(2));
+    fn meet() {
+        BARRIER.get().unwrap().wait();
+    }
+    std::thread::scope(|s| {
+        let ranks: Vec<_> = (0..2)
+            .map(|rank| {
+                let o = StudyOptions { stage_done: meet, ..tasks(Tasks::Share { rank, size: 2 }) };
+                let spec = &spec;
+                s.spawn(move || campaigns::ensemble(spec, &o, &Quiet).unwrap())
+            })
+            .collect();
+        for r in ranks {
+            let r = r.join().unwrap();
+            assert!(r.table.is_none() && r.failed.is_empty());
+        }
+    });
+    assert!(!dir.join("tasks/ensemble.csv").exists());
+    let summary = campaigns::ensemble(&spec, &tasks(Tasks::Summarize), &Quiet).unwrap();
+    assert_eq!(summary.table.unwrap().rows.len(), 2);
+    // The samples, hence the runs and the ensemble, are those of the whole study, byte for byte.
+    let bytes = |d: &str, f: &str| std::fs::read(dir.join(d).join(f)).unwrap();
+    assert_eq!(bytes("ens", "ensemble.csv"), bytes("tasks", "ensemble.csv"));
+    for f in ["samples/seed_4/sample.toml", "runs/seed_3_k_1e0/cycles.csv", "runs/seed_4_k_1e0/series.csv"] {
+        assert_eq!(bytes("ens", f), bytes("tasks", f), "{f}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -278,9 +278,11 @@ fn run_study(
     (out, jobs, resume, checkpoint_every): (PathBuf, Option<usize>, bool, f64),
     run: impl FnOnce(&StudyOptions) -> ballast_core::Result<StudyReport> + Send,
 ) -> PyResult<(String, Vec<(String, String)>)> {
-    let study = StudyOptions { out, jobs, resume, checkpoint_every_s: checkpoint_every };
+    let study = StudyOptions { jobs, resume, checkpoint_every_s: checkpoint_every, ..StudyOptions::new(out) };
     let report = py.detach(|| run(&study)).map_err(to_py)?;
-    Ok((report.table.path.display().to_string(), report.failed))
+    // Every task runs here (StudyOptions::new), so the summary is written.
+    let table = report.table.ok_or_else(|| pyo3::exceptions::PyRuntimeError::new_err("the study wrote no summary"))?;
+    Ok((table.path.display().to_string(), report.failed))
 }
 
 /// Saussine §3.2 (`ballast saussine convergence`) into `out`; the path of `convergence.csv` and the failed

@@ -3,7 +3,6 @@
 //! others, and rank 0 writes the summary from the tasks' folders. Without the feature, or on one rank, a study
 //! runs as it always does.
 
-use ballast::studies::saussine::{SettleOptions, SettleReplicas};
 use ballast::studies::tasks::Tasks;
 use std::sync::OnceLock;
 
@@ -66,23 +65,25 @@ pub(crate) fn share(selection: Tasks) -> Tasks {
     }
 }
 
-/// Runs a replica study with `opts` (`study`); on a rank's share, waits for every rank, and rank 0 writes the
-/// summary from the folders: what to print (`None` on the other ranks, which print their own failures).
+/// Runs a study whose tasks are `tasks` (`study` with a selection of them); on a rank's share, waits for every
+/// rank, and rank 0 writes the summary from the folders: what to print (`None` on the other ranks, which
+/// print their own failures, `failed` of the report).
 ///
 /// # Errors
 /// The study's.
-pub(crate) fn shared(
-    opts: &SettleOptions,
-    study: impl Fn(&SettleOptions) -> ballast::Result<SettleReplicas>,
-) -> ballast::Result<Option<SettleReplicas>> {
-    let r = study(opts)?;
-    let Tasks::Share { rank, .. } = opts.tasks else { return Ok(Some(r)) };
+pub(crate) fn shared<R>(
+    tasks: Tasks,
+    study: impl Fn(Tasks) -> ballast::Result<R>,
+    failed: impl Fn(&R) -> &[(String, String)],
+) -> ballast::Result<Option<R>> {
+    let r = study(tasks)?;
+    let Tasks::Share { rank, .. } = tasks else { return Ok(Some(r)) };
     barrier();
     if rank > 0 {
-        for (label, e) in &r.failed {
+        for (label, e) in failed(&r) {
             eprintln!("run {label} failed: {e}");
         }
         return Ok(None);
     }
-    study(&SettleOptions { tasks: Tasks::Summarize, ..opts.clone() }).map(Some)
+    study(Tasks::Summarize).map(Some)
 }

@@ -42,15 +42,22 @@ pub fn main(args: CompareArgs) -> Result<(), Failure> {
         replicas: args.replicas.replicas(),
         loading: args.loading.loading()?,
     };
-    let report = compare::compare(&spec, &args.study.options(), &Bars::group(args.study.quiet))?;
+    let bars = Bars::group(args.study.quiet);
+    args.study.run(|| spec.task_count(), |o| compare::compare(&spec, o, &bars), |r| &r.study.failed, print)
+}
+
+/// The failed runs, `compare.md` and where the outputs are.
+fn print(report: &compare::CompareReport) {
+    let Some(table) = &report.study.table else {
+        return super::print_study(&report.study);
+    };
     for (label, e) in &report.study.failed {
         eprintln!("run {label} failed: {e}");
     }
-    let table = report.study.table.path.with_file_name("compare.md");
-    match std::fs::read_to_string(&table) {
+    let md = table.path.with_file_name("compare.md");
+    match std::fs::read_to_string(&md) {
         Ok(text) => println!("{text}"),
-        Err(e) => eprintln!("{}: {e}", table.display()),
+        Err(e) => eprintln!("{}: {e}", md.display()),
     }
-    println!("per cycle: {}; runs in {}", report.study.table.path.display(), report.study.runs.display());
-    Ok(())
+    println!("per cycle: {}; runs in {}", table.path.display(), report.study.runs.display());
 }

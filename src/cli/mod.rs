@@ -304,9 +304,16 @@ pub(crate) fn print_study(r: &StudyReport) {
     for (label, e) in &r.failed {
         eprintln!("run {label} failed: {e}");
     }
-    println!("{}", r.table.header.join("  "));
-    for row in &r.table.rows {
+    let Some(table) = &r.table else {
+        println!(
+            "task done (runs in {}); --summarize-only writes the summary once every task has run",
+            r.runs.display()
+        );
+        return;
+    };
+    println!("{}", table.header.join("  "));
+    for row in &table.rows {
         println!("{}", row.join("  "));
     }
-    println!("summary: {}; runs in {}", r.table.path.display(), r.runs.display());
+    println!("summary: {}; runs in {}", table.path.display(), r.runs.display());
 }

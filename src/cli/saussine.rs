@@ -311,16 +311,42 @@ pub struct StudyArgs {
     /// No progress bars.
     #[arg(long)]
     pub quiet: bool,
+    #[command(flatten)]
+    pub tasks: TaskArgs,
 }
 
 impl StudyArgs {
+    /// The library's options: the tasks asked for, or this MPI rank's share of them.
     pub(crate) fn options(&self) -> StudyOptions {
         StudyOptions {
             out: self.out.clone(),
             jobs: self.jobs,
             resume: self.resume,
             checkpoint_every_s: self.checkpoint_every,
+            tasks: super::cluster::share(self.tasks.selection()),
+            stage_done: super::cluster::barrier,
         }
+    }
+
+    /// Runs `study` with these options (on MPI ranks, each its share, then rank 0 the summary) and prints its
+    /// report; with `--tasks`, prints the study's `count` tasks instead.
+    pub(crate) fn run<R>(
+        &self,
+        count: impl FnOnce() -> u64,
+        study: impl Fn(&StudyOptions) -> ballast::Result<R>,
+        failed: impl Fn(&R) -> &[(String, String)],
+        print: impl FnOnce(&R),
+    ) -> Result<(), Failure> {
+        if self.tasks.tasks {
+            println!("{}", count());
+            return Ok(());
+        }
+        let opts = self.options();
+        let run = |tasks| study(&StudyOptions { tasks, ..opts.clone() });
+        if let Some(r) = super::cluster::shared(opts.tasks, run, failed)? {
+            print(&r);
+        }
+        Ok(())
     }
 }
 
@@ -536,7 +562,11 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                             &sample, &loading, &acc, &out, opts, &replicas, jobs,
                         )
                     };
-                    if let Some(r) = super::cluster::shared(&opts, study)? {
+                    if let Some(r) = super::cluster::shared(
+                        opts.tasks,
+                        |tasks| study(&SettleOptions { tasks, ..opts.clone() }),
+                        |r| &r.failed,
+                    )? {
                         print_replicas(&r);
                     }
                     return Ok(());
@@ -566,7 +596,11 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                 let study = |opts: &SettleOptions| {
                     saussine::settle_replicas(&sample, &loading, &out, opts, &replicas, jobs, &bars)
                 };
-                if let Some(r) = super::cluster::shared(&opts, study)? {
+                if let Some(r) = super::cluster::shared(
+                    opts.tasks,
+                    |tasks| study(&SettleOptions { tasks, ..opts.clone() }),
+                    |r| &r.failed,
+                )? {
                     print_replicas(&r);
                 }
             }
@@ -580,16 +614,19 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                 replicas: replicas.replicas(),
                 loading: loading.loading()?,
             };
-            print_study(&campaigns::convergence(&spec, &study.options(), &Bars::group(study.quiet))?);
+            let bars = Bars::group(study.quiet);
+            study.run(|| spec.task_count(), |o| campaigns::convergence(&spec, o, &bars), |r| &r.failed, print_study)?;
         }
         SaussineCommand::Steps { sample, dts, inclinations, replicas, loading, study } => {
             let spec =
                 StepsSpec { sample, dts, inclinations, replicas: replicas.replicas(), loading: loading.loading()? };
-            print_study(&campaigns::steps(&spec, &study.options(), &Bars::group(study.quiet))?);
+            let bars = Bars::group(study.quiet);
+            study.run(|| spec.task_count(), |o| campaigns::steps(&spec, o, &bars), |r| &r.failed, print_study)?;
         }
         SaussineCommand::Ensemble { samples, first_seed, factors, grains, sample_dt, loading, study } => {
             let spec = EnsembleSpec { samples, first_seed, factors, grains, sample_dt, loading: loading.loading()? };
-            print_study(&campaigns::ensemble(&spec, &study.options(), &Bars::group(study.quiet))?);
+            let bars = Bars::group(study.quiet);
+            study.run(|| spec.task_count(), |o| campaigns::ensemble(&spec, o, &bars), |r| &r.failed, print_study)?;
         }
     }
     Ok(())

@@ -15,6 +15,7 @@
 //! - [`FINAL_SCENE`]: the input scene with the final state, to restart from;
 //! - [`RUN_INFO`]: seed, engine, crate version, number of steps, time step ([`super::RunInfo`]);
 //! - [`CHECKPOINT`]: the whole state, every few minutes, for `--resume` ([`crate::run::Checkpoint`]);
+//! - a study's task that failed: [`FAILED`], its one-line error ([`crate::studies::tasks`]);
 //! - with `vtk_every`: [`VTK_DIR`]`/*.vtp` and [`PVD`], snapshots that ParaView opens and animates
 //!   ([`super::vtk`]);
 //! - an accelerated run (Karrech et al. 2007, Fig. 10): [`SETTLEMENT`] per cycle, [`JUMPS`] per jump, and
@@ -46,6 +47,9 @@ pub const PVD: &str = "run.pvd";
 pub const VTK_DIR: &str = "vtk";
 /// The checkpoint to resume from.
 pub const CHECKPOINT: &str = "checkpoint.json";
+/// The one-line error of a study's run that failed (a diverged run), which the study's summary reports
+/// however the run was launched; removed when the run is run again and ends.
+pub const FAILED: &str = "failed.txt";
 /// The reference coordinates of the bodies whose positions are followed cycle by cycle.
 pub const CYCLE_BODIES: &str = "cycle_bodies.csv";
 /// Their displacements at each cycle end.

@@ -11,7 +11,7 @@ use super::saussine::{
     finish_replicas, not_summarized, replica_dir, replica_folders, replica_jobs, settle_accelerated,
 };
 use super::saussine::{Accelerate, SettleOptions, SettleReplicas};
-use super::tasks::{failures_from_folders, Tasks};
+use super::tasks::failures_from_folders;
 use crate::error::Result;
 use crate::io;
 use crate::io::layout;
@@ -68,20 +68,22 @@ pub fn settle_accelerated_replicas(
                     let opts = SettleOptions { resume: prior == Prior::Checkpointed, ..opts.clone() };
                     let dir = replica_dir(out, r);
                     let threads = super::campaigns::run_threads(if opts.tasks.side_by_side() { threads } else { 1 });
-                    settle_accelerated(sample, loading, &start, accelerate, &dir, &opts, threads, &mut |_| {})
-                        .map(|_| ())
+                    let result =
+                        settle_accelerated(sample, loading, &start, accelerate, &dir, &opts, threads, &mut |_| {})
+                            .map(|_| ());
+                    super::tasks::record(&dir, &result)?;
+                    result
                 }
             })
             .collect()
     });
     let seating = replicas.seating_cycles.min(loading.cycles);
     let read = |path: &Path| io::read_csv::<SettlementRow>(path);
-    let failures = match opts.tasks {
-        Tasks::Summarize => failures_from_folders(&replica_folders(out, replicas.count))?,
-        _ => super::saussine::failures(results)?,
-    };
+    let failures = super::saussine::failures(results)?;
     if !opts.tasks.summarizes() {
         return Ok(not_summarized(out, &failures));
     }
+    // The ends recorded in the folders: also those of the replicas an earlier invocation ran.
+    let failures = failures_from_folders(&replica_folders(out, replicas.count))?;
     finish_replicas(out, &failures, "settlement.csv", read, seating, "Settlement of the sleeper, accelerated")
 }

@@ -27,8 +27,8 @@
 //! settlement is counted from the seating cycle `S` ([`Replicas::seating_cycles`]).
 
 use super::campaigns::{
-    cycles_of, label_number, replicate, report, run_jobs, settlement_figure, Job, Outcome, Source, StudyOptions,
-    StudyReport,
+    cycles_of, label_number, not_summarized, replicate, report, run_jobs, settlement_figure, Job, Outcome, Source,
+    StudyOptions, StudyReport,
 };
 use super::replicas::{welch, Difference, Estimate, Replicas, SettlementSummary};
 use super::{write_file, RunDisplay};
@@ -64,6 +64,13 @@ pub struct CompareSpec {
     pub replicas: Replicas,
     /// The loading of a deposited sample (its `cycles` applies to a loaded scene too).
     pub loading: LoadingSpec,
+}
+
+impl CompareSpec {
+    /// The study's tasks (`--tasks`): the settings (NSCD and each overlap ratio) × the replicas.
+    pub fn task_count(&self) -> u64 {
+        (1 + self.overlaps.len() as u64) * self.replicas.count
+    }
 }
 
 /// One row of `compare.csv`: one run (an engine, a stiffness, a replica) at
@@ -266,7 +273,10 @@ pub fn compare(spec: &CompareSpec, study: &StudyOptions, display: &dyn RunDispla
         &spec.replicas,
     );
     let mut failed = Vec::new();
-    let outcomes = run_jobs(&jobs, study, display, &mut failed)?;
+    study.tasks.check(jobs.len() as u64)?;
+    let Some(outcomes) = run_jobs(&jobs, 0, study, display, &mut failed)? else {
+        return Ok(CompareReport { study: not_summarized(&study.out, failed), settings: vec![] });
+    };
     let r = spec.replicas.count as usize;
     let seating = spec.replicas.seating_cycles.min(spec.loading.cycles);
     let per_setting: Vec<Vec<&Outcome>> = outcomes.chunks(r).map(|c| c.iter().collect()).collect();

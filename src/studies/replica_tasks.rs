@@ -63,7 +63,8 @@ pub fn write_starts(
 
 /// Runs replica `r` of the study in `out` from its folder (its `loaded.toml`, written by [`write_starts`]) as
 /// `ballast saussine settle --replicas` runs it, on `threads` threads: `opts.resume` skips a finished replica
-/// and resumes a checkpointed one. The run is labelled `replica-<r>`.
+/// and resumes a checkpointed one. The run is labelled `replica-<r>`; a run that fails leaves its error in the
+/// folder ([`super::tasks::record`]) for the summary.
 ///
 /// # Errors
 /// [`Error::Scene`] if the start is missing or invalid; else as [`crate::run::Runner::run`].
@@ -78,7 +79,9 @@ pub fn run_replica(out: &Path, r: u64, opts: &SettleOptions, threads: usize, dis
     let frequency = scene.plan()?.cycles.map_or(1.0 / scene.simulation.dt, |c| c.frequency);
     let per_cycle = steps_per_cycle(frequency, scene.simulation.dt);
     let resume = prior == Prior::Checkpointed;
-    run_settle(&path, &dir, per_cycle, opts, threads, resume, display, &format!("replica-{r}")).map(drop)
+    let result = run_settle(&path, &dir, per_cycle, opts, threads, resume, display, &format!("replica-{r}")).map(drop);
+    super::tasks::record(&dir, &result)?;
+    result
 }
 
 /// The ensemble of the replicas in `out` (`failures[r]`: the one-line error of replica `r`, `None` if it ran;

@@ -349,13 +349,12 @@ pub fn settle_replicas(
             })
             .collect()
     });
-    let failures = match opts.tasks {
-        Tasks::Summarize => failures_from_folders(&replica_folders(out, replicas.count))?,
-        _ => failures(results)?,
-    };
+    let failures = failures(results)?;
     if !opts.tasks.summarizes() {
         return Ok(not_summarized(out, &failures));
     }
+    // The ends recorded in the folders: also those of the replicas an earlier invocation ran.
+    let failures = failures_from_folders(&replica_folders(out, replicas.count))?;
     super::replica_tasks::finish(out, &failures, tasks.seating)
 }
 

@@ -7,7 +7,7 @@
 
 use crate::error::{Error, Result};
 use crate::io::layout;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Which of a study's tasks (`0..count`, in the study's fixed order) this invocation runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -68,28 +68,64 @@ impl Tasks {
     }
 }
 
-/// The failures of the tasks in `folders` (`(label, folder)`, in task order), read from the folders for a
-/// summary written apart from the runs: `None` for a run that ended, `Some` with how it ended for one that
-/// diverged or stalled (its `summary.json`'s `end`).
+/// Records in the folder `dir` of a task how its run ended (`result`), so that a summary written later, by
+/// another process, reports it: [`layout::FAILED`] with the one-line error of a run that failed, none for a
+/// run that ended. An input error ([`Error::is_input`]: an invalid scene or checkpoint, which stops the
+/// study) is not a run's end and is not recorded.
 ///
 /// # Errors
-/// [`Error::Scene`] naming the tasks whose folder holds no finished run (no `summary.json`, or a
-/// checkpoint still to resume), or whose `summary.json` cannot be read.
+/// The record that cannot be written or removed.
+pub fn record(dir: &Path, result: &Result<()>) -> Result<()> {
+    let path = dir.join(layout::FAILED);
+    match result {
+        Ok(()) if path.exists() => std::fs::remove_file(&path).map_err(|e| crate::io::io_error(&path, "remove", e)),
+        Err(e) if !e.is_input() => {
+            std::fs::write(&path, format!("{}\n", e.one_line())).map_err(|e| crate::io::io_error(&path, "write", e))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// How the run in the folder `dir` ended, for a summary: `None` if it holds no finished run (no
+/// `summary.json`, or a checkpoint still to resume), `Some(None)` for a run that ended, `Some(Some(error))` for
+/// one that failed: its [`layout::FAILED`], else, for a folder without one whose `summary.json` says the run
+/// diverged or stalled, that.
+///
+/// # Errors
+/// A `summary.json` or record that cannot be read.
+pub fn folder_end(dir: &Path) -> Result<Option<Option<String>>> {
+    let summary = dir.join(layout::SUMMARY);
+    if !summary.is_file() || dir.join(layout::CHECKPOINT).exists() {
+        return Ok(None);
+    }
+    let failed = dir.join(layout::FAILED);
+    if failed.is_file() {
+        let text = std::fs::read_to_string(&failed).map_err(|e| crate::io::io_error(&failed, "read", e))?;
+        return Ok(Some(Some(text.trim_end().to_string())));
+    }
+    let text = std::fs::read_to_string(&summary).map_err(|e| crate::io::io_error(&summary, "read", e))?;
+    let value: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| Error::Scene(format!("{}: not a run's summary: {e}", summary.display())))?;
+    let end = value.get("end").and_then(|e| e.as_str()).unwrap_or("");
+    Ok(Some(matches!(end, "diverged" | "stalled").then(|| format!("the run {end} (its summary.json)"))))
+}
+
+/// The failures of the tasks in `folders` (`(label, folder)`, in task order), read from the folders
+/// ([`folder_end`]) for a summary: `None` for a run that ended, `Some` with the error of one that failed.
+///
+/// # Errors
+/// [`Error::Scene`] naming the tasks whose folder holds no finished run, or a folder that cannot be read.
 pub fn failures_from_folders(folders: &[(String, PathBuf)]) -> Result<Vec<Option<String>>> {
     let mut missing = Vec::new();
     let mut failures = Vec::with_capacity(folders.len());
     for (label, dir) in folders {
-        let summary = dir.join(layout::SUMMARY);
-        if !summary.is_file() || dir.join(layout::CHECKPOINT).exists() {
-            missing.push(label.as_str());
-            failures.push(None);
-            continue;
+        match folder_end(dir)? {
+            Some(end) => failures.push(end),
+            None => {
+                missing.push(label.as_str());
+                failures.push(None);
+            }
         }
-        let text = std::fs::read_to_string(&summary).map_err(|e| crate::io::io_error(&summary, "read", e))?;
-        let value: serde_json::Value = serde_json::from_str(&text)
-            .map_err(|e| Error::Scene(format!("{}: not a run's summary: {e}", summary.display())))?;
-        let end = value.get("end").and_then(|e| e.as_str()).unwrap_or("");
-        failures.push(matches!(end, "diverged" | "stalled").then(|| format!("the run {end} (its summary.json)")));
     }
     if !missing.is_empty() {
         return Err(Error::Scene(format!(

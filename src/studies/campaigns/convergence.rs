@@ -21,6 +21,22 @@ pub struct ConvergenceSpec {
     pub loading: LoadingSpec,
 }
 
+impl ConvergenceSpec {
+    /// The runs' settings `(policy, tolerance)`: those given, else the paper's table.
+    fn settings(&self) -> Vec<(String, f64)> {
+        if self.policies.is_empty() {
+            PAPER_POLICIES.iter().map(|&(p, t)| (p.to_string(), t)).collect()
+        } else {
+            self.policies.clone()
+        }
+    }
+
+    /// The study's tasks (`--tasks`): the settings × the replicas.
+    pub fn task_count(&self) -> u64 {
+        self.settings().len() as u64 * self.replicas.count
+    }
+}
+
 /// The reference setting of [`ConvergenceSpec::reference`] among `runs`: its index.
 fn reference_of(runs: &[(String, f64)], given: Option<&(String, f64)>) -> Result<usize> {
     if let Some((p, t)) = given {
@@ -54,11 +70,7 @@ fn reference_of(runs: &[(String, f64)], given: Option<&(String, f64)>) -> Result
 pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
     crate::io::figures::require()?; // the stage ends with its figures
     spec.replicas.check()?;
-    let runs: Vec<(String, f64)> = if spec.policies.is_empty() {
-        PAPER_POLICIES.iter().map(|&(p, t)| (p.to_string(), t)).collect()
-    } else {
-        spec.policies.clone()
-    };
+    let runs = spec.settings();
     let reference = reference_of(&runs, spec.reference.as_ref())?;
     let sample_path = &spec.sample;
     let sample_scene = Scene::load(sample_path)?;
@@ -76,7 +88,10 @@ pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn R
         .collect();
     let jobs = replicate(settings, &spec.replicas);
     let mut failed = Vec::new();
-    let outcomes = run_jobs(&jobs, study, display, &mut failed)?;
+    study.tasks.check(jobs.len() as u64)?;
+    let Some(outcomes) = run_jobs(&jobs, 0, study, display, &mut failed)? else {
+        return Ok(not_summarized(&study.out, failed));
+    };
     let r = spec.replicas.count as usize;
     let seating = spec.replicas.seating_cycles.min(spec.loading.cycles);
     let per_setting: Vec<Vec<&Outcome>> = outcomes.chunks(r).map(|c| c.iter().collect()).collect();

@@ -47,6 +47,14 @@ pub struct EnsembleSpec {
     pub loading: LoadingSpec,
 }
 
+impl EnsembleSpec {
+    /// The study's tasks (`--tasks`): the deposits (tasks `0..samples`, seed after seed), then every sample on
+    /// every sublayer (tasks `samples..`, seed-major, factor-minor), which need the deposits finished.
+    pub fn task_count(&self) -> u64 {
+        self.samples * (1 + self.factors.len() as u64)
+    }
+}
+
 /// §4.2 (`ballast saussine ensemble`): the samples deposited side by side in
 /// `DIR/samples/seed_<seed>/` ([`crate::studies::saussine::sample`], each told to
 /// [`RunDisplay::sample`]), then one run per sample and stiffness, labelled
@@ -57,7 +65,10 @@ pub struct EnsembleSpec {
 /// # Errors
 /// As [`convergence`]; no sample or a stiffness factor that is not positive is
 /// an [`Error::Scene`], and so is an invalid loading or option, before any
-/// deposit. A deposit that fails stops the study.
+/// deposit. A deposit that fails stops the study. With [`StudyOptions::tasks`], the deposits are tasks
+/// `0..samples` and the loaded runs the next ones ([`EnsembleSpec::task_count`]); the invocation calls
+/// [`StudyOptions::stage_done`] between the two stages, and a loaded run asked for while a sample is not
+/// deposited is an [`Error::Scene`] naming the deposit's task.
 pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
     crate::io::figures::require()?; // the stage ends with its figures
     let factors = &spec.factors;
@@ -74,14 +85,18 @@ pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisp
         loading.check()?;
     }
     let threads = study.threads()?;
+    study.tasks.check(spec.task_count())?;
     let out = &study.out;
     let seeds: Vec<u64> = (0..spec.samples).map(|k| spec.first_seed + k).collect();
-    // 1. The samples, deposited side by side.
+    // 1. The samples, deposited side by side (tasks 0..samples).
     let pool = pool(threads)?;
+    let side_by_side = if study.tasks.side_by_side() { threads } else { 1 };
     let deposited: Vec<Result<()>> = pool.install(|| {
         seeds
             .par_iter()
-            .map(|&seed| {
+            .enumerate()
+            .filter(|(i, _)| study.tasks.runs(*i as u64))
+            .map(|(_, &seed)| {
                 let mut sample_spec = SampleSpec { dt: spec.sample_dt, ..SampleSpec::saussine(seed) };
                 if let Some(n) = spec.grains {
                     sample_spec = sample_spec.scaled(n);
@@ -90,18 +105,30 @@ pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisp
                 if study.resume && dir.join("sample.toml").exists() {
                     return Ok(());
                 }
-                let s = sample(&sample_spec, &dir, study.resume, run_threads(threads), display)?;
+                let s = sample(&sample_spec, &dir, study.resume, run_threads(side_by_side), display)?;
                 display.sample(&s);
                 Ok(())
             })
             .collect()
     });
     deposited.into_iter().collect::<Result<Vec<()>>>()?;
-    // 2. Every sample on every sublayer.
+    (study.stage_done)();
+    let loads = spec.samples..spec.task_count();
+    if !loads.clone().any(|k| study.tasks.runs(k)) && !study.tasks.summarizes() {
+        return Ok(not_summarized(out, Vec::new()));
+    }
+    // 2. Every sample on every sublayer (tasks samples..).
     let mut jobs = Vec::new();
     let mut keys = Vec::new();
-    for &seed in &seeds {
+    for (i, &seed) in seeds.iter().enumerate() {
         let sample_path = out.join("samples").join(format!("seed_{seed}")).join("sample.toml");
+        if !sample_path.is_file() {
+            return Err(Error::Scene(format!(
+                "task: the loaded runs need every sample deposited first: seed_{seed} is not (task {i}; \
+                 deposits are tasks 0 to {})",
+                spec.samples - 1
+            )));
+        }
         let sample_scene = Scene::load(&sample_path).map_err(output_error)?;
         for (&k, loading) in factors.iter().zip(&loadings) {
             jobs.push(Job::loaded(
@@ -114,7 +141,9 @@ pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisp
         }
     }
     let mut failed = Vec::new();
-    let outcomes = run_jobs(&jobs, study, display, &mut failed)?;
+    let Some(outcomes) = run_jobs(&jobs, spec.samples, study, display, &mut failed)? else {
+        return Ok(not_summarized(out, failed));
+    };
     // 3. Per run, and mean and spread per stiffness and cycle.
     let rows: Vec<_> = keys.iter().zip(&outcomes).map(|(&(seed, k), o)| ((seed, k), run_columns(o))).collect();
     write_table(&out.join("runs.csv"), &["seed", "stiffness_factor"], &RUN_COLUMNS, &rows)?;

@@ -48,6 +48,7 @@ use super::replicas::{
     SettlementSummary, ENSEMBLE_COLUMNS, REFERENCE_COLUMNS, REPLICA_FILE,
 };
 use super::saussine::sample;
+use super::tasks::{failures_from_folders, record, Tasks};
 use super::{axes, output_error, run_scene, RunDisplay, SummaryTable};
 use crate::error::{Error, Result};
 use crate::io;
@@ -66,7 +67,7 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// Settings shared by the studies.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct StudyOptions {
     /// Output directory of the study.
     pub out: PathBuf,
@@ -76,12 +77,30 @@ pub struct StudyOptions {
     pub resume: bool,
     /// Wall-clock seconds between checkpoints of each run.
     pub checkpoint_every_s: f64,
+    /// Which of the study's tasks this invocation runs, and whether it writes the summary (default: every
+    /// task, then the summary). A study's tasks are its runs in the order of its summary (settings ×
+    /// replicas; for [`ensemble`], the deposits first, then samples × stiffnesses).
+    pub tasks: Tasks,
+    /// Called by a study of two stages ([`ensemble`]: the deposits, then the loaded runs that need them) when
+    /// this invocation is done with its tasks of the first: with [`Tasks::Share`] it must return only once
+    /// every process sharing the tasks is done with it too (an MPI barrier). Default: returns at once.
+    pub stage_done: fn(),
 }
 
+/// A [`StudyOptions::stage_done`] that returns at once.
+fn no_wait() {}
+
 impl StudyOptions {
-    /// A fresh study in `out`: one run per core, checkpoints every 5 minutes.
+    /// A fresh study in `out`: every task, one run per core, checkpoints every 5 minutes.
     pub fn new(out: impl Into<PathBuf>) -> Self {
-        Self { out: out.into(), jobs: None, resume: false, checkpoint_every_s: 300.0 }
+        Self {
+            out: out.into(),
+            jobs: None,
+            resume: false,
+            checkpoint_every_s: 300.0,
+            tasks: Tasks::All,
+            stage_done: no_wait,
+        }
     }
 
     /// The runs at once (the pool's threads).
@@ -103,11 +122,13 @@ impl StudyOptions {
 /// the runs that failed (reported in the table's `status`; the others went on).
 #[derive(Debug, Clone, PartialEq)]
 pub struct StudyReport {
-    /// The summary CSV: `convergence.csv`, `steps.csv` or `runs.csv`.
-    pub table: SummaryTable,
+    /// The summary CSV: `convergence.csv`, `steps.csv` or `runs.csv`; `None` when the invocation ran tasks
+    /// without the summary ([`StudyOptions::tasks`]).
+    pub table: Option<SummaryTable>,
     /// The folder of the runs, `DIR/runs`.
     pub runs: PathBuf,
-    /// `(label, error)` of each run that failed in this invocation.
+    /// `(label, error)` of each run that failed: with the summary, every failed run of the study (also those
+    /// of earlier invocations, read from their folders); without it, those of this invocation.
     pub failed: Vec<(String, String)>,
 }
 
@@ -282,22 +303,30 @@ pub(crate) fn run_threads(pool: usize) -> usize {
     }
 }
 
-/// Writes the scenes of `jobs`, runs them `study.jobs` at a time and reads
-/// back their outcomes; the failed runs are added to `failed`.
+/// Runs the `jobs` (task `first + j` is job `j`) that `study.tasks` selects, `study.jobs` at a time, each
+/// from its scene (written first); the failed runs are added to `failed`. Then, for an invocation that
+/// writes the summary, reads back the outcome of every job from its folder (`None` for one that does not).
+///
+/// # Errors
+/// An invalid scene or checkpoint (before any run for a scene); with the summary, a job without a finished
+/// run (named).
 pub(super) fn run_jobs(
     jobs: &[Job],
+    first: u64,
     study: &StudyOptions,
     display: &dyn RunDisplay,
     failed: &mut Vec<(String, String)>,
-) -> Result<Vec<Outcome>> {
+) -> Result<Option<Vec<Outcome>>> {
     let out = &study.out;
     let threads = study.threads()?;
+    let runs = |j: usize| study.tasks.runs(first + j as u64);
     for dir in ["scenes", "runs"] {
         io::create_output_dir(&out.join(dir))?;
     }
-    // All scenes first, so that an invalid one stops the study before any run.
+    // Every scene first, so that an invalid one stops the study before any run; written for the runs this
+    // invocation makes (processes running other tasks write theirs).
     let mut samples: Vec<(PathBuf, Scene)> = Vec::new();
-    for job in jobs {
+    for (j, job) in jobs.iter().enumerate() {
         let (mut loaded, from) = match &job.source {
             Source::Loaded { spec, sample: path } => {
                 let sample = match samples.iter().find(|(p, _)| p == path) {
@@ -313,6 +342,9 @@ pub(super) fn run_jobs(
             Source::Ready(scene) => ((**scene).clone(), String::new()),
         };
         let record = perturb_scene(&mut loaded, &job.perturbation, job.replica)?;
+        if !runs(j) {
+            continue;
+        }
         let what = format!("{} of the study in {}{from}", job.label, out.display());
         let scene = job.scene(out);
         if let Some(parent) = scene.parent() {
@@ -323,38 +355,53 @@ pub(super) fn run_jobs(
         io::write_json(&job.dir(out).join(REPLICA_FILE), &record)?;
     }
     let pool = pool(threads)?;
+    let side_by_side = if study.tasks.side_by_side() { threads } else { 1 };
     let results: Vec<Result<()>> = pool.install(|| {
         jobs.par_iter()
-            .map(|job| {
+            .enumerate()
+            .map(|(j, job)| {
                 let dir = job.dir(out);
                 // summary.json: a diverged run is finished too (and reported as such).
                 let prior = Prior::of(&dir, layout::SUMMARY, study.resume);
-                if prior == Prior::Finished {
+                if !runs(j) || prior == Prior::Finished {
                     return Ok(());
                 }
                 let opts = RunOptions {
                     checkpoint_every_s: study.checkpoint_every_s,
                     resume: prior == Prior::Checkpointed,
                     figures: true,
-                    threads: run_threads(threads),
+                    threads: run_threads(side_by_side),
                     ..RunOptions::default()
                 };
-                run_scene(&job.scene(out), &dir, &opts, display, &job.label).map(|_| ())
+                let result = run_scene(&job.scene(out), &dir, &opts, display, &job.label).map(|_| ());
+                record(&dir, &result)?;
+                result
             })
             .collect()
     });
-    let mut outcomes = Vec::with_capacity(jobs.len());
     for (job, result) in jobs.iter().zip(results) {
-        let dir = job.dir(out);
-        let status = match result {
-            // Skipped on --resume, but diverged in an earlier invocation (no final scene).
-            Ok(()) if !dir.join(layout::FINAL_SCENE).exists() => "failed in an earlier invocation".to_string(),
-            Ok(()) => "ok".to_string(),
+        match result {
+            Ok(()) => {}
             Err(e) if e.is_input() => return Err(e),
-            // A diverged run still wrote its series and summary: keep it in the study.
-            Err(e) => {
-                failed.push((job.label.clone(), e.to_string()));
-                format!("failed: {}", e.one_line())
+            // A diverged run still wrote its series and summary: kept in the study.
+            Err(e) => failed.push((job.label.clone(), e.to_string())),
+        }
+    }
+    if !study.tasks.summarizes() {
+        return Ok(None);
+    }
+    // The ends recorded in the folders, whichever invocation ran each job.
+    let folders: Vec<(String, PathBuf)> = jobs.iter().map(|j| (j.label.clone(), j.dir(out))).collect();
+    let ends = failures_from_folders(&folders)?;
+    failed.clear();
+    let mut outcomes = Vec::with_capacity(jobs.len());
+    for (job, end) in jobs.iter().zip(ends) {
+        let dir = job.dir(out);
+        let status = match end {
+            None => "ok".to_string(),
+            Some(e) => {
+                failed.push((job.label.clone(), e.clone()));
+                format!("failed: {e}")
             }
         };
         let report = std::fs::read_to_string(dir.join(layout::SUMMARY))
@@ -365,7 +412,7 @@ pub(super) fn run_jobs(
         let cycles = if cycles_path.exists() { crate::plane::rows::read_cycles(&cycles_path)? } else { vec![] };
         outcomes.push(Outcome { status, report, series, cycles });
     }
-    Ok(outcomes)
+    Ok(Some(outcomes))
 }
 
 /// The columns of a study's summary CSVs that describe one run, from its report
@@ -399,7 +446,7 @@ pub struct RunColumns {
     /// Column `settlement_at_min_load_m`: the sleeper's settlement at the smallest load of
     /// the last completed cycle (m, positive downwards).
     pub settlement_at_min_load_m: f64,
-    /// Column `status`: `ok`, `failed: <error>`, or `failed in an earlier invocation`.
+    /// Column `status`: `ok`, or `failed: <error>` (the run's one-line error, recorded in its folder).
     pub status: String,
 }
 
@@ -451,5 +498,10 @@ pub(super) fn write_table<R: Serialize>(path: &Path, key: &[&str], rest: &[&str]
 
 /// The report of a study whose summary table is `DIR/name`.
 pub(super) fn report(out: &Path, name: &str, failed: Vec<(String, String)>) -> Result<StudyReport> {
-    Ok(StudyReport { table: SummaryTable::read(&out.join(name))?, runs: out.join("runs"), failed })
+    Ok(StudyReport { table: Some(SummaryTable::read(&out.join(name))?), runs: out.join("runs"), failed })
+}
+
+/// The report of an invocation that ran tasks of the study in `out` without its summary.
+pub(super) fn not_summarized(out: &Path, failed: Vec<(String, String)>) -> StudyReport {
+    StudyReport { table: None, runs: out.join("runs"), failed }
 }

@@ -19,6 +19,13 @@ pub struct StepsSpec {
     pub loading: LoadingSpec,
 }
 
+impl StepsSpec {
+    /// The study's tasks (`--tasks`): inclinations × time steps × replicas.
+    pub fn task_count(&self) -> u64 {
+        (self.inclinations.len() * self.dts.len()) as u64 * self.replicas.count
+    }
+}
+
 /// §3.3 (`ballast saussine steps`): one run per inclination and time step,
 /// labelled `incl_<a>_dt_<dt>` (with `R` replicas, `R` runs labelled
 /// `incl_<a>_dt_<dt>/replica-<r>`, [`crate::studies::replicas`]); `steps.csv` (one row
@@ -55,7 +62,10 @@ pub fn steps(spec: &StepsSpec, study: &StudyOptions, display: &dyn RunDisplay) -
     }
     let jobs = replicate(settings, &spec.replicas);
     let mut failed = Vec::new();
-    let outcomes = run_jobs(&jobs, study, display, &mut failed)?;
+    study.tasks.check(jobs.len() as u64)?;
+    let Some(outcomes) = run_jobs(&jobs, 0, study, display, &mut failed)? else {
+        return Ok(not_summarized(&study.out, failed));
+    };
     let r = spec.replicas.count as usize;
     let seating = spec.replicas.seating_cycles.min(spec.loading.cycles);
     let per_setting: Vec<Vec<&Outcome>> = outcomes.chunks(r).map(|c| c.iter().collect()).collect();
