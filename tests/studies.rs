@@ -12,6 +12,7 @@ use ballast::scenarios::saussine::{SampleSpec, SLEEPER};
 use ballast::scene::Scene;
 use ballast::scene::SceneFile;
 use ballast::studies::campaigns::{self, ConvergenceSpec, EnsembleRow, EnsembleSpec, StudyOptions};
+use ballast::studies::karrech_replicas::{load_replicas, KarrechReplicas};
 use ballast::studies::luding::{self, CompareRow, Compression, LoopRow, StrainRow};
 use ballast::studies::md_stage::{Stage, TestSpec};
 use ballast::studies::replicas::Replicas;
@@ -252,6 +253,38 @@ fn karrech_deposit_then_one_cycle() {
     figures_exist(&dir.join("load"), &load.written);
     let cycles = ballast::io::table::read_columns(&dir.join("load/cycles.csv"), &["cycle"]).unwrap();
     assert_eq!(cycles[0], [1.0]);
+
+    // Three replicas of two cycles: the ensemble is the mean of the plates' settlements (their cycles.csv), and
+    // the same study run task by task, in another order, then summarized, writes it byte for byte.
+    let study = KarrechReplicas {
+        loading: Plate::FULL,
+        cycles: 2,
+        replicas: Replicas { count: 3, seating_cycles: 1, ..Replicas::default() },
+        accelerate: None,
+    };
+    let from = dir.join("deposit");
+    let whole = load_replicas(&from, &study, &stage("whole"), Some(2), Tasks::All, &Quiet).unwrap();
+    assert!(whole.summarized && whole.failed.is_empty());
+    let plates: Vec<Vec<f64>> = (0..3)
+        .map(|r| {
+            let path = dir.join(format!("whole/runs/replica-{r}/cycles.csv"));
+            ballast::io::table::read_columns(&path, &["plate_position_m"]).unwrap().remove(0)
+        })
+        .collect();
+    assert_eq!(whole.rows.len(), 2);
+    for (c, row) in whole.rows.iter().enumerate() {
+        let mean = plates.iter().map(|p| p[c]).sum::<f64>() / 3.0;
+        assert!((row.settlement_mean_m - mean).abs() <= 1e-12 * mean.abs(), "cycle {}: {row:?}", c + 1);
+        assert_eq!(row.replicas, 3);
+    }
+    // Replicas from perturbed starts differ (the perturbation reaches the settlement).
+    assert_ne!(plates[1], plates[2]);
+    for t in [Tasks::One(2), Tasks::One(0), Tasks::One(1), Tasks::Summarize] {
+        let r = load_replicas(&from, &study, &stage("tasks"), Some(2), t, &Quiet).unwrap();
+        assert_eq!(r.summarized, t == Tasks::Summarize);
+    }
+    let table = |d: &str| std::fs::read(dir.join(d).join("settlement_ensemble.csv")).unwrap();
+    assert_eq!(table("whole"), table("tasks"));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -8,7 +8,9 @@
 //!   coordination number, packing fraction, kinetic and potential energy.
 //! - `karrech load --from DEPOSIT --out DIR --mode full|partial --cycles K`: the
 //!   deposited sample under the cyclic plate (§4), then `cycles.csv` (residual
-//!   displacement per cycle) and its figures.
+//!   displacement per cycle) and its figures; with `--replicas R`, R runs from
+//!   perturbed starts and the ensemble of the plate's settlement
+//!   ([`ballast::studies::karrech_replicas`]; `--task K`, `--summarize-only`, MPI ranks).
 //! - `luding compress --out DIR --spheres N --friction μ`: isotropic compression of
 //!   the triaxial box of David et al.; `luding cycle --from COMPRESSED --out DIR
 //!   --cycles K`: the cyclic σ_xx, then `loops.csv` (σ_D, ε_D), `strain.csv`
@@ -23,9 +25,11 @@ use super::{Bars, Failure};
 use ballast::run::{default_threads, RunOptions};
 use ballast::scenarios::karrech::Loading;
 use ballast::studies::karrech::{self as karrech_test, Deposit, Start};
+use ballast::studies::karrech_replicas::{load_replicas, KarrechReplicas};
 use ballast::studies::luding::{self, Compression};
 use ballast::studies::md_stage::{Stage, StageOutcome};
-use ballast::studies::replicas::{Perturbation, DEFAULT_PERTURBATION_M, DEFAULT_PERTURB_SEED};
+use ballast::studies::replicas::{Perturbation, Replicas, DEFAULT_PERTURBATION_M, DEFAULT_PERTURB_SEED};
+use ballast::studies::tasks::Tasks;
 use clap::{Args, Subcommand, ValueEnum};
 use std::path::PathBuf;
 
@@ -117,8 +121,20 @@ pub enum KarrechCommand {
         cycles: u32,
         /// Start from replica R of the deposit: 0 as deposited, R ≥ 1 with every sphere
         /// moved by at most --perturb (the noise floor of a comparison; `replica.json`).
-        #[arg(long, value_name = "R", default_value_t = 0)]
+        #[arg(long, value_name = "R", default_value_t = 0, conflicts_with = "replicas")]
         replica: u64,
+        /// Load R replicas (0 … R−1, each as --replica gives it) side by side in DIR/runs/replica-<r>/,
+        /// then DIR/settlement_ensemble.csv: the plate's settlement per cycle, mean, sd, 95 % CI.
+        #[arg(long, value_name = "R", default_value_t = 1)]
+        replicas: u64,
+        /// Seating cycles S of the ensemble: accrued settlement = settlement − settlement after S cycles.
+        #[arg(long, value_name = "S", default_value_t = ballast::studies::replicas::DEFAULT_SEATING_CYCLES)]
+        seating_cycles: u64,
+        /// Replicas run at once, each on one core (default: the number of cores).
+        #[arg(long)]
+        jobs: Option<usize>,
+        #[command(flatten)]
+        tasks: super::saussine::TaskArgs,
         /// Largest displacement of a sphere at a replica's start (m), uniform in the ball.
         #[arg(long, value_name = "DIST", default_value_t = DEFAULT_PERTURBATION_M)]
         perturb: f64,
@@ -184,9 +200,51 @@ pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
             let o = karrech_test::deposit(&spec, &args.stage(), &args.display())?;
             print_written(&o, "figures fig3a–d");
         }
-        KarrechCommand::Load { from, mode, cycles, replica, perturb, perturb_seed, run: args, accelerate } => {
+        KarrechCommand::Load {
+            from,
+            mode,
+            cycles,
+            replica,
+            replicas,
+            seating_cycles,
+            jobs,
+            tasks,
+            perturb,
+            perturb_seed,
+            run: args,
+            accelerate,
+        } => {
             let loading = if mode == Mode::Full { Loading::FULL } else { Loading::PARTIAL };
-            let start = Start { replica, perturbation: Perturbation { distance_m: perturb, seed: perturb_seed } };
+            let perturbation = Perturbation { distance_m: perturb, seed: perturb_seed };
+            if tasks.tasks {
+                println!("{replicas}"); // one task per replica (a single run is one task)
+                return Ok(());
+            }
+            if replicas > 1 {
+                let study = KarrechReplicas {
+                    loading,
+                    cycles,
+                    replicas: Replicas { count: replicas, perturbation, seating_cycles },
+                    accelerate: accelerate.accelerate()?,
+                };
+                let (stage, bars) = (args.stage(), Bars::group(args.quiet()));
+                let run = |t| load_replicas(&from, &study, &stage, jobs, t, &bars);
+                let shared = super::cluster::shared(super::cluster::share(tasks.selection()), run, |r| &r.failed)?;
+                if let Some(r) = shared {
+                    super::saussine::print_replicas(&r);
+                }
+                return Ok(());
+            }
+            if tasks.selection() != Tasks::All {
+                let flag = if tasks.summarize_only { "--summarize-only" } else { "--task" };
+                return Err(super::input(format!(
+                    "{flag}: for a study of --replicas R > 1 (a single run is its one task)"
+                )));
+            }
+            if super::cluster::ranks().0 > 0 {
+                return Ok(()); // one run: rank 0's
+            }
+            let start = Start { replica, perturbation };
             if let Some(acc) = accelerate.accelerate()? {
                 let bar = super::cycle_bar(args.quiet());
                 let mut show = |p: &ballast::settlement::AccelerationProgress| super::show_cycles(&bar, p);

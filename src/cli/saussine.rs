@@ -473,7 +473,7 @@ pub(crate) fn print_errors(out: &std::path::Path, s: &ballast::settlement::Accel
 }
 
 /// The line of an ensemble of settlement runs.
-fn print_replicas(r: &SettleReplicas) {
+pub(crate) fn print_replicas(r: &SettleReplicas) {
     for (label, e) in &r.failed {
         eprintln!("run {label} failed: {e}");
     }

@@ -44,6 +44,7 @@ pub mod campaigns;
 pub mod compare;
 mod display;
 pub mod karrech;
+pub mod karrech_replicas;
 pub mod luding;
 pub mod md_stage;
 pub mod replica_tasks;

@@ -283,10 +283,9 @@ pub struct SettleReplicas {
     pub table: PathBuf,
     /// Its rows: the ensemble per cycle.
     pub rows: Vec<SettlementEnsembleRow>,
-    /// `(label, error)` of each replica that failed in this invocation (its
-    /// cycles, if any, are still in the ensemble, which stops at the last
-    /// cycle every replica reached); with [`Tasks::Summarize`], those whose
-    /// `summary.json` says they diverged or stalled.
+    /// `(label, error)` of each replica that failed (its cycles, if any, are still in the ensemble, which
+    /// stops at the last cycle every replica reached): with the summary, every one, as recorded in its folder
+    /// ([`super::tasks::folder_end`], also by earlier invocations); without it, those of this invocation.
     pub failed: Vec<(String, String)>,
     /// Whether the summary was written (not by a [`Tasks::One`] or [`Tasks::Share`] invocation, whose `rows`
     /// are empty).

@@ -66,8 +66,8 @@ impl EnsembleSpec {
 /// As [`convergence`]; no sample or a stiffness factor that is not positive is
 /// an [`Error::Scene`], and so is an invalid loading or option, before any
 /// deposit. A deposit that fails stops the study. With [`StudyOptions::tasks`], the deposits are tasks
-/// `0..samples` and the loaded runs the next ones ([`EnsembleSpec::task_count`]); the invocation calls
-/// [`StudyOptions::stage_done`] between the two stages, and a loaded run asked for while a sample is not
+/// `0..samples` and the loaded runs the next ones ([`EnsembleSpec::task_count`]); a [`Tasks::Share`]
+/// invocation calls [`StudyOptions::stage_done`] between the two stages, and a loaded run asked for while a sample is not
 /// deposited is an [`Error::Scene`] naming the deposit's task.
 pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
     crate::io::figures::require()?; // the stage ends with its figures
@@ -112,7 +112,9 @@ pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisp
             .collect()
     });
     deposited.into_iter().collect::<Result<Vec<()>>>()?;
-    (study.stage_done)();
+    if let Tasks::Share { .. } = study.tasks {
+        (study.stage_done)(); // every sharing process, and only they, meet here
+    }
     let loads = spec.samples..spec.task_count();
     if !loads.clone().any(|k| study.tasks.runs(k)) && !study.tasks.summarizes() {
         return Ok(not_summarized(out, Vec::new()));

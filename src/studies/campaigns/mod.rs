@@ -81,9 +81,9 @@ pub struct StudyOptions {
     /// task, then the summary). A study's tasks are its runs in the order of its summary (settings ×
     /// replicas; for [`ensemble`], the deposits first, then samples × stiffnesses).
     pub tasks: Tasks,
-    /// Called by a study of two stages ([`ensemble`]: the deposits, then the loaded runs that need them) when
-    /// this invocation is done with its tasks of the first: with [`Tasks::Share`] it must return only once
-    /// every process sharing the tasks is done with it too (an MPI barrier). Default: returns at once.
+    /// Called, with [`Tasks::Share`], by a study of two stages ([`ensemble`]: the deposits, then the loaded
+    /// runs that need them) once this process is done with its tasks of the first: it must return only once
+    /// every process sharing the tasks is done with them too (an MPI barrier). Default: returns at once.
     pub stage_done: fn(),
 }
 
