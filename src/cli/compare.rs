@@ -43,7 +43,7 @@ pub fn main(args: CompareArgs) -> Result<(), Failure> {
         loading: args.loading.loading()?,
     };
     let bars = Bars::group(args.study.quiet);
-    args.study.run(|| spec.task_count(), |o| compare::compare(&spec, o, &bars), |r| &r.study.failed, print)
+    args.study.run((spec.task_count(), 0), |o| compare::compare(&spec, o, &bars), |r| &r.study.failed, print)
 }
 
 /// The failed runs, `compare.md` and where the outputs are.

@@ -229,7 +229,7 @@ pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
                 };
                 let (stage, bars) = (args.stage(), Bars::group(args.quiet()));
                 let run = |t| load_replicas(&from, &study, &stage, jobs, t, &bars);
-                let shared = super::cluster::shared(super::cluster::share(tasks.selection()), run, |r| &r.failed)?;
+                let shared = super::cluster::shared(tasks.plan(replicas, 0), run, |r| &r.failed)?;
                 if let Some(r) = shared {
                     super::saussine::print_replicas(&r);
                 }

@@ -18,6 +18,7 @@
 //! A sample scaled to fewer grains (`--grains`) is loaded with the sleeper's width
 //! and the load scaled alike (same pressure), unless `--sleeper-width` is given.
 
+use super::cluster::Schedule;
 use super::{input, print_sample, print_study, Bars, Failure};
 use ballast::io::layout;
 use ballast::run::default_threads;
@@ -280,9 +281,19 @@ pub struct TaskArgs {
     /// others are named).
     #[arg(long)]
     pub summarize_only: bool,
+    /// Under mpirun: static (task k on rank k mod N) or dynamic (rank 0 hands out the tasks in order
+    /// and runs none: for tasks of unequal cost on many ranks).
+    #[arg(long, value_enum, default_value_t = Schedule::Static)]
+    pub schedule: Schedule,
 }
 
 impl TaskArgs {
+    /// How to share a study of `count` tasks whose tasks from `second_stage` on need the ones before (0: one
+    /// stage).
+    pub(crate) fn plan(&self, count: u64, second_stage: u64) -> super::cluster::Plan {
+        super::cluster::Plan { selection: self.selection(), schedule: self.schedule, count, second_stage }
+    }
+
     /// The library's selection.
     pub fn selection(&self) -> Tasks {
         match (self.task, self.summarize_only) {
@@ -316,34 +327,35 @@ pub struct StudyArgs {
 }
 
 impl StudyArgs {
-    /// The library's options: the tasks asked for, or this MPI rank's share of them.
+    /// The library's options (every task; [`Self::run`] selects them).
     pub(crate) fn options(&self) -> StudyOptions {
         StudyOptions {
             out: self.out.clone(),
             jobs: self.jobs,
             resume: self.resume,
             checkpoint_every_s: self.checkpoint_every,
-            tasks: super::cluster::share(self.tasks.selection()),
+            tasks: Tasks::All,
             stage_done: super::cluster::barrier,
         }
     }
 
-    /// Runs `study` with these options (on MPI ranks, each its share, then rank 0 the summary) and prints its
-    /// report; with `--tasks`, prints the study's `count` tasks instead.
+    /// Runs `study` with these options on the tasks asked for (on MPI ranks, shared as `--schedule` says, then
+    /// rank 0 the summary) and prints its report; with `--tasks`, prints the study's `count` tasks instead.
+    /// Tasks from `second_stage` on need every task before finished (0: one stage).
     pub(crate) fn run<R>(
         &self,
-        count: impl FnOnce() -> u64,
+        (count, second_stage): (u64, u64),
         study: impl Fn(&StudyOptions) -> ballast::Result<R>,
         failed: impl Fn(&R) -> &[(String, String)],
         print: impl FnOnce(&R),
     ) -> Result<(), Failure> {
         if self.tasks.tasks {
-            println!("{}", count());
+            println!("{count}");
             return Ok(());
         }
         let opts = self.options();
         let run = |tasks| study(&StudyOptions { tasks, ..opts.clone() });
-        if let Some(r) = super::cluster::shared(opts.tasks, run, failed)? {
+        if let Some(r) = super::cluster::shared(self.tasks.plan(count, second_stage), run, failed)? {
             print(&r);
         }
         Ok(())
@@ -551,8 +563,9 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
             if replicas.count == 1 && super::cluster::ranks().0 > 0 {
                 return Ok(()); // one run: rank 0's
             }
-            let selection = super::cluster::share(tasks.selection());
-            let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume, tasks: selection };
+            let plan = tasks.plan(replicas.count, 0);
+            let opts =
+                SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume, tasks: plan.selection };
             let start = Start { replica, perturbation: replicas.perturbation };
             if let Some(acc) = accelerate.accelerate()? {
                 if replicas.count > 1 {
@@ -563,7 +576,7 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                         )
                     };
                     if let Some(r) = super::cluster::shared(
-                        opts.tasks,
+                        plan,
                         |tasks| study(&SettleOptions { tasks, ..opts.clone() }),
                         |r| &r.failed,
                     )? {
@@ -597,7 +610,7 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                     saussine::settle_replicas(&sample, &loading, &out, opts, &replicas, jobs, &bars)
                 };
                 if let Some(r) = super::cluster::shared(
-                    opts.tasks,
+                    plan,
                     |tasks| study(&SettleOptions { tasks, ..opts.clone() }),
                     |r| &r.failed,
                 )? {
@@ -615,18 +628,28 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                 loading: loading.loading()?,
             };
             let bars = Bars::group(study.quiet);
-            study.run(|| spec.task_count(), |o| campaigns::convergence(&spec, o, &bars), |r| &r.failed, print_study)?;
+            study.run(
+                (spec.task_count(), 0),
+                |o| campaigns::convergence(&spec, o, &bars),
+                |r| &r.failed,
+                print_study,
+            )?;
         }
         SaussineCommand::Steps { sample, dts, inclinations, replicas, loading, study } => {
             let spec =
                 StepsSpec { sample, dts, inclinations, replicas: replicas.replicas(), loading: loading.loading()? };
             let bars = Bars::group(study.quiet);
-            study.run(|| spec.task_count(), |o| campaigns::steps(&spec, o, &bars), |r| &r.failed, print_study)?;
+            study.run((spec.task_count(), 0), |o| campaigns::steps(&spec, o, &bars), |r| &r.failed, print_study)?;
         }
         SaussineCommand::Ensemble { samples, first_seed, factors, grains, sample_dt, loading, study } => {
             let spec = EnsembleSpec { samples, first_seed, factors, grains, sample_dt, loading: loading.loading()? };
             let bars = Bars::group(study.quiet);
-            study.run(|| spec.task_count(), |o| campaigns::ensemble(&spec, o, &bars), |r| &r.failed, print_study)?;
+            study.run(
+                (spec.task_count(), spec.samples),
+                |o| campaigns::ensemble(&spec, o, &bars),
+                |r| &r.failed,
+                print_study,
+            )?;
         }
     }
     Ok(())
