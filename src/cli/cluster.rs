@@ -133,7 +133,10 @@ pub(crate) fn shared<R>(
     failed: impl Fn(&R) -> &[(String, String)],
 ) -> ballast::Result<Option<R>> {
     let tasks = share(plan.selection);
-    let Tasks::Share { rank, .. } = tasks else { return study(tasks).map(Some) };
+    let Tasks::Share { rank, .. } = tasks else {
+        // A task or a summary asked for under mpirun: rank 0's alone (two ranks would write the same folder).
+        return if ranks().0 == 0 { study(tasks).map(Some) } else { Ok(None) };
+    };
     let mut failures = Vec::new();
     match plan.schedule {
         Schedule::Static => failures.extend(failed(&study(tasks)?).iter().cloned()),
