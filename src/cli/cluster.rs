@@ -1,7 +1,8 @@
 //! MPI ranks for the studies' tasks (feature `mpi`): under `mpirun -np N ballast …` every rank runs its share
-//! of the study's tasks (task `k` on rank `k mod N`, `ballast::studies::tasks::Tasks::Share`), waits for the
-//! others, and rank 0 writes the summary from the tasks' folders. Without the feature, or on one rank, a study
-//! runs as it always does.
+//! of the study's tasks (static: task `k` on rank `k mod N`, `ballast::studies::tasks::Tasks::Share`; dynamic:
+//! the tasks rank 0 hands out one at a time, `--schedule dynamic`), waits for the others, and rank 0 writes
+//! the summary from the tasks' folders. Without the feature, without a launcher, or on one rank, a study runs
+//! as it always does.
 
 use ballast::studies::tasks::Tasks;
 use std::sync::OnceLock;
