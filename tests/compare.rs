@@ -14,6 +14,7 @@ use ballast::studies::campaigns::StudyOptions;
 use ballast::studies::compare::{compare, CompareReport, CompareRow, CompareSpec};
 use ballast::studies::replicas::Replicas;
 use ballast::studies::saussine;
+use ballast::studies::tasks::Tasks;
 use ballast::studies::Quiet;
 use ballast::Error;
 use std::path::{Path, PathBuf};
@@ -94,6 +95,21 @@ fn compare_writes_every_run_and_cycle_and_derives_the_md_settings_from_the_ratio
     )
     .unwrap();
     assert_eq!(again.study.table, report.study.table);
+
+    // The same study as its 6 tasks, run one at a time in another order, then summarized: compare.csv is the
+    // whole study's but for the wall times.
+    let tasks = scratch::dir("files-tasks");
+    let spec = spec(&sleeper_scene(), &[1e-2, 1e-3], 2, 2);
+    assert_eq!(spec.task_count(), 6);
+    for t in [5, 0, 3, 1, 4, 2].map(Tasks::One).into_iter().chain([Tasks::Summarize]) {
+        let r = compare(&spec, &StudyOptions { tasks: t, ..StudyOptions::new(&tasks) }, &Quiet).unwrap();
+        assert_eq!(r.study.table.is_some(), t == Tasks::Summarize);
+    }
+    let without_times = |dir: &Path| -> Vec<CompareRow> {
+        let rows: Vec<CompareRow> = read_csv(&dir.join("compare.csv")).unwrap();
+        rows.into_iter().map(|r| CompareRow { wall_time_s: 0.0, ..r }).collect()
+    };
+    assert_eq!(without_times(&tasks), without_times(&out));
 }
 
 #[test]
