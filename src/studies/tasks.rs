@@ -86,22 +86,23 @@ pub fn record(dir: &Path, result: &Result<()>) -> Result<()> {
     }
 }
 
-/// How the run in the folder `dir` ended, for a summary: `None` if it holds no finished run (no
-/// `summary.json`, or a checkpoint still to resume), `Some(None)` for a run that ended, `Some(Some(error))` for
-/// one that failed: its [`layout::FAILED`], else, for a folder without one whose `summary.json` says the run
-/// diverged or stalled, that.
+/// How the run in the folder `dir` ended, for a summary: `Some(Some(error))` for one that failed (its
+/// [`layout::FAILED`], whatever else the folder holds: a run that diverged after a checkpoint keeps it),
+/// `None` if it holds no finished run (no `summary.json`, or a checkpoint still to resume), `Some(None)` for a
+/// run that ended, and `Some(Some(…))` too for a folder without a record whose `summary.json` says the run
+/// diverged or stalled (a folder of an earlier version).
 ///
 /// # Errors
 /// A `summary.json` or record that cannot be read.
 pub fn folder_end(dir: &Path) -> Result<Option<Option<String>>> {
-    let summary = dir.join(layout::SUMMARY);
-    if !summary.is_file() || dir.join(layout::CHECKPOINT).exists() {
-        return Ok(None);
-    }
     let failed = dir.join(layout::FAILED);
     if failed.is_file() {
         let text = std::fs::read_to_string(&failed).map_err(|e| crate::io::io_error(&failed, "read", e))?;
         return Ok(Some(Some(text.trim_end().to_string())));
+    }
+    let summary = dir.join(layout::SUMMARY);
+    if !summary.is_file() || dir.join(layout::CHECKPOINT).exists() {
+        return Ok(None);
     }
     let text = std::fs::read_to_string(&summary).map_err(|e| crate::io::io_error(&summary, "read", e))?;
     let value: serde_json::Value = serde_json::from_str(&text)
@@ -136,4 +137,41 @@ pub fn failures_from_folders(folders: &[(String, PathBuf)]) -> Result<Vec<Option
         )));
     }
     Ok(failures)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A run's end recorded in its folder and read back: a failure wins over a stale checkpoint (a run that
+    /// diverged after checkpointing keeps it), a rerun that ends removes it, an input error is not a run's
+    /// end, and a folder of an earlier version tells a divergence by its summary.
+    #[test]
+    fn a_runs_end_is_recorded_in_its_folder_and_read_back() {
+        let dir = std::env::temp_dir().join(format!("ballast-tasks-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        assert_eq!(folder_end(&dir).unwrap(), None, "nothing run");
+        let diverged = Error::Diverged { step: 7, body: 3, name: "g2".into(), what: "runaway overlap".into() };
+        record(&dir, &Err(diverged)).unwrap();
+        std::fs::write(dir.join(layout::CHECKPOINT), "{}").unwrap();
+        let message = "step 7: body 3 ('g2'): runaway overlap".to_string();
+        assert_eq!(folder_end(&dir).unwrap(), Some(Some(message.clone())));
+        // An input error leaves the record as it was.
+        record(&dir, &Err(Error::Scene("dt: must be positive".into()))).unwrap();
+        assert_eq!(folder_end(&dir).unwrap(), Some(Some(message)));
+        // Rerun and ended: no record; the checkpoint says the run is not finished, then its summary that it is.
+        record(&dir, &Ok(())).unwrap();
+        assert!(!dir.join(layout::FAILED).exists());
+        assert_eq!(folder_end(&dir).unwrap(), None);
+        std::fs::remove_file(dir.join(layout::CHECKPOINT)).unwrap();
+        std::fs::write(dir.join(layout::SUMMARY), r#"{"end": "finished"}"#).unwrap();
+        assert_eq!(folder_end(&dir).unwrap(), Some(None));
+        std::fs::write(dir.join(layout::SUMMARY), r#"{"end": "diverged"}"#).unwrap();
+        assert_eq!(folder_end(&dir).unwrap(), Some(Some("the run diverged (its summary.json)".into())));
+        let folders = [("a".to_string(), dir.clone()), ("b".to_string(), dir.join("missing"))];
+        let e = failures_from_folders(&folders).unwrap_err().to_string();
+        assert!(e.contains("1 of 2 tasks have no finished run: b"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }
