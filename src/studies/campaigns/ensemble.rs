@@ -67,8 +67,8 @@ impl EnsembleSpec {
 /// an [`Error::Scene`], and so is an invalid loading or option, before any
 /// deposit. A deposit that fails stops the study. With [`StudyOptions::tasks`], the deposits are tasks
 /// `0..samples` and the loaded runs the next ones ([`EnsembleSpec::task_count`]); a [`Tasks::Share`]
-/// invocation calls [`StudyOptions::stage_done`] between the two stages, and a loaded run asked for while a sample is not
-/// deposited is an [`Error::Scene`] naming the deposit's task.
+/// invocation calls [`StudyOptions::stage_done`] between the two stages, and a loaded run asked for while a
+/// sample is not deposited is an [`Error::Scene`] naming the deposit's task.
 pub fn ensemble(spec: &EnsembleSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
     crate::io::figures::require()?; // the stage ends with its figures
     let factors = &spec.factors;
