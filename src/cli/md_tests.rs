@@ -220,7 +220,8 @@ pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
                 println!("{replicas}"); // one task per replica (a single run is one task)
                 return Ok(());
             }
-            if replicas > 1 {
+            if replicas != 1 {
+                // A replica study (R = 0 refused by it, naming --replicas).
                 let study = KarrechReplicas {
                     loading,
                     cycles,
