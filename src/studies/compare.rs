@@ -148,7 +148,7 @@ pub struct SettingSummary {
 pub struct CompareReport {
     /// `compare.csv`, the runs' folder and the runs that failed.
     pub study: StudyReport,
-    /// One per setting.
+    /// One per setting; empty when the invocation ran tasks without the summary.
     pub settings: Vec<SettingSummary>,
 }
 
