@@ -7,11 +7,8 @@
 //! cent: BENCHMARKS.md, "Settlement acceleration"), so its error is an ensemble's.
 
 use super::replicas::{Replicas, Start};
-use super::saussine::{
-    finish_replicas, not_summarized, replica_dir, replica_folders, replica_jobs, settle_accelerated,
-};
+use super::saussine::{end_replicas, finish_replicas, replica_dir, replica_jobs, settle_accelerated};
 use super::saussine::{Accelerate, SettleOptions, SettleReplicas};
-use super::tasks::failures_from_folders;
 use crate::error::Result;
 use crate::io;
 use crate::io::layout;
@@ -79,11 +76,7 @@ pub fn settle_accelerated_replicas(
     });
     let seating = replicas.seating_cycles.min(loading.cycles);
     let read = |path: &Path| io::read_csv::<SettlementRow>(path);
-    let failures = super::saussine::failures(results)?;
-    if !opts.tasks.summarizes() {
-        return Ok(not_summarized(out, &failures));
-    }
-    // The ends recorded in the folders: also those of the replicas an earlier invocation ran.
-    let failures = failures_from_folders(&replica_folders(out, replicas.count))?;
-    finish_replicas(out, &failures, "settlement.csv", read, seating, "Settlement of the sleeper, accelerated")
+    end_replicas(out, replicas.count, opts.tasks, results, |failures| {
+        finish_replicas(out, failures, "settlement.csv", read, seating, "Settlement of the sleeper, accelerated")
+    })
 }

@@ -14,9 +14,9 @@
 use super::karrech::{load, load_accelerated, Start};
 use super::md_stage::Stage;
 use super::replicas::{CycleSettlement, Replicas};
-use super::saussine::{failures, finish_replicas, not_summarized, replica_dir, replica_folders, replica_jobs};
+use super::saussine::{end_replicas, finish_replicas, replica_dir, replica_jobs};
 use super::saussine::{Accelerate, SettleReplicas};
-use super::tasks::{failures_from_folders, record, Tasks};
+use super::tasks::{record, Tasks};
 use super::RunDisplay;
 use crate::error::Result;
 use crate::io::{self, layout};
@@ -120,18 +120,13 @@ pub fn load_replicas(
             })
             .collect()
     });
-    let failures = failures(results)?;
-    if !tasks.summarizes() {
-        return Ok(not_summarized(out, &failures));
-    }
-    let failures = failures_from_folders(&replica_folders(out, replicas.count))?;
     let seating = replicas.seating_cycles.min(u64::from(study.cycles));
     let title = "Settlement of the plate (Karrech et al. 2007)";
-    match study.accelerate {
+    end_replicas(out, replicas.count, tasks, results, |failures| match study.accelerate {
         Some(_) => {
             let read = |path: &Path| io::read_csv::<SettlementRow>(path);
-            finish_replicas(out, &failures, layout::SETTLEMENT, read, seating, &format!("{title}, accelerated"))
+            finish_replicas(out, failures, layout::SETTLEMENT, read, seating, &format!("{title}, accelerated"))
         }
-        None => finish_replicas(out, &failures, layout::CYCLES, read_plate_cycles, seating, title),
-    }
+        None => finish_replicas(out, failures, layout::CYCLES, read_plate_cycles, seating, title),
+    })
 }

@@ -348,22 +348,36 @@ pub fn settle_replicas(
             })
             .collect()
     });
-    let failures = failures(results)?;
-    if !opts.tasks.summarizes() {
-        return Ok(not_summarized(out, &failures));
-    }
-    // The ends recorded in the folders: also those of the replicas an earlier invocation ran.
-    let failures = failures_from_folders(&replica_folders(out, replicas.count))?;
-    super::replica_tasks::finish(out, &failures, tasks.seating)
+    end_replicas(out, replicas.count, opts.tasks, results, |failures| {
+        super::replica_tasks::finish(out, failures, tasks.seating)
+    })
 }
 
-/// The `(label, folder)` of each of the `count` replicas in `out`.
-pub(crate) fn replica_folders(out: &Path, count: u64) -> Vec<(String, PathBuf)> {
-    (0..count).map(|r| (format!("replica-{r}"), replica_dir(out, r))).collect()
+/// The end of an invocation of a replica study in `out` of `count` replicas, once the runs it made ended
+/// (`results`, replica by replica; `Ok` for those it did not run): without the summary (`tasks`), the failures
+/// of this invocation; with it, `summarize` given every replica's end as recorded in its folder (also those an
+/// earlier invocation or another process ran).
+///
+/// # Errors
+/// The first input error of `results`; with the summary, a replica without a finished run (named), or
+/// `summarize`'s.
+pub(crate) fn end_replicas(
+    out: &Path,
+    count: u64,
+    tasks: Tasks,
+    results: Vec<Result<()>>,
+    summarize: impl FnOnce(&[Option<String>]) -> Result<SettleReplicas>,
+) -> Result<SettleReplicas> {
+    let failures = failures(results)?;
+    if !tasks.summarizes() {
+        return Ok(not_summarized(out, &failures));
+    }
+    let folders: Vec<(String, PathBuf)> = (0..count).map(|r| (format!("replica-{r}"), replica_dir(out, r))).collect();
+    summarize(&failures_from_folders(&folders)?)
 }
 
 /// What a replica study in `out` that ran a task without its summary reports: the failures of this invocation.
-pub(crate) fn not_summarized(out: &Path, failures: &[Option<String>]) -> SettleReplicas {
+fn not_summarized(out: &Path, failures: &[Option<String>]) -> SettleReplicas {
     let failed = failures.iter().enumerate().filter_map(|(r, f)| Some((format!("replica-{r}"), f.clone()?))).collect();
     SettleReplicas {
         runs: out.join("runs"),
@@ -379,7 +393,7 @@ pub(crate) fn not_summarized(out: &Path, failures: &[Option<String>]) -> SettleR
 ///
 /// # Errors
 /// That input error.
-pub(crate) fn failures(results: Vec<Result<()>>) -> Result<Vec<Option<String>>> {
+fn failures(results: Vec<Result<()>>) -> Result<Vec<Option<String>>> {
     results
         .into_iter()
         .map(|r| match r {
