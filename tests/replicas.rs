@@ -430,6 +430,14 @@ fn replica_tasks_run_one_by_one_summarize_to_the_whole_studys_bytes() {
         let e = String::from_utf8_lossy(&r.unwrap().stderr).into_owned();
         assert!(e.contains("--task: the study has 4 tasks, 0 to 3; got 4"), "{e}");
     }
+    // A single run is its one task: --task and --summarize-only are refused for it, naming the flag.
+    for flag in [&["--task", "0"][..], &["--summarize-only"]] {
+        let args = [&["saussine", "settle", "--sample", &sample, "--out", "unused", "--quiet"][..], flag].concat();
+        let r = Command::new(env!("CARGO_BIN_EXE_ballast")).args(&args).output().unwrap();
+        let e = String::from_utf8_lossy(&r.stderr).into_owned();
+        assert_eq!(r.status.code(), Some(2), "{e}");
+        assert!(e.contains(&format!("{}: for a study of --replicas R > 1", flag[0])), "{e}");
+    }
 }
 
 /// A study's summary table without the columns of wall-clock time (which differ between any two runs).

@@ -162,24 +162,24 @@ pub(crate) fn shared<R>(
 #[cfg(feature = "mpi")]
 const NONE: u64 = u64::MAX;
 
-/// Rank 0 of a dynamic schedule (asleep between requests, [`poll`]): answers each rank's request (which carries the task it finished) with the
-/// next task in order, or [`NONE`] when none is left; a task of the second stage waits until every task
-/// before `second_stage` has finished.
+/// Rank 0 of a dynamic schedule (asleep between requests, [`poll`]): answers each rank's request (which
+/// carries the task it finished) with the next task in order, or [`NONE`] when none is left; a task of the
+/// second stage waits until every task before `second_stage` has finished.
 fn hand_out(count: u64, second_stage: u64) {
     #[cfg(feature = "mpi")]
     {
         use mpi::traits::{Communicator, Destination, Source};
         let world = mpi::topology::SimpleCommunicator::world();
         let (mut next, mut first_done, mut workers) = (0u64, 0u64, world.size() - 1);
-        let mut waiting: Vec<i32> = Vec::new();
+        let mut waiting = std::collections::VecDeque::new();
         while workers > 0 {
             let (message, status) = poll(|| world.any_process().immediate_matched_probe());
             let (done, _) = message.matched_receive::<u64>();
             if done != NONE && done < second_stage {
                 first_done += 1;
             }
-            waiting.push(status.source_rank());
-            while let Some(&r) = waiting.first() {
+            waiting.push_back(status.source_rank());
+            while let Some(&r) = waiting.front() {
                 if next >= second_stage.min(count) && next < count && first_done < second_stage {
                     break; // the second stage needs the first finished
                 }
@@ -190,7 +190,7 @@ fn hand_out(count: u64, second_stage: u64) {
                 } else {
                     next += 1;
                 }
-                waiting.remove(0);
+                waiting.pop_front();
             }
         }
     }

@@ -29,7 +29,6 @@ use ballast::studies::karrech_replicas::{load_replicas, KarrechReplicas};
 use ballast::studies::luding::{self, Compression};
 use ballast::studies::md_stage::{Stage, StageOutcome};
 use ballast::studies::replicas::{Perturbation, Replicas, DEFAULT_PERTURBATION_M, DEFAULT_PERTURB_SEED};
-use ballast::studies::tasks::Tasks;
 use clap::{Args, Subcommand, ValueEnum};
 use std::path::PathBuf;
 
@@ -236,14 +235,8 @@ pub(crate) fn karrech_main(cmd: KarrechCommand) -> Result<(), Failure> {
                 }
                 return Ok(());
             }
-            if tasks.selection() != Tasks::All {
-                let flag = if tasks.summarize_only { "--summarize-only" } else { "--task" };
-                return Err(super::input(format!(
-                    "{flag}: for a study of --replicas R > 1 (a single run is its one task)"
-                )));
-            }
-            if super::cluster::ranks().0 > 0 {
-                return Ok(()); // one run: rank 0's
+            if !tasks.single_run()? {
+                return Ok(());
             }
             let start = Start { replica, perturbation };
             if let Some(acc) = accelerate.accelerate()? {

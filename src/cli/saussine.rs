@@ -294,6 +294,16 @@ impl TaskArgs {
         super::cluster::Plan { selection: self.selection(), schedule: self.schedule, count, second_stage }
     }
 
+    /// For a single run (no replica study): refuses `--task` and `--summarize-only`, and says whether this
+    /// process runs it (under mpirun, rank 0 alone).
+    pub(crate) fn single_run(&self) -> Result<bool, Failure> {
+        if self.selection() != Tasks::All {
+            let flag = if self.summarize_only { "--summarize-only" } else { "--task" };
+            return Err(input(format!("{flag}: for a study of --replicas R > 1 (a single run is its one task)")));
+        }
+        Ok(super::cluster::ranks().0 == 0)
+    }
+
     /// The library's selection.
     pub fn selection(&self) -> Tasks {
         match (self.task, self.summarize_only) {
@@ -556,12 +566,8 @@ pub fn main(cmd: SaussineCommand) -> Result<(), Failure> {
                 println!("{}", replicas.count);
                 return Ok(());
             }
-            if tasks.selection() != Tasks::All && replicas.count == 1 {
-                let flag = if tasks.summarize_only { "--summarize-only" } else { "--task" };
-                return Err(input(format!("{flag}: for a study of --replicas R > 1 (a single run is its one task)")));
-            }
-            if replicas.count == 1 && super::cluster::ranks().0 > 0 {
-                return Ok(()); // one run: rank 0's
+            if replicas.count == 1 && !tasks.single_run()? {
+                return Ok(());
             }
             let plan = tasks.plan(replicas.count, 0);
             let opts =
