@@ -78,6 +78,7 @@ pub mod run;
 pub mod scenarios;
 pub mod scene;
 pub mod settlement;
+pub mod space;
 pub mod studies;
 pub mod team;
 

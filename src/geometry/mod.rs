@@ -6,10 +6,15 @@
 //! area `A` (m²) and density `ρ` (kg/m³) has mass `ρ A t` (kg) and polar inertia
 //! `ρ t J` (kg·m²), `J` being the polar second moment of area about the centroid.
 //! Mass properties come from `parry2d-f64`.
+//!
+//! The 3D engine's shapes ([`polyhedron`]: convex polyhedra, spheres, half-spaces) are in their principal
+//! frame; hulls and mass properties come from `parry3d-f64`.
 
 mod polygon;
+pub mod polyhedron;
 
 pub use polygon::{Compound, ConvexPolygon, GeometryError, Shape};
+pub use polyhedron::{Face, Polyhedron, Pose, Solid, SolidError, Vec3};
 
 /// A 2D vector in SI units (m, m/s, N, …).
 pub type Vec2 = nalgebra::Vector2<f64>;

@@ -45,6 +45,7 @@
 pub mod apgd;
 pub mod contact;
 pub mod coulomb;
+pub mod d3;
 pub mod engine;
 #[cfg(feature = "faer")]
 pub mod interior;

@@ -1,0 +1,1 @@
+//! The 3D Signorini–Coulomb local law (placeholder: being written).

@@ -1,0 +1,1 @@
+//! Contact detection between 3D solids (placeholder: being written).
