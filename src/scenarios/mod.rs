@@ -13,6 +13,7 @@
 //! parameter, never a panic, an endless loop or a scene that fails later.
 
 pub mod deposit;
+pub mod grains3d;
 pub mod karrech;
 pub mod luding;
 pub mod md_bed;

@@ -2,4 +2,5 @@
 //! velocities with the spin in the principal frame) and its contact detection ([`detection`]: after LMGC90's
 //! PRPRx for polyhedra, with spheres and half-spaces).
 
+pub mod bodies;
 pub mod detection;

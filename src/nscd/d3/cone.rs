@@ -1,1 +1,0 @@
-//! The 3D Signorini–Coulomb local law (placeholder: being written).

@@ -1,0 +1,188 @@
+//! The 3D contact point as a row of the shared NSCD method ([`crate::nscd::method::Row`]): Signorini with the
+//! gap prediction and restitution thresholds of the 2D row (`crate::nscd::contact`, Saussine et al. 2006 §2.3,
+//! §2.8), and exact Coulomb friction on the 3D cone ([`super::cone::solve`]) over the 3×3 Delassus block.
+//!
+//! A contact point `p` with local frame `(n, t₁, t₂)` (n from the antagonist towards the candidate) maps a body's
+//! generalised velocity `u = (v, ω)` — `ω` in the body's principal frame, `R` its rotation — to the relative
+//! velocity by the rows of `H*`: for a direction `d`, `d · (v + R (ω × ρ)) = d · v + ω · (ρ × Rᵀ d)` with
+//! `ρ = Rᵀ (p − x)` the lever arm in the body frame, so `h_d = (d, ρ × Rᵀ d)`. The candidate's rows count
+//! positively, the antagonist's negatively: `U = H*_a u_a − H*_b u_b`, and an impulse `P` adds `M⁻¹ H_a P` to
+//! `u_a` and subtracts `M⁻¹ H_b P` from `u_b`. The Delassus block is `W = H*_a M_a⁻¹ H_a + H*_b M_b⁻¹ H_b`.
+
+use super::cone::{project_cone, solve, Delassus3};
+use crate::geometry::{Pose, Vec3};
+use crate::nscd::contact::ContactLaw;
+use crate::nscd::method::{Row, SweepNorms};
+use crate::space::bodies::Dofs6;
+
+/// The solver's record of one 3D contact point: contiguous, everything one visit needs.
+#[derive(Debug, Clone, Copy)]
+pub struct ContactRow3 {
+    /// Candidate body.
+    pub a: u32,
+    /// Antagonist body.
+    pub b: u32,
+    /// Rows of `H*` of the candidate: normal, first and second tangent.
+    pub h_a: [Dofs6; 3],
+    /// Rows of `H*` of the antagonist.
+    pub h_b: [Dofs6; 3],
+    /// The local Delassus block (1/kg).
+    pub w: Delassus3,
+    /// Its entries, for `W P`.
+    pub wm: [[f64; 3]; 3],
+    /// Impulse `(P_N, P_T1, P_T2)` (N·s).
+    pub p: [f64; 3],
+    /// The contact stays open when `U_0N ≥ s_open` (m/s): `−g_m / h` for a gap `g_m > 0` at `q_m`, else 0.
+    pub s_open: f64,
+    /// The normal velocity enforced once closed (m/s): `max(s_open, −e_n U_N⁻)`.
+    pub c_closed: f64,
+    /// `e_t U_T⁻` (m/s), added to the tangential velocity the law acts on.
+    pub shift_t: [f64; 2],
+    /// Coulomb friction coefficient.
+    pub mu: f64,
+}
+
+#[inline(always)]
+fn dot6(h: &Dofs6, u: &Dofs6) -> f64 {
+    h[0] * u[0] + h[1] * u[1] + h[2] * u[2] + h[3] * u[3] + h[4] * u[4] + h[5] * u[5]
+}
+
+/// The generalised direction `h_d = (d, ρ × Rᵀ d)` of direction `d` (world) at lever arm `rho` (body frame).
+#[inline]
+pub fn gen_dir(pose: &Pose, rho: &Vec3, d: &Vec3) -> Dofs6 {
+    let local = pose.rotation.inverse_transform_vector(d);
+    let m = rho.cross(&local);
+    [d.x, d.y, d.z, m.x, m.y, m.z]
+}
+
+impl ContactRow3 {
+    /// The row of a contact at point `point` (world) with the frame `frame = [n, t₁, t₂]` between candidate
+    /// `a` at `pose_a` and antagonist `b` at `pose_b` (the intermediate configuration), their inverse masses and
+    /// start-of-step velocities (for `U⁻`), the gap `gap` (m) at `q_m` and the time step `h` (s).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        (a, b): (u32, u32),
+        point: Vec3,
+        frame: [Vec3; 3],
+        (pose_a, pose_b): (&Pose, &Pose),
+        (im_a, im_b): (&Dofs6, &Dofs6),
+        (ua, ub): (&Dofs6, &Dofs6),
+        gap: f64,
+        h: f64,
+        law: &ContactLaw,
+    ) -> Self {
+        let rho_a = pose_a.rotation.inverse_transform_vector(&(point - pose_a.position));
+        let rho_b = pose_b.rotation.inverse_transform_vector(&(point - pose_b.position));
+        let h_a: [Dofs6; 3] = std::array::from_fn(|k| gen_dir(pose_a, &rho_a, &frame[k]));
+        let h_b: [Dofs6; 3] = std::array::from_fn(|k| gen_dir(pose_b, &rho_b, &frame[k]));
+        let wdot =
+            |h: &[Dofs6; 3], im: &Dofs6, i: usize, j: usize| (0..6).map(|d| h[i][d] * im[d] * h[j][d]).sum::<f64>();
+        let wm: [[f64; 3]; 3] =
+            std::array::from_fn(|i| std::array::from_fn(|j| wdot(&h_a, im_a, i, j) + wdot(&h_b, im_b, i, j)));
+        let minus: [f64; 3] = std::array::from_fn(|k| dot6(&h_a[k], ua) - dot6(&h_b[k], ub));
+        let s_open = if gap > 0.0 { -gap / h } else { 0.0 };
+        let c_closed =
+            if law.restitution_n > 0.0 && minus[0] < 0.0 { s_open.max(-law.restitution_n * minus[0]) } else { s_open };
+        Self {
+            a,
+            b,
+            h_a,
+            h_b,
+            w: Delassus3::new(wm),
+            wm,
+            p: [0.0; 3],
+            s_open,
+            c_closed,
+            shift_t: [law.restitution_t * minus[1], law.restitution_t * minus[2]],
+            mu: law.friction,
+        }
+    }
+
+    /// The relative velocity `H*_a u_a − H*_b u_b` in the local frame (m/s).
+    #[inline(always)]
+    pub fn local_velocity(&self, u: &[Dofs6]) -> [f64; 3] {
+        let (ua, ub) = (&u[self.a as usize], &u[self.b as usize]);
+        std::array::from_fn(|k| dot6(&self.h_a[k], ua) - dot6(&self.h_b[k], ub))
+    }
+
+    /// `W x`.
+    #[inline(always)]
+    fn w_times(&self, x: &[f64; 3]) -> [f64; 3] {
+        std::array::from_fn(|i| self.wm[i][0] * x[0] + self.wm[i][1] * x[1] + self.wm[i][2] * x[2])
+    }
+
+    /// Adds `sign · M⁻¹ H p` to the candidate and subtracts it from the antagonist.
+    #[inline(always)]
+    fn apply(&self, u: &mut [Dofs6], inv_m: &[Dofs6], p: [f64; 3], sign: f64) {
+        for (body, h, s) in [(self.a, &self.h_a, sign), (self.b, &self.h_b, -sign)] {
+            let (ub, im) = (&mut u[body as usize], &inv_m[body as usize]);
+            for d in 0..6 {
+                ub[d] += s * im[d] * (h[0][d] * p[0] + h[1][d] * p[1] + h[2][d] * p[2]);
+            }
+        }
+    }
+}
+
+/// The norms of one 3D contact whose impulse goes from `p` to `q` (N·s) under its block `wm`
+/// ([`SweepNorms::add`]): `ΔU = W (q − p)`, `P̄ = ½ (p + q)`, and the midpoint averages of `P·WP` and `|WP|²`.
+#[inline(always)]
+fn add_norms(norms: &mut SweepNorms, wm: &[[f64; 3]; 3], p: [f64; 3], q: [f64; 3], changed: bool) {
+    let w = |x: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| wm[i][0] * x[0] + wm[i][1] * x[1] + wm[i][2] * x[2]) };
+    let d3 = |x: &[f64; 3], y: &[f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+    let dp: [f64; 3] = std::array::from_fn(|k| q[k] - p[k]);
+    let (du, wp, wq) = (w(&dp), w(&p), w(&q));
+    let pm: [f64; 3] = std::array::from_fn(|k| 0.5 * (p[k] + q[k]));
+    let wqq = d3(&q, &wq);
+    norms.add(
+        d3(&du, &du),
+        d3(&pm, &pm),
+        d3(&pm, &du),
+        0.5 * (d3(&p, &wp) + wqq),
+        0.5 * (d3(&wp, &wp) + d3(&wq, &wq)),
+        wqq,
+        changed,
+    );
+}
+
+impl Row for ContactRow3 {
+    type Dofs = Dofs6;
+
+    #[inline(always)]
+    fn bodies(&self) -> (u32, u32) {
+        (self.a, self.b)
+    }
+
+    #[inline(always)]
+    fn set_bodies(&mut self, a: u32, b: u32) {
+        (self.a, self.b) = (a, b);
+    }
+
+    #[inline(always)]
+    fn take_impulse(&mut self, other: &Self) {
+        self.p = other.p;
+    }
+
+    #[inline(always)]
+    fn add_impulse(&self, u: &mut [Dofs6], inv_m: &[Dofs6], sign: f64) {
+        self.apply(u, inv_m, self.p, sign);
+    }
+
+    #[inline(always)]
+    fn visit<const UPDATE: bool>(&mut self, u: &mut [Dofs6], inv_m: &[Dofs6], omega: f64, norms: &mut SweepNorms) {
+        let v = self.local_velocity(u);
+        let wp = self.w_times(&self.p);
+        let u0 = [v[0] - wp[0], v[1] - wp[1] + self.shift_t[0], v[2] - wp[2] + self.shift_t[1]];
+        let p = self.p;
+        let mut q = solve(&self.w, u0, self.s_open, self.c_closed, self.mu);
+        if omega != 1.0 {
+            q = project_cone(std::array::from_fn(|k| p[k] + omega * (q[k] - p[k])), self.mu);
+        }
+        let dp: [f64; 3] = std::array::from_fn(|k| q[k] - p[k]);
+        let changed = dp.iter().any(|&d| d != 0.0);
+        if UPDATE && changed {
+            self.p = q;
+            self.apply(u, inv_m, dp, 1.0);
+        }
+        add_norms(norms, &self.wm, p, q, changed);
+    }
+}

@@ -1,0 +1,162 @@
+//! The bodies of a 3D engine as flat arrays: each body's pose (centroid and a unit quaternion, body → world),
+//! its generalised velocity `u = (v_x, v_y, v_z, ω_1, ω_2, ω_3)` and its inverse mass per degree of freedom
+//! `(1/m, 1/m, 1/m, 1/I_1, 1/I_2, 1/I_3)`.
+//!
+//! The spin `ω` is expressed in the body's **principal frame** (the frame of its [`Solid`], whose axes are the
+//! principal axes of inertia), as LMGC90's RBDY3 keeps it: the inertia tensor is then diagonal and constant, a
+//! body's inverse mass is six numbers, and the shared method's rows ([`crate::nscd::method::Row`]) see six
+//! independent degrees of freedom. Euler's equations in that frame carry the gyroscopic term `−ω × I ω`, which
+//! the engine's step adds (`crate::nscd::d3`).
+//!
+//! A fixed body has an inverse mass of zero on every component: no impulse moves it; its velocity stays the one
+//! it was given (zero for a wall).
+
+use crate::geometry::{Pose, Solid, Vec3};
+use crate::{Error, Result};
+use nalgebra::UnitQuaternion;
+use serde::{Deserialize, Serialize};
+
+/// A body's generalised velocity or inverse mass in 3D: `(v_x, v_y, v_z)` in the world (m/s, or 1/kg) then
+/// `(ω_1, ω_2, ω_3)` about the principal axes (rad/s, or 1/(kg·m²)).
+pub type Dofs6 = [f64; 6];
+
+/// What a 3D body is, apart from where it is and how it moves.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BodyInfo {
+    /// Name (for messages and outputs).
+    pub name: String,
+    /// Shape in the principal frame.
+    pub solid: Solid,
+    /// Material index (contact laws are given per pair of materials).
+    pub material: u32,
+    /// Mass (kg); infinite for a fixed body.
+    pub mass: f64,
+    /// Principal moments of inertia (kg·m²) about the body axes; infinite for a fixed body.
+    pub inertia: Vec3,
+    /// Whether the body is fixed (a wall, a floor): its velocity is imposed (zero unless given) on every
+    /// component.
+    pub fixed: bool,
+}
+
+impl BodyInfo {
+    /// A mobile body of `solid` and `density` (kg/m³): mass `ρ V`, principal inertia `ρ J`.
+    pub fn mobile(name: &str, solid: Solid, material: u32, density: f64) -> Result<Self> {
+        if !(density.is_finite() && density > 0.0) {
+            return Err(Error::Scene(format!("body '{name}': density: must be positive and finite, got {density}")));
+        }
+        if matches!(solid, Solid::HalfSpace) {
+            return Err(Error::Scene(format!("body '{name}': a half-space can only be a fixed body")));
+        }
+        let (volume, second) = solid.mass_properties();
+        Ok(Self { name: name.into(), solid, material, mass: density * volume, inertia: second * density, fixed: false })
+    }
+
+    /// A fixed body (a wall, a floor, a half-space).
+    pub fn fixed(name: &str, solid: Solid, material: u32) -> Self {
+        Self {
+            name: name.into(),
+            solid,
+            material,
+            mass: f64::INFINITY,
+            inertia: Vec3::repeat(f64::INFINITY),
+            fixed: true,
+        }
+    }
+
+    /// The inverse mass per degree of freedom ([`Dofs6`]): zero for a fixed body.
+    pub fn inverse_mass(&self) -> Dofs6 {
+        if self.fixed {
+            return [0.0; 6];
+        }
+        let (m, i) = (1.0 / self.mass, self.inertia);
+        [m, m, m, 1.0 / i.x, 1.0 / i.y, 1.0 / i.z]
+    }
+}
+
+/// A body is seen by the detection as its shape.
+impl std::borrow::Borrow<Solid> for BodyInfo {
+    fn borrow(&self) -> &Solid {
+        &self.solid
+    }
+}
+
+/// The bodies of a 3D system, as parallel arrays.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Bodies {
+    /// What each body is.
+    pub info: Vec<BodyInfo>,
+    /// Where each is: centroid (m) and rotation body → world.
+    pub pose: Vec<Pose>,
+    /// Generalised velocity of each ([`Dofs6`]).
+    pub u: Vec<Dofs6>,
+    /// Inverse mass of each ([`Dofs6`]): zero for a fixed body.
+    pub inv_m: Vec<Dofs6>,
+}
+
+impl Bodies {
+    /// The number of bodies.
+    pub fn len(&self) -> usize {
+        self.info.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.info.is_empty()
+    }
+
+    /// Adds a body at `pose` with velocity `u` and returns its index. The velocity of a fixed body is imposed
+    /// for the whole run.
+    pub fn push(&mut self, info: BodyInfo, pose: Pose, u: Dofs6) -> u32 {
+        self.inv_m.push(info.inverse_mass());
+        self.info.push(info);
+        self.pose.push(pose);
+        self.u.push(u);
+        (self.info.len() - 1) as u32
+    }
+
+    /// Whether body `i` can move under contacts.
+    pub fn is_mobile(&self, i: usize) -> bool {
+        !self.info[i].fixed
+    }
+
+    /// Body `i`'s velocity: translation (m/s, world) and spin (rad/s, world).
+    pub fn world_velocity(&self, i: usize) -> (Vec3, Vec3) {
+        let u = &self.u[i];
+        (Vec3::new(u[0], u[1], u[2]), self.pose[i].rotation * Vec3::new(u[3], u[4], u[5]))
+    }
+
+    /// Body `i`'s angular momentum about its centroid (kg·m²/s, world): `R I ω`.
+    pub fn angular_momentum(&self, i: usize) -> Vec3 {
+        let (u, inertia) = (&self.u[i], &self.info[i].inertia);
+        self.pose[i].rotation * Vec3::new(inertia.x * u[3], inertia.y * u[4], inertia.z * u[5])
+    }
+
+    /// The kinetic energy of the mobile bodies (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        (0..self.len())
+            .filter(|&i| self.is_mobile(i))
+            .map(|i| {
+                let (u, b) = (&self.u[i], &self.info[i]);
+                0.5 * b.mass * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
+                    + 0.5 * (b.inertia.x * u[3] * u[3] + b.inertia.y * u[4] * u[4] + b.inertia.z * u[5] * u[5])
+            })
+            .sum()
+    }
+}
+
+/// The rotation by the rotation vector `phi` (rad, world): `exp(φ̂)`, exact (the quaternion of angle `|φ|` about
+/// `φ/|φ|`), the identity for `φ = 0`.
+#[inline]
+pub fn rotation(phi: Vec3) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_scaled_axis(phi)
+}
+
+/// A pose moved by a velocity over `dt` (s): the centroid by `v dt`, the frame by the rotation `exp(dt R ω)`
+/// with `ω` in the body frame (`R` the pose's rotation), composed on the left (a world-frame rotation) and
+/// renormalised.
+#[inline]
+pub fn advance(pose: &Pose, u: &Dofs6, dt: f64) -> Pose {
+    let spin = pose.rotation * Vec3::new(u[3], u[4], u[5]);
+    let rotation = UnitQuaternion::new_normalize((rotation(spin * dt) * pose.rotation).into_inner());
+    Pose { position: pose.position + Vec3::new(u[0], u[1], u[2]) * dt, rotation }
+}
