@@ -12,11 +12,12 @@
 use crate::error::{Error, Result};
 use crate::md::planar::PlanarSystem;
 use crate::md::MdSystem;
+use crate::nscd::d3::system::System3;
 use crate::nscd::System;
 use crate::run::{Figures, Progress, Restart, RunOptions, RunOutcome, Runner};
 use crate::scene::common::{AccelerationPlan, SettlementSection};
 use crate::scene::SceneFile;
-use crate::scene::{planar_length, scene_on, MdScene, Scene, SceneKind, SoftModelInfo};
+use crate::scene::{planar_length, scene_on, MdScene, Scene, Scene3, SceneKind, SoftModelInfo};
 use crate::settlement::{Accelerated, AccelerationOutcome, AccelerationProgress, AccelerationSummary, FolderFigures};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -46,6 +47,8 @@ pub enum Loaded {
     PlanarMd(Box<Opened<Scene, PlanarSystem>>, SoftModelInfo),
     /// Soft 3D spheres, molecular dynamics (`engine = "md"`).
     Md(Box<Opened<MdScene, MdSystem>>),
+    /// Rigid 3D polyhedra, spheres and walls, non-smooth contact dynamics (`engine = "nscd"`, `dimension = 3`).
+    Nscd3(Box<Opened<Scene3, System3>>),
 }
 
 /// Opens the scene file at `path` with the `engine` and `length` overrides of `opts`: its engine, its
@@ -80,6 +83,13 @@ pub fn open_text(text: String, path: &Path, opts: &RunOptions) -> Result<Loaded>
             let acceleration = if scene.settlement.is_some() { scene.acceleration()? } else { None };
             Ok(Loaded::PlanarMd(Box::new(Opened { path: path.to_path_buf(), scene, text, system, acceleration }), info))
         }
+        SceneKind::Nscd3 => {
+            let mut scene = Scene3::from_toml_str_named(&text, &name)?;
+            let text = scene.text_with_length(text, opts.length)?;
+            let acceleration = if scene.settlement.is_some() { scene.acceleration()? } else { None };
+            let system = scene.build()?;
+            Ok(Loaded::Nscd3(Box::new(Opened { path: path.to_path_buf(), scene, text, system, acceleration })))
+        }
         SceneKind::Nscd => {
             let (mut scene, text) = scene_on(&text, &name, SceneKind::Nscd, opts.engine.is_some())?;
             let text = scene.text_with_length(text, opts.length)?;
@@ -97,6 +107,7 @@ impl Loaded {
             Loaded::Nscd(o) => o.acceleration.is_some(),
             Loaded::PlanarMd(o, _) => o.acceleration.is_some(),
             Loaded::Md(o) => o.acceleration.is_some(),
+            Loaded::Nscd3(o) => o.acceleration.is_some(),
         }
     }
 
@@ -171,6 +182,16 @@ impl Loaded {
                 let runner = runner(&o.system, fresh, plan, (&o.path, text), restart, opts.resume)?;
                 keep(&mut o.system, runner.with_figures(plane_figures::<System>()).run_with(out, opts, control))
             }
+            Loaded::Nscd3(o) => {
+                let mut scene = o.scene.clone();
+                let text = scene.text_with_length(o.text.clone(), length)?;
+                let plan = scene.plan()?;
+                let fresh = o.scene.build()?;
+                let restart: Restart<System3> = Box::new(move |sys| scene.with_state(sys).to_toml_string());
+                let figures: Figures<System3> = Box::new(|dir, _| crate::report::draw_run_figures(dir).map(drop));
+                let runner = runner(&o.system, fresh, plan, (&o.path, text), restart, opts.resume)?;
+                keep(&mut o.system, runner.with_figures(figures).run_with(out, opts, control))
+            }
         }
     }
 
@@ -238,6 +259,14 @@ impl Loaded {
                 keep_settled(&mut o.system, run.run_with(out, opts, control))
             }
             Loaded::Nscd(o) => {
+                let mut scene = o.scene.clone();
+                let text = request.apply(&mut scene, &o.text, |s| &mut s.settlement)?;
+                let plan = settlement_plan(&scene)?;
+                let fresh = o.scene.build()?;
+                let run = accelerated(&o.system, fresh, plan, (scene.seed(), text), opts.resume)?;
+                keep_settled(&mut o.system, run.with_figures(settlement_figures()).run_with(out, opts, control))
+            }
+            Loaded::Nscd3(o) => {
                 let mut scene = o.scene.clone();
                 let text = request.apply(&mut scene, &o.text, |s| &mut s.settlement)?;
                 let plan = settlement_plan(&scene)?;

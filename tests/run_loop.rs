@@ -355,6 +355,7 @@ fn an_opened_scene_runs_stops_and_resumes() {
         Loaded::Nscd(o) => o.system.steps_done(),
         Loaded::PlanarMd(o, _) => o.system.steps_done(),
         Loaded::Md(o) => o.system.steps_done(),
+        Loaded::Nscd3(o) => o.system.steps_done(),
     };
     for (scene, stop) in [(&nscd, 23), (&md, 777)] {
         let out = |name: &str| dir.join(format!("{}-{name}", scene.file_stem().unwrap().to_string_lossy()));

@@ -29,6 +29,7 @@ fn scene_table(loaded: &Loaded) -> Option<SettlementSection> {
         Loaded::Nscd(o) => o.scene.settlement.clone(),
         Loaded::PlanarMd(o, _) => o.scene.settlement.clone(),
         Loaded::Md(o) => o.scene.settlement.clone(),
+        Loaded::Nscd3(o) => o.scene.settlement.clone(),
     }
 }
 

@@ -32,11 +32,16 @@ macro_rules! with_system {
                 let $s = &mut o.system;
                 $body
             }
+            Loaded::Nscd3(o) => {
+                let $s = &mut o.system;
+                $body
+            }
         }
     };
 }
 
-/// A scene opened on its engine: NSCD or planar MD (2D: positions `x, y, θ`) or 3D MD (positions `x, y, z`).
+/// A scene opened on its engine: NSCD or planar MD (2D: positions `x, y, θ`), 3D MD or 3D NSCD (positions
+/// `x, y, z`).
 #[pyclass(module = "ballast")]
 pub struct Simulation {
     loaded: Loaded,
@@ -91,7 +96,7 @@ fn matrix<'py>(py: Python<'py>, rows: Vec<[f64; 3]>) -> PyResult<Bound<'py, PyAr
 
 #[pymethods]
 impl Simulation {
-    /// The engine: `nscd`, `md2d` or `md`.
+    /// The engine: `nscd`, `md2d`, `md` or `nscd3d`.
     #[getter]
     fn engine(&mut self) -> &'static str {
         with_system!(&mut self.loaded, s => name_of(s))
@@ -409,6 +414,7 @@ impl Simulation {
             Loaded::Nscd(o) => o.scene.with_state(&o.system).to_toml_string(),
             Loaded::PlanarMd(o, _) => o.scene.with_bodies(&o.system.bodies).to_toml_string(),
             Loaded::Md(o) => o.scene.with_state(&o.system).to_toml_string(),
+            Loaded::Nscd3(o) => o.scene.with_state(&o.system).to_toml_string(),
         };
         text.map_err(to_py)
     }

@@ -10,6 +10,11 @@
 //!   [{"name": "base", "displacement": s, "force": [fx, fy, fz]}, …]}` (m, m/s,
 //!   rad/s, m; a wall's displacement along its normal since the start in m, and
 //!   the total contact force of the spheres on it in N).
+//! - 3D NSCD: `{"engine": "nscd3d", …, "bodies": [{"name": "cube", "position":
+//!   [x, y, z], "velocity": [vx, vy, vz], "spin": [wx, wy, wz], "orientation":
+//!   [w, x, y, z]}, …]}`: centroid (m), velocity (m/s), spin as a world vector
+//!   (rad/s), the unit quaternion of the principal frame (body → world); a
+//!   sphere also has its `radius` (m). Walls and floors are fixed bodies.
 //!
 //! Written with `serde_json` (floats as the shortest text that reads back to
 //! the same `f64`).
@@ -45,6 +50,10 @@ pub struct BodyState {
     /// Radius (m), spheres only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub radius: Option<f64>,
+    /// Orientation (3D NSCD): the unit quaternion `[w, x, y, z]` of the rotation from the body's principal
+    /// frame to the world.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation: Option<[f64; 4]>,
 }
 
 /// State of one wall (MD).
@@ -61,7 +70,7 @@ pub struct WallState {
 /// Contents of `final.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FinalState {
-    /// `"nscd"` or `"md"`.
+    /// `"nscd"`, `"md2d"`, `"nscd3d"` or `"md"`.
     pub engine: String,
     /// Time (s).
     pub time: f64,

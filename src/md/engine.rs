@@ -125,6 +125,7 @@ impl Engine for MdSystem {
                 velocity: p.v[i].iter().copied().collect(),
                 spin: Spin::Spatial(p.w[i].into()),
                 radius: Some(p.r[i]),
+                orientation: None,
             })
             .collect();
         let walls = self

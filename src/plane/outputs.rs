@@ -40,6 +40,7 @@ pub fn final_state(sys: &impl PlaneSystem, engine: &str) -> FinalState {
             velocity: vec![u[0], u[1]],
             spin: Spin::Planar(u[2]),
             radius: None,
+            orientation: None,
         })
         .collect();
     FinalState { engine: engine.into(), time: sys.plane_time(), step: sys.plane_step(), bodies, walls: Vec::new() }

@@ -58,6 +58,11 @@ pub fn draw_run_figures(dir: &Path) -> Result<RunFigures> {
     match fin.engine.as_str() {
         "nscd" | "md2d" => plane::nscd_figures(dir, None),
         "md" => md::md_figures(dir),
+        "nscd3d" => Err(Error::Scene(format!(
+            "{}: figures of 3D NSCD runs are not built yet (the run's files are: series.csv, contacts.csv, the .vtp \
+             snapshots for ParaView)",
+            dir.display()
+        ))),
         other => Err(Error::Scene(format!("{}: unknown engine '{other}'", dir.join(layout::FINAL).display()))),
     }
 }

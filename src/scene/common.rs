@@ -133,7 +133,8 @@ pub(crate) fn check_simulation(sim: &Simulation, engine: &str, dimension: i64) -
         ));
     }
     if let Some(d) = sim.dimension.filter(|&d| d != dimension) {
-        return err(format!("simulation.dimension: must be {dimension} for the {engine} engine, got {d}"));
+        let hint = if engine == "nscd" && d == 3 { " (a 3D NSCD scene is read with scene::Scene3)" } else { "" };
+        return err(format!("simulation.dimension: must be {dimension} for the {engine} engine, got {d}{hint}"));
     }
     check_time(sim.dt, sim.duration)?;
     if let Some(g) = &sim.gravity {

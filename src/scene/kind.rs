@@ -12,6 +12,8 @@ use crate::scene::SceneFile;
 pub enum SceneKind {
     /// A 2D scene on the NSCD engine ([`Scene`]).
     Nscd,
+    /// A 3D NSCD scene ([`super::Scene3`]: `engine = "nscd"` with `dimension = 3`; polyhedra, spheres, walls).
+    Nscd3,
     /// A 3D MD scene ([`super::MdScene`]).
     Md,
     /// A 2D scene on the planar MD engine ([`Scene`] with `[soft]`).
@@ -29,7 +31,14 @@ impl SceneKind {
     pub fn of(text: &str, name: &str, engine: Option<&str>) -> Result<SceneKind> {
         let own = super::engine_of_named(text, name)?;
         let spheres = own == "md";
+        if let Some(e @ ("md" | "md2d")) = engine.filter(|_| own == "nscd") {
+            if Self::is_nscd3(text, name)? {
+                return err(format!("engine: {e} does not run 3D NSCD scenes (polyhedra), use nscd"));
+            }
+        }
+        let nscd3 = own == "nscd" && Self::is_nscd3(text, name)?;
         match engine {
+            None | Some("nscd") if nscd3 => Ok(SceneKind::Nscd3),
             None if spheres => Ok(SceneKind::Md),
             None if own == "md2d" => Ok(SceneKind::PlanarMd),
             None => Ok(SceneKind::Nscd),
@@ -44,10 +53,42 @@ impl SceneKind {
         }
     }
 
+    /// Whether the scene text `text` (named `name` in messages) is a 3D NSCD scene, read with
+    /// [`super::Scene3`]: `[simulation] engine = "nscd"` with `dimension = 3` ([`SceneKind::Nscd3`]; an `engine`
+    /// override other than `nscd` is refused, and [`scene_on`], the 2D reader, refuses it naming `scene::Scene3`).
+    ///
+    /// # Errors
+    /// [`Error::Scene`](crate::Error::Scene) for a TOML syntax error (`NAME line L: …`); a scene without
+    /// `[simulation] engine` is not a 3D NSCD scene (its reader says what is missing).
+    ///
+    /// ```
+    /// use ballast::scene::SceneKind;
+    /// let text = "[simulation]\nengine = \"nscd\"\ndimension = 3\ndt = 1e-3\n";
+    /// assert!(SceneKind::is_nscd3(text, "scene.toml").unwrap());
+    /// assert!(!SceneKind::is_nscd3("[simulation]\nengine = \"nscd\"\ndt = 1e-3\n", "scene.toml").unwrap());
+    /// ```
+    pub fn is_nscd3(text: &str, name: &str) -> Result<bool> {
+        #[derive(serde::Deserialize)]
+        struct Probe {
+            simulation: Option<ProbeSimulation>,
+        }
+        #[derive(serde::Deserialize)]
+        struct ProbeSimulation {
+            engine: Option<toml::Value>,
+            dimension: Option<toml::Value>,
+        }
+        let probe: Probe =
+            toml::from_str(text).map_err(|e| crate::Error::Scene(super::parse::one_line(name, text, &e)))?;
+        Ok(probe.simulation.is_some_and(|s| {
+            s.engine.as_ref().and_then(|e| e.as_str()) == Some("nscd")
+                && s.dimension.and_then(|d| d.as_integer()) == Some(3)
+        }))
+    }
+
     /// The engine's name, as scenes, `--engine` and the outputs write it: `nscd`, `md2d`, `md`.
     pub fn name(self) -> &'static str {
         match self {
-            SceneKind::Nscd => "nscd",
+            SceneKind::Nscd | SceneKind::Nscd3 => "nscd",
             SceneKind::PlanarMd => "md2d",
             SceneKind::Md => "md",
         }
@@ -59,8 +100,11 @@ impl SceneKind {
 /// the engine was `overridden` (`--engine`), the scene rewritten with that engine.
 ///
 /// # Errors
-/// [`Error::Scene`](crate::Error::Scene) for an invalid scene, or a 3D `kind`.
+/// [`Error::Scene`](crate::Error::Scene) for an invalid scene, a 3D `kind` or a 3D NSCD scene.
 pub fn scene_on(text: &str, name: &str, kind: SceneKind, overridden: bool) -> Result<(Scene, String)> {
+    if SceneKind::is_nscd3(text, name)? {
+        return err("simulation.dimension: a 3D NSCD scene (dimension = 3) is read with scene::Scene3".into());
+    }
     let scene = Scene::from_toml_str_named(text, name)?;
     if kind == SceneKind::Md {
         return err("a 3D MD scene is read with scene::MdScene".into());

@@ -26,6 +26,7 @@
 
 mod build;
 pub mod common;
+pub mod d3;
 mod file;
 mod format;
 mod kind;
@@ -35,6 +36,7 @@ mod soft;
 mod validate;
 mod write;
 
+pub use d3::Scene3;
 pub use file::{read_text, SceneFile};
 pub use format::*;
 pub use kind::{planar_length, scene_on, SceneKind};

@@ -29,9 +29,11 @@ pub struct BodyInfo {
     pub solid: Solid,
     /// Material index (contact laws are given per pair of materials).
     pub material: u32,
-    /// Mass (kg); infinite for a fixed body.
+    /// Mass (kg); infinite for a fixed body (JSON `null`, read back as +∞: [`infinite`]).
+    #[serde(with = "infinite")]
     pub mass: f64,
-    /// Principal moments of inertia (kg·m²) about the body axes; infinite for a fixed body.
+    /// Principal moments of inertia (kg·m²) about the body axes; infinite for a fixed body (JSON `null`s).
+    #[serde(with = "infinite::vec3")]
     pub inertia: Vec3,
     /// Whether the body is fixed (a wall, a floor): its velocity is imposed (zero unless given) on every
     /// component.
@@ -70,6 +72,40 @@ impl BodyInfo {
         }
         let (m, i) = (1.0 / self.mass, self.inertia);
         [m, m, m, 1.0 / i.x, 1.0 / i.y, 1.0 / i.z]
+    }
+}
+
+/// The serde form of a number that is infinite for a fixed body (its mass, its moments of inertia): JSON has no
+/// infinity, serde_json writes a non-finite number as `null`; this reads `null` back as +∞, so that a state with
+/// walls (a checkpoint, `initial_state.json`) reads back as it was written. A finite number reads back bit for bit.
+pub mod infinite {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    /// Writes `x` (`null` when not finite).
+    pub fn serialize<S: Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+        x.serialize(s)
+    }
+
+    /// Reads a number, or `null` as +∞.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
+    }
+
+    /// The same for the three components of a vector.
+    pub mod vec3 {
+        use crate::geometry::Vec3;
+        use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+        /// Writes `[x, y, z]` (`null` for a component that is not finite).
+        pub fn serialize<S: Serializer>(v: &Vec3, s: S) -> Result<S::Ok, S::Error> {
+            [v.x, v.y, v.z].serialize(s)
+        }
+
+        /// Reads `[x, y, z]`, `null` as +∞.
+        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec3, D::Error> {
+            let c = <[Option<f64>; 3]>::deserialize(d)?;
+            Ok(Vec3::from(c.map(|x| x.unwrap_or(f64::INFINITY))))
+        }
     }
 }
 
@@ -123,6 +159,18 @@ impl Bodies {
     pub fn world_velocity(&self, i: usize) -> (Vec3, Vec3) {
         let u = &self.u[i];
         (Vec3::new(u[0], u[1], u[2]), self.pose[i].rotation * Vec3::new(u[3], u[4], u[5]))
+    }
+
+    /// Body `i`'s orientation as a unit quaternion `[w, x, y, z]` (body → world).
+    pub fn orientation(&self, i: usize) -> [f64; 4] {
+        let q = self.pose[i].rotation.quaternion();
+        [q.w, q.i, q.j, q.k]
+    }
+
+    /// The velocity (m/s, world) of the material point of body `i` at `point` (world): `v + R ω × (p − x)`.
+    pub fn point_velocity(&self, i: usize, point: &Vec3) -> Vec3 {
+        let (v, w) = self.world_velocity(i);
+        v + w.cross(&(point - self.pose[i].position))
     }
 
     /// Body `i`'s angular momentum about its centroid (kg·m²/s, world): `R I ω`.

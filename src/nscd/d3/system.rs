@@ -14,8 +14,15 @@
 //!    the same key (kept as world vectors and projected on the new frame), solved by the method's policies.
 //! 4. **Update**: `u_{n+1}` from the solve; `q_{n+1} = q_m + θ h u_{n+1}` (centroid and frame as in 2).
 //!
-//! A step that produces a non-finite velocity or position returns [`Error::Diverged`] naming the step and the
-//! body, and the system keeps the state of the last good step.
+//! A step that starts from or produces a non-finite velocity or position, or leaves an overlap deeper than half
+//! the smaller inradius of a pair at `q_{n+1}` (predicted to first order, `g + θ h U_N`, as the 2D engine does),
+//! returns [`Error::Diverged`] naming the step and the body, and the system keeps the state of the last good step
+//! (its bodies, clock, warm start and contact list).
+//!
+//! The system is plain serde data (a checkpoint of the run loop is its serde form): the parameters, bodies, laws,
+//! clock and the last step's contacts with their impulses (the warm start of the next step); the solver's
+//! buffers and the detector are not kept (the detector's per-pair memory of the normal only lets it stop early:
+//! its result does not depend on it), so a state read back steps on with the same numbers.
 
 use super::contact::ContactRow3;
 use crate::geometry::{Pose, Vec3};
@@ -24,9 +31,10 @@ use crate::nscd::method::{apply_impulses, solve_nlgs, NlgsReport, NlgsSettings, 
 use crate::space::bodies::{advance, Bodies, Dofs6};
 use crate::space::detection::Detector;
 use crate::{Error, Result};
+use serde::{Deserialize, Serialize};
 
 /// The parameters of a 3D NSCD system.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Params3 {
     /// Time step `h` (s). Default 1e-3.
     pub dt: f64,
@@ -74,8 +82,20 @@ pub struct ContactForce3 {
 /// What one step did.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct StepStats3 {
-    /// Contact points in the problem.
+    /// Time at the end of the step (s).
+    pub time: f64,
+    /// Kinetic energy of the mobile bodies at the end of the step (J).
+    pub kinetic_energy: f64,
+    /// Contact points in the problem (open ones within the alert distance included).
     pub contacts: usize,
+    /// Contact points carrying an impulse or overlapping at the end of the step.
+    pub active_contacts: usize,
+    /// Mean overlap over the active contact points at the end of the step (m), `max(0, −(g + θ h U_N))`.
+    pub mean_overlap: f64,
+    /// Largest overlap at the end of the step (m).
+    pub max_overlap: f64,
+    /// Sum of the overlaps of the contact points (m).
+    pub total_overlap: f64,
     /// The solve's report.
     pub nlgs: NlgsReport,
     /// Wall time of the detection (s): for measurements, not part of any result.
@@ -86,6 +106,22 @@ pub struct StepStats3 {
 
 /// A key that names a contact point from step to step: candidate, antagonist, point of the pair.
 type Key = (u32, u32, u32);
+
+/// A contact point of the last step as the system keeps it (in its serde form too): where it was and the impulse
+/// it carried.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Contact3 {
+    /// Candidate, antagonist, point of the pair.
+    pub key: Key,
+    /// Contact point at the intermediate configuration (m, world).
+    pub point: Vec3,
+    /// Local frame `[n, t₁, t₂]` (world; `n` from the antagonist towards the candidate).
+    pub frame: [Vec3; 3],
+    /// Gap at the intermediate configuration (m).
+    pub gap: f64,
+    /// Impulse `(P_N, P_T1, P_T2)` over the step (N·s).
+    pub p: [f64; 3],
+}
 
 /// No spring rows yet in 3D (the sublayer's law (17) in 3D is not built): the type of an empty list.
 #[derive(Debug, Clone, Copy)]
@@ -115,29 +151,43 @@ impl Row for NoSpring {
     }
 }
 
-/// A 3D NSCD system: its bodies, contact laws, detection and warm-start memory.
-#[derive(Debug, Clone)]
+/// A 3D NSCD system: its bodies, contact laws, detection and warm-start memory (module doc: its serde form).
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct System3 {
     /// Parameters.
     pub params: Params3,
     /// The bodies.
     pub bodies: Bodies,
-    /// Time (s).
+    /// Time (s): `t_0 + (k − k_0) h` from [`Self::origin`] after every step, never accumulated.
     pub time: f64,
     /// Steps made.
     pub steps: u64,
+    /// The clock's origin `(t_0, k_0)`: the time and step at which the time step last changed
+    /// ([`Self::set_dt`]).
+    #[serde(flatten)]
+    pub origin: crate::clock::Origin,
     materials: usize,
     laws: Vec<ContactLaw>,
+    /// The impulses (world, N·s) of the last step's contacts, sorted by key: the next step's warm start.
+    memory: Vec<(Key, Vec3)>,
+    /// The last step's contact points with their impulses, sorted by key.
+    contacts: Vec<Contact3>,
+    #[serde(skip)]
     detector: Detector,
+    #[serde(skip)]
     poses_m: Vec<Pose>,
+    #[serde(skip)]
     rows: Vec<ContactRow3>,
     /// Per row: its key, point, frame `[n, t₁, t₂]` and gap.
+    #[serde(skip)]
     geometry: Vec<(Key, Vec3, [Vec3; 3], f64)>,
-    /// The impulses (world, N·s) of the last step's contacts, sorted by key.
-    memory: Vec<(Key, Vec3)>,
+    #[serde(skip)]
     u_begin: Vec<Dofs6>,
+    #[serde(skip)]
     u: Vec<Dofs6>,
+    #[serde(skip)]
     mobile: Vec<bool>,
+    #[serde(skip)]
     springs: Vec<NoSpring>,
 }
 
@@ -150,8 +200,10 @@ impl System3 {
             bodies: Bodies::default(),
             time: 0.0,
             steps: 0,
+            origin: crate::clock::Origin::default(),
             materials,
             laws: vec![ContactLaw::default(); materials * materials],
+            contacts: Vec::new(),
             detector: Detector::default(),
             poses_m: Vec::new(),
             rows: Vec::new(),
@@ -169,6 +221,32 @@ impl System3 {
         let n = self.materials;
         self.laws[i * n + j] = law;
         self.laws[j * n + i] = law;
+    }
+
+    /// Changes the time step (s) from now on, keeping the clock exact (the origin moves to now).
+    pub fn set_dt(&mut self, dt: f64) {
+        self.origin.rebase(self.time, self.steps);
+        self.params.dt = dt;
+    }
+
+    /// The number of materials.
+    pub fn materials(&self) -> usize {
+        self.materials
+    }
+
+    /// The contact laws, pair `(i, j)` at `i * materials + j`.
+    pub fn laws(&self) -> &[ContactLaw] {
+        &self.laws
+    }
+
+    /// The warm-start memory: the world impulses (N·s) of the last step's contact points, sorted by key.
+    pub fn warm_start(&self) -> &[((u32, u32, u32), Vec3)] {
+        &self.memory
+    }
+
+    /// The last step's contact points with their impulses, sorted by key.
+    pub fn contacts(&self) -> &[Contact3] {
+        &self.contacts
     }
 
     fn law(&self, a: usize, b: usize) -> &ContactLaw {
@@ -202,6 +280,13 @@ impl System3 {
         self.check()?;
         let (h, theta) = (self.params.dt, self.params.theta);
         let n = self.bodies.len();
+        // A non-finite start (a body given a NaN) is refused before the detection sees it.
+        for i in 0..n {
+            let (pose, u) = (&self.bodies.pose[i], &self.bodies.u[i]);
+            if !pose.position.iter().chain(pose.rotation.coords.iter()).chain(u).all(|x| x.is_finite()) {
+                return Err(self.diverged(i, "non-finite position or velocity at the start of the step"));
+            }
+        }
         // 1. Free velocity, explicit gyroscopic term.
         self.u_begin.clear();
         self.u_begin.extend_from_slice(&self.bodies.u);
@@ -271,16 +356,55 @@ impl System3 {
             }
             self.poses_m[i] = pose;
         }
+        let overlaps = self.overlaps_at_end()?;
         std::mem::swap(&mut self.bodies.pose, &mut self.poses_m);
         std::mem::swap(&mut self.bodies.u, &mut self.u);
         self.memory.clear();
-        for (row, (key, _, frame, _)) in self.rows.iter().zip(&self.geometry) {
+        self.contacts.clear();
+        for (row, &(key, point, frame, gap)) in self.rows.iter().zip(&self.geometry) {
             let pw = frame[0] * row.p[0] + frame[1] * row.p[1] + frame[2] * row.p[2];
-            self.memory.push((*key, pw));
+            self.memory.push((key, pw));
+            self.contacts.push(Contact3 { key, point, frame, gap, p: row.p });
         }
         self.steps += 1;
-        self.time = self.params.dt * self.steps as f64;
-        Ok(StepStats3 { contacts: self.rows.len(), nlgs: report, detect_seconds, solve_seconds })
+        self.time = self.origin.time_at(self.steps, self.params.dt);
+        Ok(StepStats3 {
+            time: self.time,
+            kinetic_energy: self.bodies.kinetic_energy(),
+            contacts: self.rows.len(),
+            active_contacts: overlaps.0,
+            mean_overlap: if overlaps.0 > 0 { overlaps.1 / overlaps.0 as f64 } else { 0.0 },
+            max_overlap: overlaps.2,
+            total_overlap: overlaps.1,
+            nlgs: report,
+            detect_seconds,
+            solve_seconds,
+        })
+    }
+
+    /// The overlaps of the solved rows at the end of the step, `max(0, −(g + θ h U_N))` with `U_N` from the new
+    /// velocities (`self.u`): the active rows (an impulse or an overlap), the sum and the largest; a runaway
+    /// overlap (beyond half the smaller inradius of the pair, [`inradius`]) or a non-finite one is
+    /// [`Error::Diverged`] naming the body that moved into the other (the candidate unless it is fixed).
+    fn overlaps_at_end(&self) -> Result<(usize, f64, f64)> {
+        let th = self.params.theta * self.params.dt;
+        let (mut active, mut sum, mut max) = (0, 0.0, 0.0f64);
+        for (row, g) in self.rows.iter().zip(&self.geometry) {
+            let gap_end = g.3 + th * row.local_velocity(&self.u)[0];
+            let overlap = (-gap_end).max(0.0);
+            if row.p[0] > 0.0 || overlap > 0.0 {
+                active += 1;
+                sum += overlap;
+            }
+            max = max.max(overlap);
+            let (a, b) = (row.a as usize, row.b as usize);
+            let limit = 0.5 * inradius(&self.bodies.info[a].solid).min(inradius(&self.bodies.info[b].solid));
+            if overlap > limit || !gap_end.is_finite() {
+                let (culprit, other) = if self.bodies.is_mobile(a) { (a, b) } else { (b, a) };
+                return Err(self.diverged(culprit, &format!("runaway overlap {overlap:.3e} m with body {other}")));
+            }
+        }
+        Ok((active, sum, max))
     }
 
     fn diverged(&self, body: usize, what: &str) -> Error {
@@ -290,14 +414,154 @@ impl System3 {
     /// The contacts of the last step with their mean forces over it.
     pub fn contact_forces(&self) -> impl Iterator<Item = ContactForce3> + '_ {
         let h = self.params.dt;
-        self.rows.iter().zip(&self.geometry).map(move |(row, (key, point, frame, gap))| ContactForce3 {
-            candidate: key.0,
-            antagonist: key.1,
-            point: *point,
-            normal: frame[0],
-            gap: *gap,
-            r_n: row.p[0] / h,
-            force: (frame[0] * row.p[0] + frame[1] * row.p[1] + frame[2] * row.p[2]) / h,
+        self.contacts.iter().map(move |c| ContactForce3 {
+            candidate: c.key.0,
+            antagonist: c.key.1,
+            point: c.point,
+            normal: c.frame[0],
+            gap: c.gap,
+            r_n: c.p[0] / h,
+            force: (c.frame[0] * c.p[0] + c.frame[1] * c.p[1] + c.frame[2] * c.p[2]) / h,
         })
+    }
+}
+
+impl System3 {
+    /// Checks that the state holds together (a state read from a checkpoint): one pose, velocity and inverse mass
+    /// per body, the inverse masses those of the bodies' descriptions, finite positions and velocities, unit
+    /// quaternions (to 1e-9), one law per pair of materials, the warm start and the contact list sorted by key and
+    /// naming existing bodies, the parameters' ranges and the clock. The message names the body or what is wrong.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] with that message.
+    pub fn check_state(&self) -> Result<()> {
+        let bad = |msg: String| Err(Error::Scene(msg));
+        let b = &self.bodies;
+        let n = b.len();
+        if b.pose.len() != n || b.u.len() != n || b.inv_m.len() != n {
+            let (p, u, m) = (b.pose.len(), b.u.len(), b.inv_m.len());
+            return bad(format!("bodies: {n} descriptions, {p} poses, {u} velocities, {m} inverse masses"));
+        }
+        for i in 0..n {
+            let name = crate::error::clip(&b.info[i].name);
+            let (pose, u) = (&b.pose[i], &b.u[i]);
+            if !pose.position.iter().all(|x| x.is_finite()) {
+                return bad(format!("body {i} ('{name}'): its position is not finite"));
+            }
+            if !u.iter().all(|x| x.is_finite()) {
+                return bad(format!("body {i} ('{name}'): its velocity is not finite"));
+            }
+            let (norm, off) = (pose.rotation.coords.norm(), (pose.rotation.coords.norm() - 1.0).abs());
+            if off.is_nan() || off > 1e-9 {
+                return bad(format!("body {i} ('{name}'): its orientation is not a unit quaternion (norm {norm})"));
+            }
+            if b.inv_m[i].iter().zip(b.info[i].inverse_mass()).any(|(a, c)| a.to_bits() != c.to_bits()) {
+                return bad(format!("body {i} ('{name}'): its inverse masses are not those of its mass and inertia"));
+            }
+        }
+        if self.materials == 0 || self.materials.checked_mul(self.materials) != Some(self.laws.len()) {
+            return bad(format!("{} contact laws for {} materials", self.laws.len(), self.materials));
+        }
+        let in_range = |k: &Key| (k.0 as usize) < n && (k.1 as usize) < n;
+        if !self.memory.iter().all(|(k, _)| in_range(k)) || self.memory.windows(2).any(|w| w[0].0 >= w[1].0) {
+            return bad("warm start: bodies out of range or keys not sorted".into());
+        }
+        if !self.contacts.iter().all(|c| in_range(&c.key)) || self.contacts.windows(2).any(|w| w[0].key >= w[1].key) {
+            return bad("last contacts: bodies out of range or keys not sorted".into());
+        }
+        self.check()?;
+        self.origin.check(self.steps, Some(self.time), self.params.dt).or_else(bad)
+    }
+
+    /// Checks that `self` (read from a checkpoint) is a state of the model `fresh` (the system built from the
+    /// same scene or code): the same bodies (names, shapes, materials, masses, inertia, fixed flags, inverse
+    /// masses), materials and contact laws, parameters and clock origin.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] "… differs from the scene's", naming the body.
+    pub fn check_same_model(&self, fresh: &System3) -> Result<()> {
+        let bad = |what: String| Err(Error::Scene(format!("{what} differs from the scene's")));
+        let (a, b) = (&self.bodies, &fresh.bodies);
+        if a.len() != b.len() {
+            return bad(format!("the number of bodies ({})", a.len()));
+        }
+        for i in 0..a.len() {
+            let same_inverse = a.inv_m[i].iter().zip(&b.inv_m[i]).all(|(x, y)| x.to_bits() == y.to_bits());
+            if !same(&a.info[i], &b.info[i]) || !same_inverse {
+                return bad(format!("body {i} ('{}')", crate::error::clip(&b.info[i].name)));
+            }
+        }
+        if self.materials != fresh.materials || !same(&self.laws, &fresh.laws) {
+            return bad("the contact laws".into());
+        }
+        if !same(&self.params, &fresh.params) {
+            return bad("the 3D NSCD parameters or time step".into());
+        }
+        if !self.origin.same(&fresh.origin) {
+            return bad("the clock's origin".into());
+        }
+        Ok(())
+    }
+
+    /// Moves every body of `bodies` to its position `x` (centroid, m) and orientation `rotations` (unit
+    /// quaternions, renormalised), sets the velocity of every mobile body to zero (a fixed body keeps the
+    /// velocity imposed on it) and forgets the warm start and
+    /// the contact list (and the detector's memory), so that the next step starts from this configuration as a
+    /// system built there would. The clock goes on.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming the body if one does not exist, is fixed, or a value is not finite or the
+    /// quaternion is zero; the system is then unchanged.
+    pub fn place(&mut self, bodies: &[usize], x: &[Vec3], rotations: &[nalgebra::Quaternion<f64>]) -> Result<()> {
+        let n = self.bodies.len();
+        let bad = |msg: String| Err(Error::Scene(format!("configuration: {msg}")));
+        if x.len() != bodies.len() || rotations.len() != bodies.len() {
+            return bad(format!("{} bodies, {} positions, {} orientations", bodies.len(), x.len(), rotations.len()));
+        }
+        let mut poses = Vec::with_capacity(bodies.len());
+        for ((&i, x), q) in bodies.iter().zip(x).zip(rotations) {
+            if i >= n {
+                return bad(format!("body {i} does not exist (the engine has {n})"));
+            }
+            let name = crate::error::clip(&self.bodies.info[i].name);
+            if self.bodies.info[i].fixed {
+                return bad(format!("body {i} ('{name}') is fixed"));
+            }
+            if !x.iter().chain(q.coords.iter()).all(|v| v.is_finite()) {
+                return bad(format!("body {i} ('{name}'): a coordinate is not finite"));
+            }
+            let norm = q.norm();
+            if !(norm > 0.0 && norm.is_finite()) {
+                return bad(format!("body {i} ('{name}'): its orientation is a zero quaternion"));
+            }
+            poses.push(Pose { position: *x, rotation: nalgebra::UnitQuaternion::from_quaternion(q / norm) });
+        }
+        for (&i, pose) in bodies.iter().zip(poses) {
+            self.bodies.pose[i] = pose;
+        }
+        for (info, u) in self.bodies.info.iter().zip(self.bodies.u.iter_mut()) {
+            if !info.fixed {
+                *u = [0.0; 6];
+            }
+        }
+        self.memory.clear();
+        self.contacts.clear();
+        self.detector = Detector::default();
+        Ok(())
+    }
+}
+
+/// Whether two values serialise to the same JSON (floats bit for bit through serde_json's shortest round trip).
+fn same<T: Serialize>(a: &T, b: &T) -> bool {
+    serde_json::to_value(a).ok() == serde_json::to_value(b).ok()
+}
+
+/// The radius of the largest sphere about the centroid inside a solid (m): a polyhedron's inradius, a sphere's
+/// radius, infinite for a half-space. Half of the smaller of a pair's is the deepest overlap a step may leave.
+pub fn inradius(solid: &crate::geometry::Solid) -> f64 {
+    match solid {
+        crate::geometry::Solid::Polyhedron(p) => p.inradius,
+        crate::geometry::Solid::Sphere { radius } => *radius,
+        crate::geometry::Solid::HalfSpace => f64::INFINITY,
     }
 }

@@ -1,0 +1,168 @@
+//! The serde mirror of the 3D NSCD scene format (`[simulation] engine = "nscd"`, `dimension = 3`; the format is
+//! described in [`super`]).
+//!
+//! As in the 2D format every table refuses unknown keys and optional keys are `Option`s, so that a scene written
+//! back with [`to_toml_string`](crate::scene::SceneFile::to_toml_string) keeps exactly the keys the user gave.
+//! `[simulation]`, `[output]`, `[settlement]`, `[nscd]`, `[[material]]` and `[[contact]]` are the 2D scene's own
+//! types. Vectors are arrays of exactly 3 numbers (a quaternion of 4). `imposed`, `load` and `[[spring]]` are read
+//! as any TOML value only so that validation can refuse them by name: they are not built for 3D NSCD.
+
+use crate::scene::common::{OutputSection, SettlementSection, Simulation};
+use crate::scene::format::{array, opt_array, ContactEntry, Material, NscdSection};
+use serde::{Deserialize, Deserializer, Serialize};
+
+/// A whole 3D NSCD scene file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene3 {
+    /// `[simulation]`: engine (`"nscd"`), `dimension = 3`, time step, duration, gravity (3 components), seed,
+    /// equilibrium stop.
+    pub simulation: Simulation,
+    /// `[nscd]`: the 2D scene's settings (optional); `solver` other than `"nlgs"` and `on_stall = "stop"` are
+    /// refused (not built for 3D).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nscd: Option<NscdSection>,
+    /// `[output]` (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output: Option<OutputSection>,
+    /// `[settlement]`: the settlement-acceleration procedure instead of a plain run (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settlement: Option<SettlementSection>,
+    /// `[[material]]` entries; a material's index is its position here.
+    #[serde(default, rename = "material", skip_serializing_if = "Vec::is_empty")]
+    pub materials: Vec<Material>,
+    /// `[[contact]]` entries: contact laws between pairs of materials (a pair without one is frictionless and
+    /// plastic, as in 2D).
+    #[serde(default, rename = "contact", skip_serializing_if = "Vec::is_empty")]
+    pub contacts: Vec<ContactEntry>,
+    /// `[[body]]` entries, in order (body `i` of the system is `bodies[i]`).
+    #[serde(default, rename = "body", skip_serializing_if = "Vec::is_empty")]
+    pub bodies: Vec<BodySpec3>,
+    /// `[[spring]]`: read only to be refused (sublayer springs are not built for 3D NSCD).
+    #[serde(default, rename = "spring", skip_serializing_if = "Vec::is_empty")]
+    pub springs: Vec<toml::Value>,
+}
+
+/// `[[body]]` of a 3D scene: exactly one of `polyhedron`, `box`, `sphere`, `plane`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec3 {
+    /// Optional name (default empty); non-empty names are unique.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub name: String,
+    /// Name of the body's material.
+    pub material: String,
+    /// Convex hull of vertices given in the body frame.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polyhedron: Option<PolyhedronSpec>,
+    /// Box centred on the body-frame origin, along its axes.
+    #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
+    pub cuboid: Option<BoxSpec>,
+    /// Sphere centred on the body-frame origin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sphere: Option<SphereSpec>,
+    /// Half-space wall whose boundary passes through `position` (fixed bodies only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plane: Option<PlaneSpec>,
+    /// World position of the body-frame origin (m).
+    #[serde(deserialize_with = "array")]
+    pub position: [f64; 3],
+    /// Rotation of the body frame (body → world); default none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation: Option<OrientationSpec>,
+    /// Velocity of the body-frame origin (m/s, world); default 0.
+    #[serde(default, deserialize_with = "opt_array", skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<[f64; 3]>,
+    /// Angular velocity (rad/s, world axes); default 0.
+    #[serde(default, deserialize_with = "opt_array", skip_serializing_if = "Option::is_none")]
+    pub spin: Option<[f64; 3]>,
+    /// A fixed body never moves; default false. A plane must be fixed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fixed: Option<bool>,
+    /// Read only to be refused: imposed velocities are not built for 3D NSCD.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub imposed: Option<toml::Value>,
+    /// Read only to be refused: harmonic loads are not built for 3D NSCD.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load: Option<toml::Value>,
+}
+
+impl BodySpec3 {
+    /// Whether the body is fixed.
+    pub fn is_fixed(&self) -> bool {
+        self.fixed.unwrap_or(false)
+    }
+
+    /// Velocity of the body-frame origin (m/s).
+    pub fn velocity(&self) -> [f64; 3] {
+        self.velocity.unwrap_or([0.0; 3])
+    }
+
+    /// Angular velocity (rad/s, world).
+    pub fn spin(&self) -> [f64; 3] {
+        self.spin.unwrap_or([0.0; 3])
+    }
+}
+
+/// `polyhedron = { vertices = [[x, y, z], …], merge_angle = rad }`: the convex hull of the vertices (m, body
+/// frame); points inside the hull are dropped.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PolyhedronSpec {
+    /// At least 4 points spanning a volume (m, body frame).
+    #[serde(deserialize_with = "points")]
+    pub vertices: Vec<[f64; 3]>,
+    /// Adjacent hull triangles whose normals are within this angle (rad) make one face; default
+    /// [`crate::geometry::Polyhedron::MERGE_ANGLE`], at most [`crate::geometry::Polyhedron::MAX_MERGE_ANGLE`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub merge_angle: Option<f64>,
+}
+
+/// `box = { half = [a, b, c] }`: a box of half sizes `a, b, c` (m) along the body axes.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec {
+    /// Half sizes (m), > 0.
+    #[serde(deserialize_with = "array")]
+    pub half: [f64; 3],
+}
+
+/// `sphere = { radius = r }`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereSpec {
+    /// Radius (m), > 0.
+    pub radius: f64,
+}
+
+/// `plane = { normal = [nx, ny, nz] }`: the half-space behind the plane through the body's `position`, `normal`
+/// pointing out of it (towards the bodies it carries).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneSpec {
+    /// Outward normal, any non-zero length (normalised).
+    #[serde(deserialize_with = "array")]
+    pub normal: [f64; 3],
+}
+
+/// `orientation = { quaternion = [w, x, y, z] }` or `orientation = { rotation_vector = [rx, ry, rz] }`: exactly
+/// one of the two.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OrientationSpec {
+    /// A unit quaternion, scalar first (`[cos ½α, sin ½α · axis]`).
+    #[serde(default, deserialize_with = "opt_array", skip_serializing_if = "Option::is_none")]
+    pub quaternion: Option<[f64; 4]>,
+    /// A rotation vector (rad): the rotation by its length about its direction.
+    #[serde(default, deserialize_with = "opt_array", skip_serializing_if = "Option::is_none")]
+    pub rotation_vector: Option<[f64; 3]>,
+}
+
+/// A point of exactly 3 coordinates.
+#[derive(Deserialize)]
+#[serde(transparent)]
+struct Point3(#[serde(deserialize_with = "array")] [f64; 3]);
+
+fn points<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[f64; 3]>, D::Error> {
+    Vec::<Point3>::deserialize(d).map(|v| v.into_iter().map(|p| p.0).collect())
+}
