@@ -484,7 +484,11 @@ fn configuration_energies_and_model_checks() {
     assert!(sys.set_configuration(&bad).unwrap_err().to_string().contains("body 99 does not exist"));
     assert_eq!(sys.configuration(), c, "unchanged after a refusal");
     let sizes = sys.body_sizes(&[0, 4]);
-    assert!(sizes[0] == f64::INFINITY && (sizes[1] - 2.0 * 3f64.sqrt() * HALF).abs() < 1e-15, "{sizes:?}");
+    // The radius of the sphere of a cube's volume 8 a³: (6/π)^(1/3) a.
+    assert!(
+        sizes[0] == f64::INFINITY && (sizes[1] - (6.0 / std::f64::consts::PI).cbrt() * HALF).abs() < 1e-15,
+        "{sizes:?}"
+    );
 
     // A spinning cube alone above a floor, 100 steps of free fall (5 cm, no contact).
     let mut drop = System3::new(pile(1e-3, false).params, 1);

@@ -25,8 +25,8 @@
 //!   counts once); the mean over the mobile bodies that have at least two (rattlers excluded), 0 if none has.
 //!   The cycle rows take it over the mobile bodies other than the followed one, as the 2D engines do.
 //! - **Potential energy** (when the equilibrium rule asks): `−Σ m g · x` over the mobile bodies.
-//! - **Body sizes**: twice the bounding radius (the diameter of the sphere about the centroid that holds the
-//!   shape).
+//! - **Body sizes**: the radius of the sphere of the body's volume, `(3V/4π)^(1/3)` — the 3D analogue of the
+//!   2D engines' `√(A/π)` and the MD engine's sphere radius, the contract's scale; infinite for a half-space.
 //! - **Relaxation**: not built for the 3D engine. [`Engine::relax`] returns [`Error::Scene`] saying so and
 //!   leaves the system unchanged: a settlement driver that reaches a landing stops there with that message,
 //!   rather than landing on an unrelaxed configuration. The 2D engines' mass-metric projection
@@ -260,7 +260,8 @@ impl Engine for System3 {
     }
 
     fn body_sizes(&self, bodies: &[usize]) -> Vec<f64> {
-        bodies.iter().map(|&i| 2.0 * self.bodies.info[i].solid.radius()).collect()
+        let radius = |volume: f64| (3.0 * volume / (4.0 * std::f64::consts::PI)).cbrt();
+        bodies.iter().map(|&i| radius(self.bodies.info[i].solid.mass_properties().0)).collect()
     }
 
     fn contact_counts(&self, bodies: &[usize]) -> Vec<usize> {

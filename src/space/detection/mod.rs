@@ -32,6 +32,8 @@ pub mod polygon;
 mod tests;
 #[cfg(test)]
 mod tests_detector;
+#[cfg(test)]
+mod tests_reference;
 
 pub use detector::{Detector, Found};
 pub use narrow::{
