@@ -216,8 +216,12 @@ fn a_run_writes_files_that_read_back() {
     let mut plan = RunPlan::new(60, 7);
     plan.cycles = Some(CyclePlan { frequency: 50.0, body: Some(4), positions: true });
     let runner = Runner::from_system(sys.clone(), plan).unwrap();
-    let done = runner.run(&dir, &RunOptions { vtk_every: 20, ..quiet() }, &mut |_| {}).unwrap();
+    // Two threads asked: the 3D step runs on one, and the run's summary says so.
+    let done = runner.run(&dir, &RunOptions { vtk_every: 20, threads: 2, ..quiet() }, &mut |_| {}).unwrap();
     assert_eq!((done.status, done.step), (Status::Ended(RunEnd::Finished), 60));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["threads"], 1, "{summary}");
 
     let series = read_series(&dir.join("series.csv")).unwrap();
     let times: Vec<f64> = series.iter().map(|r| r.time_s).collect();

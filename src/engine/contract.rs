@@ -87,6 +87,12 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// Threads of a step (1 or 2); the numbers do not depend on it.
     fn set_threads(&mut self, threads: usize);
 
+    /// The threads a step uses when `asked` were asked for ([`Engine::set_threads`]), as the run's summary
+    /// records them: `asked` unless the engine runs on fewer.
+    fn threads_used(&self, asked: usize) -> usize {
+        asked
+    }
+
     /// Number of bodies (bodies or spheres, walls not included).
     fn body_count(&self) -> usize;
 

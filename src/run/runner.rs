@@ -373,7 +373,7 @@ impl<E: Engine> Runner<E> {
             &live.summary,
             end,
             live.sys.body_count(),
-            opts.threads.max(1),
+            live.sys.threads_used(opts.threads.max(1)),
             live.sys.dt(),
             live.sys.time(),
             plan.cycles.map(|_| live.cycles_done),

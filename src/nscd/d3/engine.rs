@@ -81,6 +81,11 @@ impl Engine for System3 {
     /// One thread whatever is asked (module doc).
     fn set_threads(&mut self, _threads: usize) {}
 
+    /// One: the 3D step has no two-thread path yet, so the run's summary says one whatever was asked.
+    fn threads_used(&self, _asked: usize) -> usize {
+        1
+    }
+
     fn body_count(&self) -> usize {
         self.bodies.len()
     }
