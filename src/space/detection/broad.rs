@@ -1,8 +1,8 @@
 //! Broad phase: a uniform grid of cubic cells, the 3D form of the 2D engines' tile grid
 //! ([`crate::plane::broad_phase`]; LMGC90's 3D modules also book bodies in boxes of a regular grid,
 //! mod_PRPRx's `creation_tab_visu`). Each finite body is replaced by its bounding box, enlarged by the alert
-//! distance, and booked in every cell that box covers; then each box, in order, lists the higher boxes it
-//! meets in those cells (each once, by a mark), sorted, so that the pairs come out sorted. The cell side is the largest box of the ordinary bodies (those
+//! distance, and booked in every cell that box covers; a pair is read in the cell holding the lowest corner
+//! of the two boxes' intersection, so once. The cell side is the largest box of the ordinary bodies (those
 //! no larger than four times the median), so such a box covers at most 2 × 2 × 2 cells; the cell count is
 //! capped at a few times the body count. Cost is linear in the number of bodies; all buffers are reused.
 
@@ -29,31 +29,15 @@ pub struct Grid3 {
     cell_start: Vec<u32>,
     entries: Vec<u32>,
     sizes: Vec<f64>,
-    /// For each box, the last box whose neighbours listed it (to list each pair once).
-    mark: Vec<u32>,
-    /// The neighbours of one box, sorted before they are appended.
-    around: Vec<u32>,
 }
 
 impl Grid3 {
     /// Fills `pairs` with the index pairs `(i, j)`, `i < j`, whose boxes overlap, skipping those where
-    /// `skip(i, j)`, sorted.
+    /// `skip(i, j)`; the order is deterministic (cell by cell).
     pub fn pairs(&mut self, boxes: &[Aabb3], skip: impl Fn(usize, usize) -> bool, pairs: &mut Vec<(u32, u32)>) {
         pairs.clear();
-        self.pairs_with(boxes, skip, |i, around| pairs.extend(around.iter().map(|&j| (i, j))));
-    }
-
-    /// [`Self::pairs`], each box's sorted list of the higher boxes it meets given to `each(i, list)` in the
-    /// order of the boxes (every box, lists empty or not).
-    pub(crate) fn pairs_with(
-        &mut self,
-        boxes: &[Aabb3],
-        skip: impl Fn(usize, usize) -> bool,
-        mut each: impl FnMut(u32, &[u32]),
-    ) {
         let n = boxes.len();
         if n < 2 {
-            (0..n).for_each(|i| each(i as u32, &[]));
             return;
         }
         self.sizes.clear();
@@ -69,7 +53,6 @@ impl Grid3 {
         }
         let span = (0..3).map(|d| hi[d] - lo[d]).fold(0.0, f64::max);
         if !span.is_finite() {
-            (0..n).for_each(|i| each(i as u32, &[]));
             return;
         }
         let limit = 4 * n + 64;
@@ -83,13 +66,12 @@ impl Grid3 {
             dim = dims(cell);
         }
         let cells = dim[0] * dim[1] * dim[2];
-        // `x ≥ lo`: the truncation is the floor.
-        let at = |x: f64, d: usize| (((x - lo[d]) / cell) as usize).min(dim[d] - 1);
+        let at = |x: f64, d: usize| (((x - lo[d]) / cell).floor() as usize).min(dim[d] - 1);
         let index = |i: [usize; 3]| (i[2] * dim[1] + i[1]) * dim[0] + i[0];
         let range = |b: &Aabb3| -> [std::ops::RangeInclusive<usize>; 3] {
             std::array::from_fn(|d| at(b.min[d], d)..=at(b.max[d], d))
         };
-        let each_cell = |b: &Aabb3, f: &mut dyn FnMut(usize)| {
+        let each = |b: &Aabb3, f: &mut dyn FnMut(usize)| {
             let [rx, ry, rz] = range(b);
             for z in rz {
                 for y in ry.clone() {
@@ -103,7 +85,7 @@ impl Grid3 {
         self.cell_start.clear();
         self.cell_start.resize(cells + 1, 0);
         for b in boxes {
-            each_cell(b, &mut |c| self.cell_start[c + 1] += 1);
+            each(b, &mut |c| self.cell_start[c + 1] += 1);
         }
         for c in 0..cells {
             self.cell_start[c + 1] += self.cell_start[c];
@@ -112,7 +94,7 @@ impl Grid3 {
         self.entries.resize(self.cell_start[cells] as usize, 0);
         for (i, b) in boxes.iter().enumerate() {
             let (start, entries) = (&mut self.cell_start, &mut self.entries);
-            each_cell(b, &mut |c| {
+            each(b, &mut |c| {
                 entries[start[c] as usize] = i as u32;
                 start[c] += 1;
             });
@@ -121,25 +103,25 @@ impl Grid3 {
             self.cell_start[c] = self.cell_start[c - 1];
         }
         self.cell_start[0] = 0;
-        // Each box's higher neighbours, from the cells it covers, each once.
-        self.mark.clear();
-        self.mark.resize(n, u32::MAX);
-        let (cell_start, entries, mark, around) = (&self.cell_start, &self.entries, &mut self.mark, &mut self.around);
-        for (i, bi) in boxes.iter().enumerate() {
-            around.clear();
-            each_cell(bi, &mut |c| {
-                for &j in &entries[cell_start[c] as usize..cell_start[c + 1] as usize] {
-                    if j as usize <= i || mark[j as usize] == i as u32 {
+        for c in 0..cells {
+            let list = &self.entries[self.cell_start[c] as usize..self.cell_start[c + 1] as usize];
+            for (k, &i) in list.iter().enumerate() {
+                let bi = &boxes[i as usize];
+                for &j in &list[k + 1..] {
+                    let bj = &boxes[j as usize];
+                    if !bi.overlaps(bj) {
                         continue;
                     }
-                    mark[j as usize] = i as u32;
-                    if bi.overlaps(&boxes[j as usize]) && !skip(i, j as usize) {
-                        around.push(j);
+                    let corner: [usize; 3] = std::array::from_fn(|d| at(bi.min[d].max(bj.min[d]), d));
+                    if index(corner) != c {
+                        continue;
+                    }
+                    let (a, b) = if i < j { (i, j) } else { (j, i) };
+                    if !skip(a as usize, b as usize) {
+                        pairs.push((a, b));
                     }
                 }
-            });
-            around.sort_unstable();
-            each(i as u32, around);
+            }
         }
     }
 }

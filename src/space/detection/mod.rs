@@ -32,8 +32,6 @@ pub mod polygon;
 mod tests;
 #[cfg(test)]
 mod tests_detector;
-#[cfg(test)]
-mod tests_reference;
 
 pub use detector::{Detector, Found};
 pub use narrow::{
