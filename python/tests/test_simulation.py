@@ -40,7 +40,7 @@ def test_every_example_loads_and_steps(scene):
     assert np.isfinite(sim.positions).all()
     contacts = sim.contacts()
     m = len(contacts["kind"])
-    dim = 3 if sim.engine == "md" else 2
+    dim = 3 if sim.engine in ("md", "nscd3d") else 2
     assert contacts["bodies"].shape == (m, 2) and contacts["bodies"].dtype == np.int64
     for key in ("points", "normals", "tangential_forces"):
         assert contacts[key].shape == (m, dim), key
