@@ -327,7 +327,7 @@ fn materials_contacts_and_fixed_bodies() {
     );
     expect(
         &edit("fixed = true", "fixed = true\nvelocity = [0.0, 0.0, 1.0]"),
-        &["body[0] 'floor': velocity: a fixed body does not move (imposed velocities are not built for 3D NSCD yet)"],
+        &["body[0] 'floor': velocity: a fixed body does not move (give a moving wall fixed = false and imposed velocities)"],
     );
     expect(
         &edit("fixed = true", "fixed = true\nspin = [0.0, 0.0, 1.0]"),
@@ -340,19 +340,105 @@ fn materials_contacts_and_fixed_bodies() {
     assert!(sys.bodies.info[1].fixed && sys.bodies.inv_m[1] == [0.0; 6]);
 }
 
-#[test]
-fn loads_and_springs_are_not_built_in_3d() {
+/// The example with body "a" guided along z (imposed `vx`, `vy`, spin) under a harmonic force and a moment, and
+/// body "b" (given by its vertices, a corner at its frame's origin, turned 30° about z) on a spring from the
+/// middle of its bottom face to a world anchor 0.1 m below it.
+fn driven() -> String {
     let a = "position = [0.0, 0.0, 0.052]";
+    let drives = "imposed = { vx = 0.0, vy = { mean = 0.0 }, spin = [0.0, 0.0, 0.0] }\n\
+                  load = { direction = [0.0, 0.0, -2.0], mean = -10.0, amplitude = -5.0, frequency = 20.0 }\n\
+                  torque = { direction = [1.0, 0.0, 0.0], mean = 0.5 }";
+    let spring =
+        "[[spring]]\nbody = \"b\"\npoint = [0.04, 0.04, 0.0]\nanchor = [0.25, 0.0, -0.097]\nk_n = 1000.0\nnu = 2.0\n";
+    format!("{}\n{spring}", edit(a, &format!("{a}\n{drives}")))
+}
+
+/// Where the example puts the middle of body "b"'s bottom face: its frame's corner at `position`, turned 30°
+/// about z.
+fn bottom_of_b() -> Vec3 {
+    let turn = UnitQuaternion::from_axis_angle(&Vec3::z_axis(), std::f64::consts::PI / 6.0);
+    Vec3::new(0.25, 0.0, 0.003) + turn * Vec3::new(0.04, 0.04, 0.0)
+}
+
+#[test]
+fn loads_imposed_velocities_and_springs_build() {
+    let scene = Scene3::from_toml_str(&driven()).unwrap();
+    let sys = scene.build().unwrap();
+    let a = &sys.bodies.info[1];
+    // vx, vy and the spin imposed: only v_z is free.
+    assert_eq!(sys.bodies.inv_m[1][..2], [0.0, 0.0]);
+    assert_eq!(sys.bodies.inv_m[1][3..], [0.0, 0.0, 0.0]);
+    assert!((sys.bodies.inv_m[1][2] - 1.0 / a.mass).abs() < 1e-15 / a.mass);
+    assert_eq!(a.loads.len(), 2);
+    // The force: −10 − 5 cos(2π 20 t) along −z, normalised; the moment 0.5 N·m about x.
+    assert!((a.loads[0].at(0.0) - Vec3::new(0.0, 0.0, 15.0)).norm() < 1e-12);
+    assert!((a.loads[1].at(0.3) - Vec3::new(0.5, 0.0, 0.0)).norm() < 1e-15);
+    // The spring: its first end where the scene put it, the anchor where given, the rest length the initial one.
+    let s = &sys.springs[0];
+    let b = index(&sys, "b");
+    let pose = &sys.bodies.pose[b];
+    let end = pose.position + pose.rotation * s.point_a;
+    assert!((end - bottom_of_b()).norm() < 1e-12, "{end:?} vs {:?}", bottom_of_b());
+    assert_eq!((s.a, s.b, s.point_b), (b, None, Vec3::new(0.25, 0.0, -0.097)));
+    assert!((s.rest_length - (bottom_of_b() - s.point_b).norm()).abs() < 1e-15);
+    assert_eq!((s.k_n, s.nu, s.compression_only), (1000.0, 2.0, false));
+    // Written and read back: the same scene, the same system; a state written back names the rest length.
+    let text = scene.to_toml_string().unwrap();
+    let again = Scene3::from_toml_str(&text).unwrap();
+    assert_eq!(again, scene);
+    assert_eq!(again.build().unwrap().springs, sys.springs);
+    let saved = scene.with_state(&sys);
+    assert_eq!(saved.springs[0].rest_length, Some(s.rest_length));
+}
+
+#[test]
+fn loads_imposed_velocities_and_springs_are_checked() {
+    let text = driven();
+    let bad = |from: &str, to: &str| {
+        assert!(text.contains(from), "test bug: {from:?}");
+        text.replacen(from, to, 1)
+    };
+    let load = "direction = [0.0, 0.0, -2.0]";
     expect(
-        &edit(a, &format!("{a}\nload = {{ direction = [0.0, 0.0, 1.0], mean = -10.0 }}")),
-        &["body[1] 'a': load: harmonic loads are not built for 3D NSCD yet"],
+        &bad(load, "direction = [0.0, 0.0, 0.0]"),
+        &["body[1] 'a': load.direction: must be a finite non-zero vector"],
     );
+    expect(&bad("mean = 0.5", "mean = nan"), &["body[1] 'a': torque.mean: must be finite"]);
+    expect(&bad("vy = { mean = 0.0 }", "vy = { mean = 0.0, amplitude = inf }"), &["body[1] 'a': imposed.vy.amplitude"]);
+    expect(&bad("spin = [0.0, 0.0, 0.0]", "spin = [0.0, nan, 0.0]"), &["body[1] 'a': imposed.spin[1]"]);
+    expect(&bad("spin = [0.0, 0.0, 0.0]", "spin = [0.0, 0.0]"), &["spin"]);
+    expect(&bad("spin = [0.0, 0.0, 0.0]", "wz = 0.0"), &["wz"]);
+    let on_floor = |key: &str| text.replacen("fixed = true", &format!("fixed = true\n{key}"), 1);
     expect(
-        &edit(a, &format!("{a}\nimposed = {{ vz = 0.0 }}")),
-        &["body[1] 'a': imposed: imposed velocities are not built for 3D NSCD yet"],
+        &on_floor("imposed = { vz = 1.0 }"),
+        &["body[0] 'floor': imposed: a fixed body cannot have imposed velocities"],
     );
-    let spring = format!("{EXAMPLE}\n[[spring]]\nbody = \"a\"\nanchor = [0.0, 0.0, -0.1]\nk_n = 100.0\n");
-    expect(&spring, &["spring[0]: sublayer springs are not built for 3D NSCD yet"]);
+    let push = "{ direction = [0.0, 0.0, 1.0], mean = 1.0 }";
+    expect(&on_floor(&format!("load = {push}")), &["body[0] 'floor': load: a fixed body cannot carry a load"]);
+    expect(&on_floor(&format!("torque = {push}")), &["body[0] 'floor': torque: a fixed body cannot carry a torque"]);
+    let anchor = "anchor = [0.25, 0.0, -0.097]";
+    expect(&bad("body = \"b\"", "body = \"z\""), &["spring[0].body: unknown body 'z'"]);
+    expect(
+        &bad(anchor, &format!("{anchor}\nother = \"a\"")),
+        &["spring[0].anchor: give either anchor or other, not both"],
+    );
+    expect(&bad(anchor, ""), &["spring[0].anchor: missing, give either anchor or other"]);
+    expect(&bad(anchor, "other = \"b\""), &["spring[0].other: the spring joins body 'b' to itself"]);
+    expect(
+        &bad(anchor, &format!("{anchor}\nother_point = [0.0, 0.0, 0.0]")),
+        &["spring[0].other_point: only allowed with other"],
+    );
+    expect(&bad("k_n = 1000.0", "k_n = -1.0"), &["spring[0].k_n: must be non-negative"]);
+    expect(&bad("nu = 2.0", "nu = -2.0"), &["spring[0].nu: must be non-negative"]);
+    expect(&bad(anchor, "anchor = [0.25, 0.0, nan]"), &["spring[0].anchor[2]: must be finite"]);
+    // The anchor at the attachment: no initial length, so the rest length must be given.
+    let at = bottom_of_b();
+    let zero = bad(anchor, &format!("anchor = [{:?}, {:?}, {:?}]", at.x, at.y, at.z));
+    let m = message(&zero);
+    assert!(
+        m.starts_with("spring[0].rest_length: the initial length is") && m.ends_with("give a positive rest_length")
+    );
+    Scene3::from_toml_str(&format!("{zero}rest_length = 0.1\n")).unwrap().build().unwrap();
 }
 
 #[test]

@@ -64,8 +64,7 @@ impl Spring {
             }
             w
         };
-        let alpha = (1.0 - theta) * r_i - theta * self.k_n * eps_m;
-        let beta = theta * (self.k_n * theta * h + self.nu) / self.rest_length;
+        let (h_alpha, h_beta) = law17_affine(r_i, eps_m, (self.k_n, self.nu, self.rest_length), h, theta);
         SpringRow {
             a: self.a as u32,
             b: self.b.map_or(u32::MAX, |b| b as u32),
@@ -73,10 +72,31 @@ impl Spring {
             hn_b,
             w,
             p: self.impulse,
-            h_alpha: h * alpha,
-            h_beta: h * beta,
+            h_alpha,
+            h_beta,
             compression_only: self.compression_only,
         }
+    }
+}
+
+/// Law (17)'s θ-weighted impulse over a step as an affine function of the end-of-step axial velocity,
+/// `P = h α − h β U_N` (module doc): `(h α, h β)` from the start-of-step force `r_i` (N), the strain `eps_m` at
+/// `q_m`, the spring's `(k_N, ν, L0)`, the step `h` and `θ`. Shared by the 2D and 3D rows.
+pub(crate) fn law17_affine(r_i: f64, eps_m: f64, (k_n, nu, rest): (f64, f64, f64), h: f64, theta: f64) -> (f64, f64) {
+    let alpha = (1.0 - theta) * r_i - theta * k_n * eps_m;
+    let beta = theta * (k_n * theta * h + nu) / rest;
+    (h * alpha, h * beta)
+}
+
+/// The exact local solution of law (17) given `U_0`, the axial velocity without the row's impulse, and the row's
+/// Delassus scalar `w`: `P = (h α − h β U_0) / (1 + h β w)`, clamped to `P ≥ 0` when `compression_only`.
+#[inline(always)]
+pub(crate) fn law17_solve(h_alpha: f64, h_beta: f64, w: f64, u0: f64, compression_only: bool) -> f64 {
+    let p = (h_alpha - h_beta * u0) / (1.0 + h_beta * w);
+    if compression_only {
+        p.max(0.0)
+    } else {
+        p
     }
 }
 
@@ -84,12 +104,7 @@ impl SpringRow {
     /// Exact local solution given `U_0`, the relative velocity without this row's impulse.
     #[inline(always)]
     pub fn solve(&self, u0: f64) -> f64 {
-        let p = (self.h_alpha - self.h_beta * u0) / (1.0 + self.h_beta * self.w);
-        if self.compression_only {
-            p.max(0.0)
-        } else {
-            p
-        }
+        law17_solve(self.h_alpha, self.h_beta, self.w, u0, self.compression_only)
     }
 }
 

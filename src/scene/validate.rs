@@ -230,7 +230,7 @@ fn named<T>(
     }
 }
 
-fn check_drive(ctx: &str, d: Drive) -> Result<()> {
+pub(crate) fn check_drive(ctx: &str, d: Drive) -> Result<()> {
     match d {
         Drive::Constant(v) => finite(ctx, v).map(|_| ()),
         Drive::Harmonic(h) => {

@@ -53,7 +53,7 @@ fn harmonic(h: &HarmonicSpec) -> String {
     )
 }
 
-fn drive(d: &Drive) -> String {
+pub(crate) fn drive(d: &Drive) -> String {
     match d {
         Drive::Constant(v) => float(*v),
         Drive::Harmonic(h) => harmonic(h),

@@ -12,6 +12,7 @@
 //! it was given (zero for a wall).
 
 use crate::geometry::{Pose, Solid, Vec3};
+use crate::space::loads::{Imposed3, Load3};
 use crate::{Error, Result};
 use nalgebra::UnitQuaternion;
 use serde::{Deserialize, Serialize};
@@ -38,6 +39,12 @@ pub struct BodyInfo {
     /// Whether the body is fixed (a wall, a floor): its velocity is imposed (zero unless given) on every
     /// component.
     pub fixed: bool,
+    /// Imposed velocity components (none by default; [`Imposed3`]): an imposed component has a zero inverse mass.
+    #[serde(default, skip_serializing_if = "Imposed3::is_empty")]
+    pub imposed: Imposed3,
+    /// External forces and moments ([`Load3`]), none by default.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub loads: Vec<Load3>,
 }
 
 impl BodyInfo {
@@ -50,7 +57,16 @@ impl BodyInfo {
             return Err(Error::Scene(format!("body '{name}': a half-space can only be a fixed body")));
         }
         let (volume, second) = solid.mass_properties();
-        Ok(Self { name: name.into(), solid, material, mass: density * volume, inertia: second * density, fixed: false })
+        Ok(Self {
+            name: name.into(),
+            solid,
+            material,
+            mass: density * volume,
+            inertia: second * density,
+            fixed: false,
+            imposed: Imposed3::default(),
+            loads: Vec::new(),
+        })
     }
 
     /// A fixed body (a wall, a floor, a half-space).
@@ -62,16 +78,56 @@ impl BodyInfo {
             mass: f64::INFINITY,
             inertia: Vec3::repeat(f64::INFINITY),
             fixed: true,
+            imposed: Imposed3::default(),
+            loads: Vec::new(),
         }
     }
 
-    /// The inverse mass per degree of freedom ([`Dofs6`]): zero for a fixed body.
+    /// The same body with `imposed` velocity components (replacing any it had; ignored on a fixed body).
+    pub fn with_imposed(mut self, imposed: Imposed3) -> Self {
+        self.imposed = imposed;
+        self
+    }
+
+    /// The same body with one more load.
+    pub fn with_load(mut self, load: Load3) -> Self {
+        self.loads.push(load);
+        self
+    }
+
+    /// The inverse mass per degree of freedom ([`Dofs6`]): zero for a fixed body and for an imposed component.
     pub fn inverse_mass(&self) -> Dofs6 {
         if self.fixed {
             return [0.0; 6];
         }
         let (m, i) = (1.0 / self.mass, self.inertia);
-        [m, m, m, 1.0 / i.x, 1.0 / i.y, 1.0 / i.z]
+        let mut inv = [m, m, m, 1.0 / i.x, 1.0 / i.y, 1.0 / i.z];
+        for (d, v) in self.imposed.velocity.iter().enumerate() {
+            if v.is_some() {
+                inv[d] = 0.0;
+            }
+        }
+        if self.imposed.spin.is_some() {
+            inv[3..].fill(0.0);
+        }
+        inv
+    }
+
+    /// The velocity ([`Dofs6`]) `u` with the imposed components set to their values at time `t` (s), for a body at
+    /// `pose` (the imposed world spin turned into the principal frame); a fixed body's `u` as it is.
+    pub fn impose(&self, u: &mut Dofs6, pose: &Pose, t: f64) {
+        if self.fixed {
+            return;
+        }
+        for (d, v) in self.imposed.velocity.iter().enumerate() {
+            if let Some(v) = v {
+                u[d] = v.at(t);
+            }
+        }
+        if let Some(w) = self.imposed.spin_at(t) {
+            let w = pose.rotation.inverse_transform_vector(&w);
+            u[3..].copy_from_slice(w.as_slice());
+        }
     }
 }
 
@@ -141,8 +197,10 @@ impl Bodies {
     }
 
     /// Adds a body at `pose` with velocity `u` and returns its index. The velocity of a fixed body is imposed
-    /// for the whole run.
+    /// for the whole run; an imposed component takes its value at `t = 0`.
     pub fn push(&mut self, info: BodyInfo, pose: Pose, u: Dofs6) -> u32 {
+        let mut u = u;
+        info.impose(&mut u, &pose, 0.0);
         self.inv_m.push(info.inverse_mass());
         self.info.push(info);
         self.pose.push(pose);
@@ -150,9 +208,14 @@ impl Bodies {
         (self.info.len() - 1) as u32
     }
 
-    /// Whether body `i` can move under contacts.
+    /// Whether body `i` is not fixed (it moves, freely or as imposed).
     pub fn is_mobile(&self, i: usize) -> bool {
         !self.info[i].fixed
+    }
+
+    /// Whether an impulse can change body `i`'s velocity: some component neither fixed nor imposed.
+    pub fn is_free(&self, i: usize) -> bool {
+        self.inv_m[i].iter().any(|&x| x > 0.0)
     }
 
     /// Body `i`'s velocity: translation (m/s, world) and spin (rad/s, world).
@@ -190,6 +253,21 @@ impl Bodies {
             })
             .sum()
     }
+}
+
+/// `h · u` of two [`Dofs6`]: a generalised direction times a velocity (m/s).
+#[inline(always)]
+pub fn dot6(h: &Dofs6, u: &Dofs6) -> f64 {
+    h[0] * u[0] + h[1] * u[1] + h[2] * u[2] + h[3] * u[3] + h[4] * u[4] + h[5] * u[5]
+}
+
+/// The generalised direction `h_d = (d, ρ × Rᵀ d)` of direction `d` (world) at lever arm `rho` (principal frame)
+/// of a body at `pose`: `h_d · u = d · (v + R (ω × ρ))`, the velocity along `d` of the body's point at `ρ`.
+#[inline]
+pub fn gen_dir(pose: &Pose, rho: &Vec3, d: &Vec3) -> Dofs6 {
+    let local = pose.rotation.inverse_transform_vector(d);
+    let m = rho.cross(&local);
+    [d.x, d.y, d.z, m.x, m.y, m.z]
 }
 
 /// The rotation by the rotation vector `phi` (rad, world): `exp(φ̂)`, exact (the quaternion of angle `|φ|` about

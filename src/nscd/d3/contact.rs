@@ -42,18 +42,7 @@ pub struct ContactRow3 {
     pub mu: f64,
 }
 
-#[inline(always)]
-fn dot6(h: &Dofs6, u: &Dofs6) -> f64 {
-    h[0] * u[0] + h[1] * u[1] + h[2] * u[2] + h[3] * u[3] + h[4] * u[4] + h[5] * u[5]
-}
-
-/// The generalised direction `h_d = (d, ρ × Rᵀ d)` of direction `d` (world) at lever arm `rho` (body frame).
-#[inline]
-pub fn gen_dir(pose: &Pose, rho: &Vec3, d: &Vec3) -> Dofs6 {
-    let local = pose.rotation.inverse_transform_vector(d);
-    let m = rho.cross(&local);
-    [d.x, d.y, d.z, m.x, m.y, m.z]
-}
+pub use crate::space::bodies::{dot6, gen_dir};
 
 impl ContactRow3 {
     /// The row of a contact at point `point` (world) with the frame `frame = [n, t₁, t₂]` between candidate

@@ -287,6 +287,10 @@ impl Engine for System3 {
     }
 
     /// Not built for the 3D engine (module doc): an [`Error::Scene`] saying so; the system is unchanged.
+    fn anchored_bodies(&self) -> Vec<usize> {
+        crate::space::springs::anchored(&self.springs)
+    }
+
     fn relax(&mut self, settings: &RelaxSettings) -> Result<RelaxReport> {
         settings.check()?;
         Err(Error::Scene(

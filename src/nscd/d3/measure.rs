@@ -27,13 +27,15 @@ pub fn height(sys: &System3, i: usize, up: &Vec3) -> f64 {
     sys.bodies.pose[i].position.dot(up)
 }
 
-/// Gravitational potential energy of the mobile bodies (J): `−Σ m g · x`, zero at the world origin.
+/// Potential energy (J): the gravitational energy of the mobile bodies `−Σ m g · x` (zero at the world origin)
+/// plus the elastic energy of the sublayer springs.
 pub fn potential_energy(sys: &System3) -> f64 {
     let g = sys.params.gravity;
-    (0..sys.bodies.len())
+    let gravitational: f64 = (0..sys.bodies.len())
         .filter(|&i| sys.bodies.is_mobile(i))
         .map(|i| -sys.bodies.info[i].mass * g.dot(&sys.bodies.pose[i].position))
-        .sum()
+        .sum();
+    gravitational + sys.spring_energy()
 }
 
 /// Per body (fixed ones too), the number of bodies it touches with a pair force `Σ r_n` over the pair's contact

@@ -9,5 +9,6 @@ pub mod contact;
 pub mod engine;
 pub mod measure;
 pub mod rows;
+pub mod spring;
 pub mod system;
 pub mod vtk;

@@ -25,11 +25,14 @@
 //! its result does not depend on it), so a state read back steps on with the same numbers.
 
 use super::contact::ContactRow3;
+use super::spring::SpringRow3;
 use crate::geometry::{Pose, Vec3};
 use crate::nscd::contact::ContactLaw;
-use crate::nscd::method::{apply_impulses, solve_nlgs, NlgsReport, NlgsSettings, Row, SweepNorms};
+use crate::nscd::method::{apply_impulses, solve_nlgs, NlgsReport, NlgsSettings};
 use crate::space::bodies::{advance, Bodies, Dofs6};
 use crate::space::detection::Detector;
+use crate::space::loads::LoadKind;
+use crate::space::springs::Spring3;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -123,34 +126,6 @@ pub struct Contact3 {
     pub p: [f64; 3],
 }
 
-/// No spring rows yet in 3D (the sublayer's law (17) in 3D is not built): the type of an empty list.
-#[derive(Debug, Clone, Copy)]
-enum NoSpring {}
-
-impl Row for NoSpring {
-    type Dofs = Dofs6;
-
-    fn bodies(&self) -> (u32, u32) {
-        match *self {}
-    }
-
-    fn set_bodies(&mut self, _: u32, _: u32) {
-        match *self {}
-    }
-
-    fn take_impulse(&mut self, _: &Self) {
-        match *self {}
-    }
-
-    fn add_impulse(&self, _: &mut [Dofs6], _: &[Dofs6], _: f64) {
-        match *self {}
-    }
-
-    fn visit<const UPDATE: bool>(&mut self, _: &mut [Dofs6], _: &[Dofs6], _: f64, _: &mut SweepNorms) {
-        match *self {}
-    }
-}
-
 /// A 3D NSCD system: its bodies, contact laws, detection and warm-start memory (module doc: its serde form).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct System3 {
@@ -158,6 +133,10 @@ pub struct System3 {
     pub params: Params3,
     /// The bodies.
     pub bodies: Bodies,
+    /// The sublayer springs (law (17) of Saussine et al. 2006, in 3D), each with its last impulse (the warm
+    /// start).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub springs: Vec<Spring3>,
     /// Time (s): `t_0 + (k − k_0) h` from [`Self::origin`] after every step, never accumulated.
     pub time: f64,
     /// Steps made.
@@ -188,7 +167,7 @@ pub struct System3 {
     #[serde(skip)]
     mobile: Vec<bool>,
     #[serde(skip)]
-    springs: Vec<NoSpring>,
+    spring_rows: Vec<SpringRow3>,
 }
 
 impl System3 {
@@ -198,6 +177,7 @@ impl System3 {
         Self {
             params,
             bodies: Bodies::default(),
+            springs: Vec::new(),
             time: 0.0,
             steps: 0,
             origin: crate::clock::Origin::default(),
@@ -212,7 +192,7 @@ impl System3 {
             u_begin: Vec::new(),
             u: Vec::new(),
             mobile: Vec::new(),
-            springs: Vec::new(),
+            spring_rows: Vec::new(),
         }
     }
 
@@ -287,25 +267,44 @@ impl System3 {
                 return Err(self.diverged(i, "non-finite position or velocity at the start of the step"));
             }
         }
-        // 1. Free velocity, explicit gyroscopic term.
+        // 1. Free velocity: gravity, the loads at t_m, the explicit gyroscopic term; imposed components take
+        //    their values at the end of the step.
         self.u_begin.clear();
         self.u_begin.extend_from_slice(&self.bodies.u);
         self.u.clear();
         self.u.extend_from_slice(&self.bodies.u);
         let g = self.params.gravity;
+        let (t_m, t_f) = (self.time + (1.0 - theta) * h, self.origin.time_at(self.steps + 1, h));
         for i in 0..n {
-            if !self.bodies.is_mobile(i) {
+            let info = &self.bodies.info[i];
+            if info.fixed {
                 continue;
             }
-            let (u, inertia) = (&mut self.u[i], self.bodies.info[i].inertia);
+            let (u, inertia, im) = (&mut self.u[i], info.inertia, &self.bodies.inv_m[i]);
             let w = Vec3::new(u[3], u[4], u[5]);
-            let gyro = -w.cross(&inertia.component_mul(&w));
-            u[0] += h * g.x;
-            u[1] += h * g.y;
-            u[2] += h * g.z;
-            u[3] += h * gyro.x / inertia.x;
-            u[4] += h * gyro.y / inertia.y;
-            u[5] += h * gyro.z / inertia.z;
+            let mut force = Vec3::zeros();
+            let mut torque = -w.cross(&inertia.component_mul(&w));
+            for load in &info.loads {
+                match load.kind {
+                    LoadKind::Force => force += load.at(t_m),
+                    // A world moment, in the principal frame at the start of the step (where ω is taken).
+                    LoadKind::Moment => torque += self.bodies.pose[i].rotation.inverse_transform_vector(&load.at(t_m)),
+                }
+            }
+            // Gravity as an acceleration (bit for bit h g), the loads through the inverse mass; imposed components
+            // (zero inverse mass) are set below.
+            for d in 0..3 {
+                if im[d] > 0.0 {
+                    u[d] += h * (g[d] + im[d] * force[d]);
+                }
+                if im[d + 3] > 0.0 {
+                    u[d + 3] += h * torque[d] / inertia[d];
+                }
+            }
+            // The imposed spin in the principal frame of the end of the step is not known before the step; it
+            // is taken in the frame at q_m, where the contacts are (the difference is O(h) in a turning body).
+            let pose_m = advance(&self.bodies.pose[i], &self.u_begin[i], (1.0 - theta) * h);
+            info.impose(u, &pose_m, t_f);
         }
         // 2. Intermediate configuration and detection.
         self.poses_m.clear();
@@ -314,7 +313,7 @@ impl System3 {
         }
         let clock = std::time::Instant::now();
         self.mobile.clear();
-        self.mobile.extend((0..n).map(|i| self.bodies.is_mobile(i)));
+        self.mobile.extend((0..n).map(|i| self.bodies.is_free(i)));
         self.detector.run(&self.bodies.info, &self.poses_m, &self.mobile, self.params.alert_distance);
         let detect_seconds = clock.elapsed().as_secs_f64();
         // 3. Rows, warm start, solve.
@@ -342,8 +341,14 @@ impl System3 {
             self.rows.push(row);
             self.geometry.push((f.key, f.position, frame, f.gap));
         }
-        apply_impulses(&mut self.u, &self.bodies.inv_m, &self.rows, &self.springs);
-        let report = solve_nlgs(&self.params.nlgs, &mut self.u, &self.bodies.inv_m, &mut self.rows, &mut self.springs);
+        self.spring_rows.clear();
+        for s in &self.springs {
+            let start = (&self.bodies.pose[..], &self.u_begin[..]);
+            self.spring_rows.push(SpringRow3::new(s, start, &self.poses_m, &self.bodies.inv_m, h, theta));
+        }
+        apply_impulses(&mut self.u, &self.bodies.inv_m, &self.rows, &self.spring_rows);
+        let report =
+            solve_nlgs(&self.params.nlgs, &mut self.u, &self.bodies.inv_m, &mut self.rows, &mut self.spring_rows);
         let solve_seconds = clock.elapsed().as_secs_f64();
         // 4. Update, checked before it is kept.
         for i in 0..n {
@@ -357,7 +362,13 @@ impl System3 {
             self.poses_m[i] = pose;
         }
         let overlaps = self.overlaps_at_end()?;
+        if let Some((body, what)) = crate::space::springs::crushed(&self.springs, &self.poses_m) {
+            return Err(self.diverged(body, &what));
+        }
         std::mem::swap(&mut self.bodies.pose, &mut self.poses_m);
+        for (s, row) in self.springs.iter_mut().zip(&self.spring_rows) {
+            s.impulse = row.p;
+        }
         std::mem::swap(&mut self.bodies.u, &mut self.u);
         self.memory.clear();
         self.contacts.clear();
@@ -409,6 +420,16 @@ impl System3 {
 
     fn diverged(&self, body: usize, what: &str) -> Error {
         Error::Diverged { step: self.steps + 1, body, name: self.bodies.info[body].name.clone(), what: what.into() }
+    }
+
+    /// The force `R_N` (N) of each spring pushing its ends apart, in the current state (law (17)).
+    pub fn spring_forces(&self) -> impl Iterator<Item = f64> + '_ {
+        self.springs.iter().map(|s| s.force(&self.bodies.pose, &self.bodies.u))
+    }
+
+    /// The elastic energy of the springs in the current configuration (J).
+    pub fn spring_energy(&self) -> f64 {
+        self.springs.iter().map(|s| s.elastic_energy(&self.bodies.pose)).sum()
     }
 
     /// The contacts of the last step with their mean forces over it.
@@ -469,13 +490,22 @@ impl System3 {
         if !self.contacts.iter().all(|c| in_range(&c.key)) || self.contacts.windows(2).any(|w| w[0].key >= w[1].key) {
             return bad("last contacts: bodies out of range or keys not sorted".into());
         }
+        for (k, s) in self.springs.iter().enumerate() {
+            if s.a >= n || s.b.is_some_and(|b| b >= n) {
+                return bad(format!("spring {k}: body out of range ({n} bodies)"));
+            }
+            if !(s.rest_length > 0.0 && s.rest_length.is_finite() && s.impulse.is_finite()) {
+                return bad(format!("spring {k}: its rest length or impulse is not a positive, finite number"));
+            }
+        }
         self.check()?;
         self.origin.check(self.steps, Some(self.time), self.params.dt).or_else(bad)
     }
 
     /// Checks that `self` (read from a checkpoint) is a state of the model `fresh` (the system built from the
-    /// same scene or code): the same bodies (names, shapes, materials, masses, inertia, fixed flags, inverse
-    /// masses), materials and contact laws, parameters and clock origin.
+    /// same scene or code): the same bodies (names, shapes, materials, masses, inertia, fixed flags, imposed
+    /// velocities, loads, inverse masses), springs but their impulses, materials and contact laws, parameters and
+    /// clock origin.
     ///
     /// # Errors
     /// [`Error::Scene`] "… differs from the scene's", naming the body.
@@ -489,6 +519,15 @@ impl System3 {
             let same_inverse = a.inv_m[i].iter().zip(&b.inv_m[i]).all(|(x, y)| x.to_bits() == y.to_bits());
             if !same(&a.info[i], &b.info[i]) || !same_inverse {
                 return bad(format!("body {i} ('{}')", crate::error::clip(&b.info[i].name)));
+            }
+        }
+        let law = |s: &Spring3| Spring3 { impulse: 0.0, ..s.clone() };
+        if self.springs.len() != fresh.springs.len() {
+            return bad(format!("the number of springs ({})", self.springs.len()));
+        }
+        for (k, (a, b)) in self.springs.iter().zip(&fresh.springs).enumerate() {
+            if !same(&law(a), &law(b)) {
+                return bad(format!("spring {k}"));
             }
         }
         if self.materials != fresh.materials || !same(&self.laws, &fresh.laws) {
@@ -511,7 +550,7 @@ impl System3 {
     ///
     /// # Errors
     /// [`Error::Scene`] naming the body if one does not exist, is fixed, or a value is not finite or the
-    /// quaternion is zero; the system is then unchanged.
+    /// quaternion is zero; the system is then unchanged. An imposed velocity component takes its value now.
     pub fn place(&mut self, bodies: &[usize], x: &[Vec3], rotations: &[nalgebra::Quaternion<f64>]) -> Result<()> {
         let n = self.bodies.len();
         let bad = |msg: String| Err(Error::Scene(format!("configuration: {msg}")));
@@ -539,9 +578,11 @@ impl System3 {
         for (&i, pose) in bodies.iter().zip(poses) {
             self.bodies.pose[i] = pose;
         }
-        for (info, u) in self.bodies.info.iter().zip(self.bodies.u.iter_mut()) {
+        let b = &mut self.bodies;
+        for ((info, u), pose) in b.info.iter().zip(b.u.iter_mut()).zip(&b.pose) {
             if !info.fixed {
                 *u = [0.0; 6];
+                info.impose(u, pose, self.time);
             }
         }
         self.memory.clear();

@@ -16,6 +16,7 @@ use crate::geometry::{Pose, Vec3};
 use crate::nscd::contact::ContactLaw;
 use crate::nscd::d3::system::System3;
 use crate::space::bodies::{Bodies, BodyInfo, Dofs6};
+use crate::space::springs::Spring3;
 use nalgebra::UnitQuaternion;
 
 impl Scene3 {
@@ -41,9 +42,24 @@ impl Scene3 {
             let info = if spec.is_fixed() {
                 BodyInfo::fixed(&spec.name, body.solid, m)
             } else {
-                BodyInfo::mobile(&spec.name, body.solid, m, self.materials[body.material].density)?
+                let info = BodyInfo::mobile(&spec.name, body.solid, m, self.materials[body.material].density)?;
+                body.loads.into_iter().fold(info.with_imposed(body.imposed), BodyInfo::with_load)
             };
             sys.bodies.push(info, pose, u);
+        }
+        for (spec, c) in self.springs.iter().zip(&checked.springs) {
+            sys.springs.push(Spring3 {
+                a: c.a,
+                point_a: c.point_a,
+                b: c.b,
+                point_b: c.point_b,
+                k_n: spec.k_n,
+                nu: spec.nu.unwrap_or(0.0),
+                rest_length: c.rest_length,
+                prestrain: spec.prestrain.unwrap_or(0.0),
+                compression_only: spec.compression_only.unwrap_or(false),
+                impulse: 0.0,
+            });
         }
         Ok(sys)
     }
@@ -52,9 +68,15 @@ impl Scene3 {
     /// `spin` replaced by the current state of `sys` (body `i` of the system is `self.bodies[i]`), so that a
     /// settled state can be saved and restarted. Fixed bodies are left as they are (they never move). The restart
     /// begins at time 0 and the warm-start impulses are not kept. If `sys` has fewer bodies than the scene, only
-    /// the first ones are updated.
+    /// the first ones are updated. Every spring's `rest_length` is written out (a default one is the length at
+    /// the start of the run, which the restart's start would not reproduce), so the restarted springs keep their
+    /// law.
     pub fn with_state(&self, sys: &System3) -> Scene3 {
-        self.with_bodies(&sys.bodies)
+        let mut out = self.with_bodies(&sys.bodies);
+        for (spec, spring) in out.springs.iter_mut().zip(&sys.springs) {
+            spec.rest_length.get_or_insert(spring.rest_length);
+        }
+        out
     }
 
     /// As [`Scene3::with_state`], from the bodies alone.

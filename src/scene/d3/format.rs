@@ -4,11 +4,11 @@
 //! As in the 2D format every table refuses unknown keys and optional keys are `Option`s, so that a scene written
 //! back with [`to_toml_string`](crate::scene::SceneFile::to_toml_string) keeps exactly the keys the user gave.
 //! `[simulation]`, `[output]`, `[settlement]`, `[nscd]`, `[[material]]` and `[[contact]]` are the 2D scene's own
-//! types. Vectors are arrays of exactly 3 numbers (a quaternion of 4). `imposed`, `load` and `[[spring]]` are read
-//! as any TOML value only so that validation can refuse them by name: they are not built for 3D NSCD.
+//! types. Vectors are arrays of exactly 3 numbers (a quaternion of 4). A drive (an imposed velocity component) is
+//! the 2D scene's [`Drive`]: a number or a harmonic table.
 
 use crate::scene::common::{OutputSection, SettlementSection, Simulation};
-use crate::scene::format::{array, opt_array, ContactEntry, Material, NscdSection};
+use crate::scene::format::{array, opt_array, ContactEntry, Drive, Material, NscdSection};
 use serde::{Deserialize, Deserializer, Serialize};
 
 /// A whole 3D NSCD scene file.
@@ -38,9 +38,9 @@ pub struct Scene3 {
     /// `[[body]]` entries, in order (body `i` of the system is `bodies[i]`).
     #[serde(default, rename = "body", skip_serializing_if = "Vec::is_empty")]
     pub bodies: Vec<BodySpec3>,
-    /// `[[spring]]`: read only to be refused (sublayer springs are not built for 3D NSCD).
+    /// `[[spring]]` entries: sublayer springs (law (17)).
     #[serde(default, rename = "spring", skip_serializing_if = "Vec::is_empty")]
-    pub springs: Vec<toml::Value>,
+    pub springs: Vec<SpringSpec3>,
 }
 
 /// `[[body]]` of a 3D scene: exactly one of `polyhedron`, `box`, `sphere`, `plane`.
@@ -79,12 +79,110 @@ pub struct BodySpec3 {
     /// A fixed body never moves; default false. A plane must be fixed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fixed: Option<bool>,
-    /// Read only to be refused: imposed velocities are not built for 3D NSCD.
+    /// Imposed velocity components (not on a fixed body).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub imposed: Option<toml::Value>,
-    /// Read only to be refused: harmonic loads are not built for 3D NSCD.
+    pub imposed: Option<ImposedSpec3>,
+    /// External force at the centroid (not on a fixed body).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub load: Option<toml::Value>,
+    pub load: Option<LoadSpec3>,
+    /// External moment about an axis through the centroid (not on a fixed body); `direction` is the axis
+    /// (right-hand rule), the magnitude in N·m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub torque: Option<LoadSpec3>,
+}
+
+/// `imposed = { vx, vy, vz, spin = [wx, wy, wz] }`: the centroid's velocity components (m/s, world), each on its
+/// own, and the spin (rad/s, world axes), all three together (`crate::space::loads`: a single world component of
+/// the spin cannot be imposed on the engine's principal-frame spin); absent components are free.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImposedSpec3 {
+    /// Imposed x velocity of the centroid (m/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vx: Option<Drive>,
+    /// Imposed y velocity of the centroid (m/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vy: Option<Drive>,
+    /// Imposed z velocity of the centroid (m/s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vz: Option<Drive>,
+    /// Imposed spin (rad/s, world axes), three drives.
+    #[serde(default, deserialize_with = "opt_drives", skip_serializing_if = "Option::is_none")]
+    pub spin: Option<[Drive; 3]>,
+}
+
+/// `load = { direction, mean, amplitude, frequency, phase }` (or `torque = { … }`): the force (N)
+/// `(mean + amplitude·cos(2π·frequency·t − phase)) · unit(direction)` at the centroid, or the moment (N·m) about
+/// the axis `direction` through it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec3 {
+    /// Direction of the force or axis of the moment (world, any non-zero length; normalised).
+    #[serde(deserialize_with = "array")]
+    pub direction: [f64; 3],
+    /// Mean (N or N·m).
+    pub mean: f64,
+    /// Amplitude (N or N·m); default 0.
+    #[serde(default)]
+    pub amplitude: f64,
+    /// Frequency (Hz); default 0.
+    #[serde(default)]
+    pub frequency: f64,
+    /// Phase (rad); default 0.
+    #[serde(default)]
+    pub phase: f64,
+}
+
+impl LoadSpec3 {
+    /// The harmonic magnitude.
+    pub fn value(&self) -> crate::nscd::Harmonic {
+        crate::nscd::Harmonic {
+            mean: self.mean,
+            amplitude: self.amplitude,
+            frequency: self.frequency,
+            phase: self.phase,
+        }
+    }
+}
+
+/// `[[spring]]` of a 3D scene: a sublayer spring (law (17)) between a point of `body` and either a world `anchor`
+/// or a point of the body `other`; the 2D table's keys with 3 coordinates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringSpec3 {
+    /// Name of the first body.
+    pub body: String,
+    /// Attachment on `body` (m), in its scene frame (the frame of its vertices, as `position` places it); default
+    /// the frame's origin.
+    #[serde(default, deserialize_with = "opt_array", skip_serializing_if = "Option::is_none")]
+    pub point: Option<[f64; 3]>,
+    /// World anchor point (m); exactly one of `anchor` and `other`.
+    #[serde(default, deserialize_with = "opt_array", skip_serializing_if = "Option::is_none")]
+    pub anchor: Option<[f64; 3]>,
+    /// Name of the second body; exactly one of `anchor` and `other`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub other: Option<String>,
+    /// Attachment on `other` (m), in its scene frame; default its origin.
+    #[serde(default, deserialize_with = "opt_array", skip_serializing_if = "Option::is_none")]
+    pub other_point: Option<[f64; 3]>,
+    /// Force per unit strain `k_N` (N), ≥ 0.
+    pub k_n: f64,
+    /// Force per unit strain rate `ν` (N·s), ≥ 0; default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nu: Option<f64>,
+    /// Rest length `L0` (m), > 0; default the initial length.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rest_length: Option<f64>,
+    /// Prestrain `ε0`; default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prestrain: Option<f64>,
+    /// Only pushes the ends apart; default false.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compression_only: Option<bool>,
+}
+
+fn opt_drives<'de, D: Deserializer<'de>>(d: D) -> Result<Option<[Drive; 3]>, D::Error> {
+    array(d).map(Some)
 }
 
 impl BodySpec3 {

@@ -66,9 +66,14 @@
 //!   length about its direction). A state written back ([`Scene3::with_state`]) is a quaternion with `w ≥ 0`.
 //! - **Planes** (`plane = { normal }`): the half-space behind the plane through `position`, `normal` pointing
 //!   out of it; fixed only, oriented by its normal alone (`orientation` refused).
-//! - **Fixed bodies do not move**: a non-zero `velocity` or `spin` on one is refused (that would be an imposed
-//!   velocity). `imposed`, `load` and `[[spring]]` are read only to be refused by name: imposed velocities,
-//!   harmonic loads and sublayer springs are not built for 3D NSCD yet.
+//! - **Fixed bodies do not move**: a non-zero `velocity` or `spin` on one is refused; a moving wall is a
+//!   non-fixed body with `imposed` velocities.
+//! - **Drives** (`drives.rs`): `imposed = { vx, vy, vz, spin = [wx, wy, wz] }` — the centroid's world velocity
+//!   components each on its own, the spin (world axes) all three together (`crate::space::loads` says why), each a
+//!   number or a harmonic table as in 2D; `load = { direction = [dx, dy, dz], mean, amplitude, frequency, phase }`
+//!   a force at the centroid and `torque = { … }` the same table for a moment about the axis `direction` through
+//!   it (N·m). `[[spring]]`: the 2D table with 3 coordinates (`point` and `other_point` in the body's scene
+//!   frame, `anchor` in the world), law (17).
 //! - **Shared sections** (`[simulation]`, `[output]`, `[settlement]`, `[nscd]`, `[[material]]`, `[[contact]]`)
 //!   are the 2D scene's types, checked by the 2D rules with the same messages; `output.cycles.body` names the
 //!   followed body and `settlement.settlement_body` a non-fixed body, as in 2D. The default alert distance is the
@@ -101,6 +106,7 @@
 //! ```
 
 mod build;
+mod drives;
 pub mod format;
 mod validate;
 mod write;

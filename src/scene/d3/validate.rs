@@ -7,8 +7,10 @@
 //! The sections the 3D scene shares with the 2D one — `[nscd]`, `[[material]]`, `[[contact]]` — are checked by the
 //! 2D scene's own validation ([`crate::scene::Scene`]) on a probe scene that carries them and one disc, so that
 //! their keys, defaults and messages are the 2D scene's word for word; then what the 3D engine does not build is
-//! refused: `nscd.solver` other than `"nlgs"`, `nscd.on_stall = "stop"`, `imposed`, `load` and `[[spring]]`.
+//! refused: `nscd.solver` other than `"nlgs"` and `nscd.on_stall = "stop"`. Imposed velocities, loads and springs
+//! are checked by [`super::drives`].
 
+use super::drives::{check_drives, check_springs, CheckedSpring3};
 use super::format::{BodySpec3, Scene3};
 use crate::error::{clip, Error, Result};
 use crate::geometry::{Polyhedron, Pose, Solid, SolidError, Vec3, MAX_LENGTH, MIN_SIZE};
@@ -17,6 +19,7 @@ use crate::nscd::nlgs::{NlgsSettings, OnStall, Solver};
 use crate::scene::common::{check_output, check_simulation};
 use crate::scene::validate::{err, label, num};
 use crate::scene::{Material, Scene, SceneFile};
+use crate::space::loads::{Imposed3, Load3};
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::collections::HashMap;
 
@@ -35,6 +38,10 @@ pub(crate) struct CheckedBody3 {
     /// Rotation of the scene's body frame (`orientation`).
     pub rotation: UnitQuaternion<f64>,
     pub material: usize,
+    /// Imposed velocity components.
+    pub imposed: Imposed3,
+    /// Forces and moments.
+    pub loads: Vec<Load3>,
 }
 
 /// Everything validation resolved.
@@ -42,6 +49,7 @@ pub(crate) struct CheckedBody3 {
 pub(crate) struct Checked3 {
     pub params: Params3,
     pub bodies: Vec<CheckedBody3>,
+    pub springs: Vec<CheckedSpring3>,
 }
 
 /// A 2D scene with one disc, into which the shared sections are copied ([`check_shared`]).
@@ -61,9 +69,7 @@ pub(crate) fn check(scene: &Scene3) -> Result<Checked3> {
     let materials: HashMap<&str, usize> =
         scene.materials.iter().enumerate().map(|(i, m)| (m.name.as_str(), i)).collect();
     let (bodies, names) = check_bodies(scene, &materials)?;
-    if !scene.springs.is_empty() {
-        return err("spring[0]: sublayer springs are not built for 3D NSCD yet: remove the [[spring]] tables".into());
-    }
+    let springs = check_springs(scene, &names, &bodies)?;
     check_output(scene.output.as_ref(), true, |name| names.get(name).copied())?;
     if scene.settlement.is_some() {
         scene.acceleration()?;
@@ -76,7 +82,7 @@ pub(crate) fn check(scene: &Scene3) -> Result<Checked3> {
         alert_distance: alert_distance(scene, &bodies),
         nlgs,
     };
-    Ok(Checked3 { params, bodies })
+    Ok(Checked3 { params, bodies, springs })
 }
 
 /// `[nscd]`, `[[material]]` and `[[contact]]` by the 2D scene's validation (module doc): θ and the solver's
@@ -216,12 +222,7 @@ fn check_bodies<'a>(
                 return err(format!("{}: duplicate body name (also body[{j}])", ctx("name")));
             }
         }
-        if b.imposed.is_some() {
-            return err(format!("{}: imposed velocities are not built for 3D NSCD yet", ctx("imposed")));
-        }
-        if b.load.is_some() {
-            return err(format!("{}: harmonic loads are not built for 3D NSCD yet", ctx("load")));
-        }
+        let (imposed, loads) = check_drives(&label, b)?;
         let Some(&material) = materials.get(b.material.as_str()) else {
             return err(format!("{}: unknown material '{}'", ctx("material"), clip(&b.material)));
         };
@@ -252,13 +253,13 @@ fn check_bodies<'a>(
         let spin = finite3(&ctx("spin"), b.spin())?;
         if b.is_fixed() && velocity != Vec3::zeros() {
             return err(format!(
-                "{}: a fixed body does not move (imposed velocities are not built for 3D NSCD yet)",
+                "{}: a fixed body does not move (give a moving wall fixed = false and imposed velocities)",
                 ctx("velocity")
             ));
         }
         if b.is_fixed() && spin != Vec3::zeros() {
             return err(format!(
-                "{}: a fixed body does not turn (imposed velocities are not built for 3D NSCD yet)",
+                "{}: a fixed body does not turn (give a moving wall fixed = false and imposed velocities)",
                 ctx("spin")
             ));
         }
@@ -274,7 +275,7 @@ fn check_bodies<'a>(
                 ));
             }
         }
-        bodies.push(CheckedBody3 { solid, frame, rotation, material });
+        bodies.push(CheckedBody3 { solid, frame, rotation, material, imposed, loads });
     }
     Ok((bodies, names))
 }

@@ -2,9 +2,9 @@
 //! writer, one `[[body]]` table per body with its shape and `orientation` as inline tables, only the keys the
 //! scene has, and floats in their shortest form that reads back to the same `f64` (the 2D writer's helpers).
 
-use super::format::{BodySpec3, Scene3};
+use super::format::{BodySpec3, LoadSpec3, Scene3};
 use crate::scene::common::{inline, write_output, write_settlement, write_simulation};
-use crate::scene::write::{float, opt, string};
+use crate::scene::write::{drive, float, opt, string};
 use std::fmt::Write;
 
 /// `[x, y, …]` of floats that read back exactly.
@@ -35,9 +35,22 @@ fn body(out: &mut String, b: &BodySpec3) {
     opt(out, "velocity", b.velocity, |v| list(&v));
     opt(out, "spin", b.spin, |w| list(&w));
     opt(out, "fixed", b.fixed, |f| f.to_string());
-    // Refused by validation; written as given so that a scene read without validation writes back the same.
-    opt(out, "imposed", b.imposed.as_ref(), ToString::to_string);
-    opt(out, "load", b.load.as_ref(), ToString::to_string);
+    opt(out, "imposed", b.imposed, |i| {
+        let spin = i.spin.map(|w| format!("[{}]", w.iter().map(drive).collect::<Vec<_>>().join(", ")));
+        let d = |x: Option<crate::scene::Drive>| x.as_ref().map(drive);
+        inline(&[("vx", d(i.vx)), ("vy", d(i.vy)), ("vz", d(i.vz)), ("spin", spin)])
+    });
+    let load = |l: LoadSpec3| {
+        inline(&[
+            ("direction", Some(list(&l.direction))),
+            ("mean", Some(float(l.mean))),
+            ("amplitude", Some(float(l.amplitude))),
+            ("frequency", Some(float(l.frequency))),
+            ("phase", Some(float(l.phase))),
+        ])
+    };
+    opt(out, "load", b.load, load);
+    opt(out, "torque", b.torque, load);
 }
 
 /// The scene as TOML text.
@@ -78,11 +91,17 @@ pub(crate) fn to_toml(scene: &Scene3) -> String {
         body(&mut out, b);
     }
     for s in &scene.springs {
-        // Refused by validation, kept as given (see `body`).
         out.push_str("\n[[spring]]\n");
-        if let Some(table) = s.as_table() {
-            out.push_str(&toml::to_string(table).unwrap_or_default());
-        }
+        let _ = writeln!(out, "body = {}", string(&s.body));
+        opt(&mut out, "point", s.point, |p| list(&p));
+        opt(&mut out, "anchor", s.anchor, |p| list(&p));
+        opt(&mut out, "other", s.other.as_deref(), string);
+        opt(&mut out, "other_point", s.other_point, |p| list(&p));
+        let _ = writeln!(out, "k_n = {}", float(s.k_n));
+        opt(&mut out, "nu", s.nu, float);
+        opt(&mut out, "rest_length", s.rest_length, float);
+        opt(&mut out, "prestrain", s.prestrain, float);
+        opt(&mut out, "compression_only", s.compression_only, |c| c.to_string());
     }
     out
 }
