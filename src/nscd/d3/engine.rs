@@ -27,11 +27,9 @@
 //! - **Potential energy** (when the equilibrium rule asks): `−Σ m g · x` over the mobile bodies.
 //! - **Body sizes**: the radius of the sphere of the body's volume, `(3V/4π)^(1/3)` — the 3D analogue of the
 //!   2D engines' `√(A/π)` and the MD engine's sphere radius, the contract's scale; infinite for a half-space.
-//! - **Relaxation**: not built for the 3D engine. [`Engine::relax`] returns [`Error::Scene`] saying so and
-//!   leaves the system unchanged: a settlement driver that reaches a landing stops there with that message,
-//!   rather than landing on an unrelaxed configuration. The 2D engines' mass-metric projection
-//!   ([`crate::plane::relax`]) carries over (rotation variables in the principal frame, the normal rows of
-//!   [`super::contact::gen_dir`] as the gaps' gradients), but it is not written nor tested yet.
+//! - **Relaxation**: the 2D engines' mass-metric projection carried over to 3D ([`crate::space::relax`]: the
+//!   centroids and rotation vectors in the principal frames, the moments of inertia as their masses, the gaps'
+//!   gradients through SO(3)'s right Jacobian), written back by [`System3::place`].
 
 use super::measure::{self, Coordination};
 use super::rows::{CycleRow3, CycleState3, SeriesRow3, CYCLE3_COLUMNS, SERIES3_COLUMNS};
@@ -286,17 +284,19 @@ impl Engine for System3 {
         self.place(&c.bodies, &x, &rotations)
     }
 
-    /// Not built for the 3D engine (module doc): an [`Error::Scene`] saying so; the system is unchanged.
     fn anchored_bodies(&self) -> Vec<usize> {
         crate::space::springs::anchored(&self.springs)
     }
 
+    /// The mass-metric projection of [`crate::space::relax`], written back as a configuration (velocities
+    /// zeroed, imposed components at their values now, contact memory forgotten).
     fn relax(&mut self, settings: &RelaxSettings) -> Result<RelaxReport> {
-        settings.check()?;
-        Err(Error::Scene(
-            "relaxation: not built for the 3D NSCD engine (a settlement driver cannot land a jump on it yet; run \
-             its cycles computed)"
-                .into(),
-        ))
+        let (report, poses) = crate::space::relax::project(&self.bodies, settings)?;
+        let bodies = self.mobile_bodies();
+        let x: Vec<Vec3> = bodies.iter().map(|&i| poses[i].position).collect();
+        let rotations: Vec<nalgebra::Quaternion<f64>> =
+            bodies.iter().map(|&i| poses[i].rotation.into_inner()).collect();
+        self.place(&bodies, &x, &rotations)?;
+        Ok(report)
     }
 }
