@@ -216,12 +216,12 @@ fn a_run_writes_files_that_read_back() {
     let mut plan = RunPlan::new(60, 7);
     plan.cycles = Some(CyclePlan { frequency: 50.0, body: Some(4), positions: true });
     let runner = Runner::from_system(sys.clone(), plan).unwrap();
-    // Two threads asked: the 3D step runs on one, and the run's summary says so.
+    // Two threads asked: the run's summary says so (the split solve's threads).
     let done = runner.run(&dir, &RunOptions { vtk_every: 20, threads: 2, ..quiet() }, &mut |_| {}).unwrap();
     assert_eq!((done.status, done.step), (Status::Ended(RunEnd::Finished), 60));
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
-    assert_eq!(summary["threads"], 1, "{summary}");
+    assert_eq!(summary["threads"], 2, "{summary}");
 
     let series = read_series(&dir.join("series.csv")).unwrap();
     let times: Vec<f64> = series.iter().map(|r| r.time_s).collect();
@@ -337,6 +337,29 @@ fn a_run_stopped_and_resumed_writes_the_same_bytes() {
         assert_eq!(std::fs::read(&f).unwrap(), std::fs::read(&g).unwrap(), "{f:?} differs");
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The split contact solve (forced on this small pile: `split_min_rows` 8) gives the same bits on one thread
+/// and on two, and two threads did use the team (joins side by side, taken back or in turn: all counted, so the
+/// split path ran).
+#[test]
+fn the_split_solve_gives_the_same_numbers_on_one_thread_and_two() {
+    let run = |threads: usize, split: usize| {
+        let mut sys = pile(1e-3, true);
+        sys.params.nlgs.split_min_rows = split;
+        sys.set_threads(threads);
+        let mut rows = 0;
+        // 150 steps: the top layer has landed on the bottom one, so rows share bodies across the halves.
+        for _ in 0..150 {
+            rows = rows.max(sys.step().unwrap().contacts);
+        }
+        assert!(split == 0 || rows >= split, "the problem reaches the split's size: {rows} rows");
+        (serde_json::to_string(&(&sys.bodies.pose, &sys.bodies.u)).unwrap(), sys.team_stats().joins)
+    };
+    let (one, _) = run(1, 8);
+    let (two, joins) = run(2, 8);
+    assert!(one == two, "one thread and two differ");
+    assert!(joins > 0, "the team was used");
 }
 
 /// The serde form (a checkpoint's) carries the warm start: a system read back after 30 steps makes the next 30

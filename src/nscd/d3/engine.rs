@@ -18,8 +18,9 @@
 //!   first three only (`EXTRAPOLATED = 3`: a polyhedron turns by rolling events, not by a creep a law can follow,
 //!   as in 2D). [`Engine::set_configuration`] builds the quaternion from the rotation vector (unit by
 //!   construction, renormalised) and refuses a non-finite value, a fixed or unknown body, naming it.
-//! - **Threads**: one. [`Engine::set_threads`] accepts any count and changes nothing: the 3D step has no split
-//!   solve yet, and the numbers would not depend on it.
+//! - **Threads**: the contact solve of a problem of at least `nscd.split_min_rows` rows (default 512) is the
+//!   shared domain split (two halves along x swept side by side, then the interface), on two threads when asked;
+//!   the numbers do not depend on the count. The detection runs on one thread.
 //! - **Coordination**: [`super::measure::coordination`] — per mobile body, the bodies (mobile or fixed) it
 //!   touches with a total normal force `Σ r_n > 0` over the pair's contact points of the last step (a pair
 //!   counts once); the mean over the mobile bodies that have at least two (rattlers excluded), 0 if none has.
@@ -76,12 +77,9 @@ impl Engine for System3 {
         self.params.dt
     }
 
-    /// One thread whatever is asked (module doc).
-    fn set_threads(&mut self, _threads: usize) {}
-
-    /// One: the 3D step has no two-thread path yet, so the run's summary says one whatever was asked.
-    fn threads_used(&self, _asked: usize) -> usize {
-        1
+    /// The split contact solve's threads (module doc).
+    fn set_threads(&mut self, threads: usize) {
+        System3::set_threads(self, threads);
     }
 
     fn body_count(&self) -> usize {
