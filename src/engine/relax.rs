@@ -366,3 +366,45 @@ fn run<'a, S: Solver<Scaled<'a>, St>>(
     let result = Executor::new(problem, wrapped).configure(|s| s.param(y0).max_iters(settings.max_iterations)).run()?;
     Ok(result.state.get_termination_reason().map_or("stopped".to_string(), |r| r.text().to_string()))
 }
+
+/// A penalised projection of rigid bodies (the 2D [`crate::plane::relax`] and 3D [`crate::space::relax`]
+/// relaxations): a [`Functional`] whose penalty stiffness can be set.
+pub trait Penalty: Functional {
+    /// The heaviest free body's mass (kg): the stiffness's scale.
+    fn heaviest(&self) -> f64;
+    /// The penalty stiffness (N/m per contact point).
+    fn stiffness(&self) -> f64;
+    /// Sets the penalty stiffness (N/m per contact point).
+    fn set_stiffness(&mut self, k: f64);
+}
+
+/// The rigid bodies' relaxation on a penalised projection (docs/relaxation.md): the stiffness starts at
+/// `k = 10 m_max δ₀ / tol` and is raised tenfold, up to three times, while the minimiser stops short of the
+/// tolerance within the iterations left; `x` goes from the start to the result. The report's `max_overlap_before`
+/// is the start's; its `largest_move` the largest change of a variable (m or rad).
+///
+/// # Errors
+/// As [`minimise`].
+pub fn penalised_projection(p: &mut dyn Penalty, x: &mut [f64], settings: &RelaxSettings) -> Result<RelaxReport> {
+    let start = x.to_vec();
+    let before = p.max_overlap(x)?;
+    p.set_stiffness(10.0 * p.heaviest().max(f64::MIN_POSITIVE) * (before / settings.tolerance).max(1.0));
+    let mut report = minimise(p, x, settings)?;
+    let mut raises = 0;
+    while !report.converged && raises < 3 && report.iterations < settings.max_iterations {
+        raises += 1;
+        p.set_stiffness(p.stiffness() * 10.0);
+        let left = RelaxSettings { max_iterations: settings.max_iterations - report.iterations, ..settings.clone() };
+        let next = minimise(p, x, &left)?;
+        report.iterations += next.iterations;
+        report.evaluations += next.evaluations;
+        // A raised stiffness is a new functional: its own sequence.
+        report.functional = next.functional;
+        report.max_overlap_after = next.max_overlap_after;
+        report.converged = next.converged;
+        report.reason = next.reason;
+    }
+    report.max_overlap_before = before;
+    report.largest_move = x.iter().zip(&start).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    Ok(report)
+}

@@ -79,6 +79,26 @@ impl Spring {
     }
 }
 
+/// The norms of a scalar row (a spring) whose impulse changes by `dp` from `p_old` to `p` (N·s) under its
+/// Delassus scalar `w` ([`SweepNorms::add`]): `ΔU = w ΔP`, `P̄ = ½ (p_old + p)`, and the midpoint averages of
+/// `P w P` and `(w P)²`. Shared by the 2D and 3D spring rows (`dp` as the row computed it, so that the norms are
+/// those of its update to the last bit).
+#[inline(always)]
+pub(crate) fn add_scalar_norms(norms: &mut SweepNorms, w: f64, p_old: f64, p: f64, dp: f64) {
+    let pm = 0.5 * (p_old + p);
+    let du = w * dp;
+    let (wp_old, wp) = (w * p_old, w * p);
+    norms.add(
+        du * du,
+        pm * pm,
+        pm * du,
+        0.5 * (p_old * wp_old + p * wp),
+        0.5 * (wp_old * wp_old + wp * wp),
+        p * wp,
+        dp != 0.0,
+    );
+}
+
 /// Law (17)'s θ-weighted impulse over a step as an affine function of the end-of-step axial velocity,
 /// `P = h α − h β U_N` (module doc): `(h α, h β)` from the start-of-step force `r_i` (N), the strain `eps_m` at
 /// `q_m`, the spring's `(k_N, ν, L0)`, the step `h` and `θ`. Shared by the 2D and 3D rows.
@@ -158,18 +178,7 @@ impl Row for SpringRow {
                 apply(&mut u[b], &inv_m[b], &s.hn_b, dp, &[0.0; 3], 0.0, -1.0);
             }
         }
-        let (p_old, du) = (p - dp, s.w * dp);
-        let pm = 0.5 * (p_old + p);
-        let (wp_old, wp) = (s.w * p_old, s.w * p);
-        norms.add(
-            du * du,
-            pm * pm,
-            pm * du,
-            0.5 * (p_old * wp_old + p * wp),
-            0.5 * (wp_old * wp_old + wp * wp),
-            p * wp,
-            dp != 0.0,
-        );
+        add_scalar_norms(norms, s.w, p - dp, p, dp);
     }
 }
 

@@ -30,7 +30,7 @@
 use super::detection::Detector;
 use super::springs::gen_dir;
 use super::Bodies;
-use crate::engine::relax::{minimise, Functional, RelaxReport, RelaxSettings};
+use crate::engine::relax::{penalised_projection, Functional, Penalty, RelaxReport, RelaxSettings};
 use crate::error::{Error, Result};
 use crate::geometry::Vec2;
 
@@ -95,10 +95,19 @@ impl<'a> Projection<'a> {
         // Only overlapping pairs matter: alert distance 0.
         self.detector.run(self.bodies, &self.q, 0.0);
     }
+}
 
-    /// The heaviest free body's mass (kg).
-    pub fn heaviest(&self) -> f64 {
+impl Penalty for Projection<'_> {
+    fn heaviest(&self) -> f64 {
         self.vars.iter().filter(|(_, d)| *d < 2).map(|&(i, _)| self.bodies.info[i].mass).fold(0.0, f64::max)
+    }
+
+    fn stiffness(&self) -> f64 {
+        self.stiffness
+    }
+
+    fn set_stiffness(&mut self, k: f64) {
+        self.stiffness = k;
     }
 }
 
@@ -160,25 +169,7 @@ pub fn project(bodies: &Bodies, settings: &RelaxSettings) -> Result<(RelaxReport
     }
     let mut projection = Projection::new(bodies, &settings.held, 0.0);
     let mut x = projection.start();
-    let before = projection.max_overlap(&x)?;
-    projection.stiffness = 10.0 * projection.heaviest().max(f64::MIN_POSITIVE) * (before / settings.tolerance).max(1.0);
-    let mut report = minimise(&mut projection, &mut x, settings)?;
-    let mut raises = 0;
-    while !report.converged && raises < 3 && report.iterations < settings.max_iterations {
-        raises += 1;
-        projection.stiffness *= 10.0;
-        let left = RelaxSettings { max_iterations: settings.max_iterations - report.iterations, ..settings.clone() };
-        let next = minimise(&mut projection, &mut x, &left)?;
-        report.iterations += next.iterations;
-        report.evaluations += next.evaluations;
-        // A raised stiffness is a new functional: its own sequence.
-        report.functional = next.functional;
-        report.max_overlap_after = next.max_overlap_after;
-        report.converged = next.converged;
-        report.reason = next.reason;
-    }
+    let report = penalised_projection(&mut projection, &mut x, settings)?;
     projection.place(&x);
-    report.max_overlap_before = before;
-    report.largest_move = x.iter().zip(projection.start()).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
     Ok((report, projection.positions().to_vec()))
 }

@@ -17,7 +17,7 @@
 
 use super::{force_lines, max_abs, read_contacts, read_final, require, RunFigures};
 use crate::engine::FinalState;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::geometry::{Pose, Solid, Vec3};
 use crate::io::figures::{self, Axes, Series};
 use crate::io::layout;
@@ -91,32 +91,8 @@ pub fn nscd3d_figures(dir: &Path) -> Result<RunFigures> {
 
 /// The system of the run in `dir` (its bodies' shapes) at the poses of `fin`.
 fn final_system(dir: &Path, fin: &FinalState) -> Result<System3> {
-    #[derive(serde::Deserialize)]
-    struct Input {
-        system: System3,
-    }
-    let (scene, initial) = (dir.join(layout::SCENE), dir.join(layout::INITIAL_STATE));
-    let (mut sys, source) = if scene.is_file() {
-        (crate::scene::Scene3::load(&scene)?.build()?, scene)
-    } else if initial.is_file() {
-        (crate::io::read_json::<Input>(&initial)?.system, initial)
-    } else {
-        return Err(Error::Scene(format!(
-            "'{}' is not the folder of a finished run: it has neither {} nor {} (the shapes of the bodies)",
-            dir.display(),
-            layout::SCENE,
-            layout::INITIAL_STATE
-        )));
-    };
-    if fin.bodies.len() != sys.bodies.len() {
-        return Err(Error::Scene(format!(
-            "{} has {} bodies, {} has {}",
-            dir.join(layout::FINAL).display(),
-            fin.bodies.len(),
-            source.display(),
-            sys.bodies.len()
-        )));
-    }
+    let build = |path: &Path| crate::scene::Scene3::load(path)?.build();
+    let mut sys = super::input_system(dir, fin, build, |s: &System3| s.bodies.len())?;
     for (pose, b) in sys.bodies.pose.iter_mut().zip(&fin.bodies) {
         if let (&[x, y, z], Some([w, i, j, k])) = (&b.position[..], b.orientation) {
             *pose = Pose {

@@ -78,6 +78,44 @@ pub(crate) fn require(dir: &Path, name: &str) -> Result<PathBuf> {
     }
 }
 
+/// The system of the run in `dir` as its input recorded it: built from its copy of the scene (`scene.toml`) by
+/// `from_scene`, or read from `initial_state.json` (a system built in code); checked to have as many bodies as
+/// `final.json` (`count` of the system).
+pub(crate) fn input_system<T: serde::de::DeserializeOwned>(
+    dir: &Path,
+    fin: &FinalState,
+    from_scene: impl FnOnce(&Path) -> Result<T>,
+    count: impl Fn(&T) -> usize,
+) -> Result<T> {
+    #[derive(serde::Deserialize)]
+    struct Input<T> {
+        system: T,
+    }
+    let (scene, initial) = (dir.join(layout::SCENE), dir.join(layout::INITIAL_STATE));
+    let (sys, source) = if scene.is_file() {
+        (from_scene(&scene)?, scene)
+    } else if initial.is_file() {
+        (crate::io::read_json::<Input<T>>(&initial)?.system, initial)
+    } else {
+        return Err(Error::Scene(format!(
+            "'{}' is not the folder of a finished run: it has neither {} nor {} (the shapes of the bodies)",
+            dir.display(),
+            layout::SCENE,
+            layout::INITIAL_STATE
+        )));
+    };
+    if fin.bodies.len() != count(&sys) {
+        return Err(Error::Scene(format!(
+            "{} has {} bodies, {} has {}",
+            dir.join(layout::FINAL).display(),
+            fin.bodies.len(),
+            source.display(),
+            count(&sys)
+        )));
+    }
+    Ok(sys)
+}
+
 /// `dir/final.json`, which must exist.
 pub(crate) fn read_final(dir: &Path) -> Result<FinalState> {
     FinalState::read(&require(dir, layout::FINAL)?)

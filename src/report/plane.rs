@@ -16,7 +16,7 @@
 
 use super::{force_lines, max_abs, read_contacts, read_final, require, RunFigures};
 use crate::engine::FinalState;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::io::figures::{self, Arrow, Axes, ForceLine, Series};
 use crate::io::layout;
 use crate::nscd::System;
@@ -61,32 +61,8 @@ pub fn displacement_arrows(q0: &[[f64; 3]], sys: &System) -> Vec<Arrow> {
 /// The NSCD system of the run in `dir` at its end: the bodies of `scene.toml`
 /// (or of `initial_state.json`) moved to their positions in `fin`.
 fn nscd_final_system(dir: &Path, fin: &FinalState) -> Result<System> {
-    #[derive(serde::Deserialize)]
-    struct Input {
-        system: System,
-    }
-    let (scene, initial) = (dir.join(layout::SCENE), dir.join(layout::INITIAL_STATE));
-    let (mut sys, source) = if scene.is_file() {
-        (crate::scene::Scene::load(&scene)?.build()?, scene)
-    } else if initial.is_file() {
-        (crate::io::read_json::<Input>(&initial)?.system, initial)
-    } else {
-        return Err(Error::Scene(format!(
-            "'{}' is not the folder of a finished run: it has neither {} nor {} (the shapes of the bodies)",
-            dir.display(),
-            layout::SCENE,
-            layout::INITIAL_STATE
-        )));
-    };
-    if fin.bodies.len() != sys.bodies.len() {
-        return Err(Error::Scene(format!(
-            "{} has {} bodies, {} has {}",
-            dir.join(layout::FINAL).display(),
-            fin.bodies.len(),
-            source.display(),
-            sys.bodies.len()
-        )));
-    }
+    let build = |path: &Path| crate::scene::Scene::load(path)?.build();
+    let mut sys = super::input_system(dir, fin, build, |s: &System| s.bodies.len())?;
     for (q, b) in sys.bodies.q.iter_mut().zip(&fin.bodies) {
         if let [x, y] = b.position[..] {
             *q = [x, y, b.angle.unwrap_or(q[2])];

@@ -6,7 +6,7 @@
 
 use crate::geometry::Pose;
 use crate::nscd::method::{Row, SweepNorms};
-use crate::nscd::sublayer::{law17_affine, law17_solve};
+use crate::nscd::sublayer::{add_scalar_norms, law17_affine, law17_solve};
 use crate::space::bodies::{dot6, Dofs6};
 use crate::space::springs::Spring3;
 
@@ -127,17 +127,6 @@ impl Row for SpringRow3 {
             self.p = p;
             self.apply(u, inv_m, dp, 1.0);
         }
-        let du = self.w * dp;
-        let pm = 0.5 * (p_old + p);
-        let (wp_old, wp) = (self.w * p_old, self.w * p);
-        norms.add(
-            du * du,
-            pm * pm,
-            pm * du,
-            0.5 * (p_old * wp_old + p * wp),
-            0.5 * (wp_old * wp_old + wp * wp),
-            p * wp,
-            dp != 0.0,
-        );
+        add_scalar_norms(norms, self.w, p_old, p, dp);
     }
 }
