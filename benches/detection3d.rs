@@ -127,28 +127,54 @@ fn median(x: &mut [f64]) -> f64 {
     x[x.len() / 2]
 }
 
-/// With `DETECTION3D_PROFILE=jammed` (or `random`) and `DETECTION3D_CALLS=n` (default 200): only `n` calls
-/// on one thread (`DETECTION3D_THREADS` to change), for a profiler (`perf stat`, `perf record`), then exit.
+/// With `DETECTION3D_PROFILE=jammed` (or `random`): only calls on one detector, for a profiler (`perf stat`,
+/// `perf record`) or a comparison between builds, then exit: `DETECTION3D_CALLS=n` calls (default 200), or
+/// calls for `DETECTION3D_SECONDS=s` if given, on `DETECTION3D_THREADS` threads (default 1), after three
+/// warm-up calls. Prints the median, mean and fastest call, the mean of each phase, the team's joins and a
+/// hash of the last call's contacts.
 fn profile() -> bool {
     let Some(which) = std::env::var_os("DETECTION3D_PROFILE") else { return false };
-    let number = |key: &str, default: usize| std::env::var(key).ok().and_then(|v| v.parse().ok()).unwrap_or(default);
-    let (calls, threads) = (number("DETECTION3D_CALLS", 200), number("DETECTION3D_THREADS", 1));
+    let var = |key: &str| std::env::var(key).ok();
+    let calls: usize = var("DETECTION3D_CALLS").and_then(|v| v.parse().ok()).unwrap_or(200);
+    let seconds: Option<f64> = var("DETECTION3D_SECONDS").and_then(|v| v.parse().ok());
+    let threads: usize = var("DETECTION3D_THREADS").and_then(|v| v.parse().ok()).unwrap_or(1);
     let (solids, poses, mobile) = pile(which != "random");
     let mut det = Detector::with_threads(threads);
-    let (start, mut phases) = (Instant::now(), [0.0; 3]);
-    for _ in 0..calls {
+    for _ in 0..3 {
         det.run(&solids, &poses, &mobile, ALERT);
+    }
+    let stats0 = det.team_stats();
+    let (start, mut times, mut phases) = (Instant::now(), Vec::new(), [0.0; 3]);
+    while seconds.map_or(times.len() < calls, |s| start.elapsed().as_secs_f64() < s) {
+        let t = Instant::now();
+        det.run(&solids, &poses, &mobile, ALERT);
+        times.push(1e3 * t.elapsed().as_secs_f64());
         let d = det.times();
         for (p, d) in phases.iter_mut().zip([d.placement, d.pairs, d.narrow]) {
-            *p += d.as_secs_f64() * 1e3 / calls as f64;
+            *p += d.as_secs_f64() * 1e3;
         }
     }
+    let n = times.len() as f64;
+    let mean = times.iter().sum::<f64>() / n;
+    let fastest = times.iter().copied().fold(f64::INFINITY, f64::min);
+    let stats = det.team_stats();
+    let digest =
+        bits(&det).iter().flatten().fold(0xcbf2_9ce4_8422_2325u64, |h, &x| (h ^ x).wrapping_mul(0x0100_0000_01b3));
     eprintln!(
-        "{calls} calls, {:.3} ms each: placement {:.3} + pairs {:.3} + narrow {:.3} ms",
-        1e3 * start.elapsed().as_secs_f64() / calls as f64,
-        phases[0],
-        phases[1],
-        phases[2]
+        "{which:?} on {threads} thread(s), {} calls: median {:.3} ms, mean {mean:.3}, fastest {fastest:.3}; \
+         placement {:.3} + pairs {:.3} + narrow {:.3} ms; joins: {} on the helper, {} taken back, {} in turn \
+         ({} trials, {} switches); contacts {} hash {digest:016x}",
+        times.len(),
+        median(&mut times),
+        phases[0] / n,
+        phases[1] / n,
+        phases[2] / n,
+        stats.on_helper - stats0.on_helper,
+        stats.taken_back - stats0.taken_back,
+        stats.in_turn - stats0.in_turn,
+        stats.trials - stats0.trials,
+        stats.switches - stats0.switches,
+        det.found.len(),
     );
     true
 }

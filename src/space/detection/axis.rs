@@ -191,7 +191,7 @@ pub(crate) fn common_plane_in(
     // Faces of the antagonist: its vertices are all below the plane, the candidate's lowest is `s` above.
     // The face facing the candidate most is tried first, so that its separation bounds out the others.
     let mut best = (f64::NEG_INFINITY, Vec3::z(), AxisKind::FaceB(0));
-    let first_b = most(b.normals.len(), |f| dot_b(f));
+    let first_b = most(b.normals.len(), dot_b);
     for f in std::iter::once(first_b).chain((0..b.normals.len()).filter(|&f| f != first_b)) {
         if dot_b(f) - inner <= best.0 {
             continue;

@@ -152,8 +152,8 @@ impl Grid3 {
             around.clear();
             if large.get(next_large) == Some(&(i as u32)) {
                 next_large += 1;
-                for j in i + 1..n {
-                    if bi.overlaps(&boxes[j]) && !skip(i, j) {
+                for (j, bj) in boxes.iter().enumerate().skip(i + 1) {
+                    if bi.overlaps(bj) && !skip(i, j) {
                         around.push(j as u32);
                     }
                 }
@@ -300,16 +300,16 @@ mod tests {
         boxes.push(Aabb3 { min: [-1.0, -1.0, -1.0], max: [6.0, 6.0, 0.2] });
         let (mut grid, mut broad, mut pairs) = (Grid3::default(), Broad3::default(), Vec::new());
         for step in 0..12 {
-            let skip = |i: usize, j: usize| (i + j + step) % 7 == 0;
+            let skip = |i: usize, j: usize| (i + j + step).is_multiple_of(7);
             let mut kept = Vec::new();
             broad.pairs_with(&boxes, 0.05, skip, |i, list| kept.extend(list.iter().map(|&j| (i, j))));
             grid.pairs(&boxes, skip, &mut pairs);
             assert_eq!(kept, pairs, "step {step}");
             for b in &mut boxes {
                 let shift = [0.0; 3].map(|_: f64| 0.02 * (rnd() - 0.5));
-                for d in 0..3 {
-                    b.min[d] += shift[d];
-                    b.max[d] += shift[d];
+                for (d, s) in shift.iter().enumerate() {
+                    b.min[d] += s;
+                    b.max[d] += s;
                 }
             }
         }

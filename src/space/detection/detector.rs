@@ -12,21 +12,25 @@
 //! does; the point index of the key is the rank in that order.
 //!
 //! The detector remembers, per polyhedron pair, the last normal (or the axis that separated the pair) in a
-//! vector sorted by pair, walked alongside the sorted pairs; it is only a cheap first test (see [`super::axis`]), so the result of
-//! a call does not depend on the previous calls. Once the buffers have grown, a call allocates nothing.
+//! vector sorted by pair, walked alongside the sorted pairs; it is only a cheap first test (see
+//! [`super::axis`]), so the result of a call does not depend on the previous calls. Once the buffers have
+//! grown, a call allocates nothing.
+//!
+//! With two threads ([`Detector::set_threads`]) the placement and the narrow phase are shared with the
+//! helper of a [`Team`] (`share`: blocks of pairs taken from both ends; `place`: blocks of bodies); the
+//! contacts are the same, bit for bit, on one thread or two.
+
+mod place;
+mod share;
 
 use super::broad::{Aabb3, Broad3};
-use super::narrow::{
-    polyhedron_half_space, polyhedron_polyhedron_into, polyhedron_sphere, sphere_half_space, sphere_polyhedron,
-    sphere_sphere, Scratch,
-};
-use super::placed::{place_into, Edge3, Plane, PolyhedronView, Topologies};
-use super::Manifold;
+use super::narrow::Scratch;
+use super::placed::{Plane, Topologies};
 use crate::geometry::{Pose, Solid, Vec3};
 use crate::team::{Team, TeamStats};
+use place::{PlaceBlock, PLACE_BLOCKS, PLACE_MIN};
+use share::{Claims, Ctx, Part, JOIN_PAIRS, MIN_BLOCK};
 use std::borrow::Borrow;
-use std::ops::Range;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -92,17 +96,6 @@ struct World {
 /// The per-pair memory: (candidate, antagonist) and the axis, sorted by pair.
 type Memory = Vec<((u32, u32), Vec3)>;
 
-/// What the helper thread's share of the narrow phase writes: its contacts and memory, block after block
-/// (blocks taken from the end of the pairs, so in decreasing order), and where each block's start.
-#[derive(Debug, Clone, Default)]
-#[repr(align(128))]
-struct Part {
-    found: Vec<Found>,
-    memory: Memory,
-    blocks: Vec<(usize, usize)>,
-    scratch: Scratch,
-}
-
 /// Reused detection buffers, the per-pair memory of the normal and the threads.
 #[derive(Debug, Clone, Default)]
 pub struct Detector {
@@ -131,258 +124,6 @@ pub struct Detector {
     times: Times,
     /// Contacts found by the last call, sorted by key.
     pub found: Vec<Found>,
-}
-
-/// Pairs of the narrow phase per join of the team (about 0.5 ms of work in a jammed pile): a long phase is
-/// cut in many joins, so that the team's timing of its two modes (which takes 16 joins at least) covers a
-/// fraction of a call.
-const JOIN_PAIRS: usize = 768;
-/// Pairs handed out at a time within a join: a sixteenth of those left, within these bounds.
-const MIN_BLOCK: u32 = 8;
-const MAX_BLOCK: u32 = 256;
-
-/// The pairs not yet taken, `front..back`, packed in one word: the caller takes blocks from the front, the
-/// helper from the back, until they meet.
-#[repr(align(128))]
-struct Claims(AtomicU64);
-
-impl Claims {
-    fn new(front: usize, back: usize) -> Self {
-        Claims(AtomicU64::new(((back as u64) << 32) | front as u64))
-    }
-
-    /// One entry from the front (`front`) or from the back, or none left.
-    fn take_one(&self, front: bool) -> Option<usize> {
-        let mut cur = self.0.load(Ordering::Relaxed);
-        loop {
-            let (f, b) = (cur as u32, (cur >> 32) as u32);
-            if f >= b {
-                return None;
-            }
-            let (k, word) = if front { (f, cur + 1) } else { (b - 1, cur - (1 << 32)) };
-            match self.0.compare_exchange_weak(cur, word, Ordering::Relaxed, Ordering::Relaxed) {
-                Ok(_) => return Some(k as usize),
-                Err(c) => cur = c,
-            }
-        }
-    }
-
-    /// A block from the front (`front`) or from the back, or none left.
-    fn take(&self, front: bool) -> Option<Range<usize>> {
-        let mut cur = self.0.load(Ordering::Relaxed);
-        loop {
-            let (f, b) = (cur as u32, (cur >> 32) as u32);
-            if f >= b {
-                return None;
-            }
-            let size = ((b - f) / 16).clamp(MIN_BLOCK, MAX_BLOCK).min(b - f);
-            let (r, next) = if front { (f..f + size, f + size) } else { (b - size..b, b - size) };
-            let word =
-                if front { (u64::from(b) << 32) | u64::from(next) } else { (u64::from(next) << 32) | u64::from(f) };
-            match self.0.compare_exchange_weak(cur, word, Ordering::Relaxed, Ordering::Relaxed) {
-                Ok(_) => return Some(r.start as usize..r.end as usize),
-                Err(c) => cur = c,
-            }
-        }
-    }
-}
-
-/// What the narrow phase reads.
-///
-/// Aligned to its own cache lines, as are [`Claims`] and [`Part`]: the two threads write nothing near what
-/// the other reads (a shared line would be passed back and forth at every write).
-#[repr(align(128))]
-struct Ctx<'a, S> {
-    placed: &'a [Placed],
-    vertices: &'a [Vec3],
-    normals: &'a [Vec3],
-    offsets: &'a [f64],
-    arcs: &'a [Vec3],
-    edges: &'a [Edge3],
-    solids: &'a [S],
-    pairs: &'a [(u32, u32)],
-    memory: &'a [((u32, u32), Vec3)],
-    alert: f64,
-}
-
-impl<S: Borrow<Solid>> Ctx<'_, S> {
-    /// The caller's share: blocks from the front, in order, into `found` and `memory`.
-    fn front(
-        &self,
-        claims: &Claims,
-        cursor: &mut usize,
-        found: &mut Vec<Found>,
-        memory: &mut Memory,
-        scratch: &mut Scratch,
-    ) {
-        while let Some(r) = claims.take(true) {
-            self.block(r, cursor, found, memory, scratch);
-        }
-    }
-
-    /// The helper's share: blocks from the back.
-    fn back(&self, claims: &Claims, part: &mut Part) {
-        while let Some(r) = claims.take(false) {
-            part.blocks.push((part.found.len(), part.memory.len()));
-            let first = self.pairs[r.start];
-            let mut cursor = self.memory.partition_point(|m| m.0 < first);
-            self.block(r, &mut cursor, &mut part.found, &mut part.memory, &mut part.scratch);
-        }
-    }
-
-    /// The narrow phase on pairs `r`, the memory walked from `cursor`.
-    fn block(
-        &self,
-        r: Range<usize>,
-        cursor: &mut usize,
-        found: &mut Vec<Found>,
-        memory: &mut Memory,
-        scratch: &mut Scratch,
-    ) {
-        let mem = self.memory;
-        let mut m = Manifold::new(Vec3::z());
-        for &(i, j) in &self.pairs[r] {
-            while *cursor < mem.len() && mem[*cursor].0 < (i, j) {
-                *cursor += 1;
-            }
-            let hint = mem.get(*cursor).filter(|m| m.0 == (i, j)).map(|m| &m.1);
-            if self.narrow(i, j, hint, memory, scratch, &mut m) {
-                for (p, q) in m.points().iter().enumerate() {
-                    found.push(Found {
-                        key: (i, j, p as u32),
-                        position: q.position,
-                        normal: m.normal,
-                        t1: m.t1,
-                        t2: m.t2,
-                        gap: q.gap,
-                    });
-                }
-            }
-        }
-    }
-
-    fn view(&self, k: u32) -> Option<PolyhedronView<'_>> {
-        match (self.placed[k as usize], self.solids[k as usize].borrow()) {
-            (
-                Placed::Polyhedron { vertices: v, faces: f, edges: e, arcs, centre, radius, inradius },
-                Solid::Polyhedron(p),
-            ) => {
-                let r = |r: (u32, u32)| r.0 as usize..r.1 as usize;
-                let w = self;
-                Some(PolyhedronView {
-                    vertices: &w.vertices[r(v)],
-                    normals: &w.normals[r(f)],
-                    offsets: &w.offsets[r(f)],
-                    faces: &p.faces,
-                    edges: &self.edges[r(e)],
-                    arcs: &w.arcs[arcs as usize..(arcs + e.1 - e.0) as usize],
-                    centre,
-                    radius,
-                    inradius,
-                })
-            }
-            _ => None,
-        }
-    }
-
-    /// The narrow phase on candidate `i` and antagonist `j`, `hint` the pair's last normal, into `out`: whether
-    /// they are in contact. A polyhedron pair's axis is pushed on `memory`.
-    fn narrow(
-        &self,
-        i: u32,
-        j: u32,
-        hint: Option<&Vec3>,
-        memory: &mut Memory,
-        scratch: &mut Scratch,
-        out: &mut Manifold,
-    ) -> bool {
-        let alert = self.alert;
-        let m = match (self.placed[i as usize], self.placed[j as usize]) {
-            (Placed::Polyhedron { .. }, Placed::Polyhedron { .. }) => {
-                let (Some(a), Some(b)) = (self.view(i), self.view(j)) else { return false };
-                let (met, axis) = polyhedron_polyhedron_into(&a, &b, alert, hint, scratch, out);
-                memory.push(((i, j), axis));
-                return met;
-            }
-            (Placed::Polyhedron { .. }, Placed::Sphere { centre, radius }) => {
-                self.view(i).and_then(|a| polyhedron_sphere(&a, &centre, radius, alert))
-            }
-            (Placed::Sphere { centre, radius }, Placed::Polyhedron { .. }) => {
-                self.view(j).and_then(|b| sphere_polyhedron(&centre, radius, &b, alert))
-            }
-            (Placed::Sphere { centre: ca, radius: ra }, Placed::Sphere { centre: cb, radius: rb }) => {
-                sphere_sphere(&ca, ra, &cb, rb, alert)
-            }
-            (Placed::Polyhedron { .. }, Placed::Wall(w)) => {
-                self.view(i).and_then(|a| polyhedron_half_space(&a, &w, alert))
-            }
-            (Placed::Sphere { centre, radius }, Placed::Wall(w)) => sphere_half_space(&centre, radius, &w, alert),
-            (Placed::Wall(_), _) => unreachable!("a half-space is never the candidate"),
-        };
-        m.map(|m| *out = m).is_some()
-    }
-}
-
-/// Most blocks the placement is cut in, and fewest bodies in a block.
-const PLACE_BLOCKS: usize = 32;
-const PLACE_MIN: usize = 32;
-
-/// A block of consecutive bodies to place: their entries and their parts of the buffers, which start at
-/// `base` (vertices, faces, arcs, finite bodies) in the whole buffers.
-struct PlaceBlock<'a> {
-    first: usize,
-    base: (u32, u32, u32, u32),
-    placed: &'a mut [Placed],
-    vertices: &'a mut [Vec3],
-    normals: &'a mut [Vec3],
-    offsets: &'a mut [f64],
-    arcs: &'a mut [Vec3],
-    boxes: &'a mut [Aabb3],
-}
-
-impl PlaceBlock<'_> {
-    /// Places the block's bodies and makes the boxes of the finite ones, enlarged by `half` (m).
-    fn fill<S: Borrow<Solid>>(self, solids: &[S], poses: &[Pose], edges: &[Edge3], half: f64) {
-        let (v0, f0, a0) = (self.base.0 as usize, self.base.1 as usize, self.base.2 as usize);
-        let mut boxes = self.boxes.iter_mut();
-        let bodies = solids[self.first..].iter().zip(&poses[self.first..]);
-        for ((solid, pose), placed) in bodies.zip(self.placed.iter_mut()) {
-            let (lo, hi) = match (solid.borrow(), placed) {
-                (
-                    Solid::Polyhedron(p),
-                    Placed::Polyhedron { vertices: v, faces: f, edges: e, arcs, radius, inradius, .. },
-                ) => {
-                    let (v, f, a) = (
-                        v.0 as usize - v0..v.1 as usize - v0,
-                        f.0 as usize - f0..f.1 as usize - f0,
-                        *arcs as usize - a0,
-                    );
-                    let bounds = place_into(
-                        p,
-                        pose,
-                        &edges[e.0 as usize..e.1 as usize],
-                        &mut self.vertices[v],
-                        &mut self.normals[f.clone()],
-                        &mut self.offsets[f],
-                        &mut self.arcs[a..a + (e.1 - e.0) as usize],
-                    );
-                    (*radius, *inradius) = (bounds.radius, bounds.inradius);
-                    (bounds.lo, bounds.hi)
-                }
-                (_, Placed::Sphere { centre, radius }) => {
-                    let r = Vec3::repeat(*radius);
-                    (*centre - r, *centre + r)
-                }
-                _ => continue,
-            };
-            if let Some(b) = boxes.next() {
-                *b = Aabb3 {
-                    min: [lo.x - half, lo.y - half, lo.z - half],
-                    max: [hi.x + half, hi.y + half, hi.z + half],
-                };
-            }
-        }
-    }
 }
 
 /// The topology cache is started again beyond this many entries (shapes that keep changing).
