@@ -94,20 +94,32 @@ pub fn common_plane(a: &PolyhedronView, b: &PolyhedronView, alert: f64, hint: Op
     common_plane_in(&mut Dots::default(), a, b, alert, hint)
 }
 
-/// The dot products of the two shapes' face normals with the line of centres that [`common_plane`] reads
-/// more than once, kept from pair to pair (only the entries a pair writes are read): in place up to
-/// [`FACES`] faces (no small allocation a thread writes at every pair next to another thread's), beyond in
-/// vectors.
+/// The buffers of [`common_plane`], kept from pair to pair (only the entries a pair writes are read): the
+/// dot products of the two shapes' face normals with the line of centres that it reads more than once, in
+/// place up to [`FACES`] faces (no small allocation a thread writes at every pair next to another thread's),
+/// beyond in vectors; and the antagonist's edges that can make an edge pair.
 #[derive(Debug, Clone)]
 pub struct Dots {
     inline: [[f64; FACES]; 4],
     heap: [Vec<f64>; 4],
+    viable: Vec<EdgeB>,
 }
 
 impl Default for Dots {
     fn default() -> Self {
-        Dots { inline: [[0.0; FACES]; 4], heap: Default::default() }
+        Dots { inline: [[0.0; FACES]; 4], heap: Default::default(), viable: Vec::new() }
     }
+}
+
+/// An edge of the antagonist that can make an edge pair, with what the pair loop reads of it, in one place:
+/// its index, its faces' normals, its arc and its first vertex.
+#[derive(Debug, Clone, Copy)]
+struct EdgeB {
+    j: u32,
+    nb0: Vec3,
+    nb1: Vec3,
+    arc: Vec3,
+    q: Vec3,
 }
 
 /// Faces whose dot products [`Dots`] keeps in place.
@@ -126,39 +138,6 @@ fn dots<'a>(normals: &[Vec3], u: &Vec3, inline: &'a mut [f64; FACES], heap: &'a 
         *o = n.dot(u);
     }
     out
-}
-
-/// The indices of a bit set of at most 128 entries, in increasing order, or all of `0..len` (`len > 128`).
-struct Indices {
-    bits: u128,
-    next: usize,
-    len: usize,
-}
-
-impl Indices {
-    #[inline(always)]
-    fn new(mask: u128, len: usize) -> Self {
-        Indices { bits: mask, next: 0, len }
-    }
-}
-
-impl Iterator for Indices {
-    type Item = usize;
-
-    #[inline(always)]
-    fn next(&mut self) -> Option<usize> {
-        if self.len <= 128 {
-            if self.bits == 0 {
-                return None;
-            }
-            let j = self.bits.trailing_zeros() as usize;
-            self.bits &= self.bits - 1;
-            Some(j)
-        } else {
-            self.next += 1;
-            (self.next <= self.len).then_some(self.next - 1)
-        }
-    }
 }
 
 /// [`common_plane`] with the buffers `dots`.
@@ -183,7 +162,7 @@ pub(crate) fn common_plane_in(
     let tol = FACE_PREFERENCE * a.radius.min(b.radius);
     let inner = a.inradius + b.inradius;
     // `n · d` of every face normal of each shape, computed once.
-    let Dots { inline: [da, db, ca, cb], heap: [ha, hb, hca, hcb] } = dots_in;
+    let Dots { inline: [da, db, ca, cb], heap: [ha, hb, hca, hcb], viable } = dots_in;
     let db = dots(b.normals, &d, db, hb);
     let da = dots(a.normals, &d, da, ha);
     let dot_b = |f: usize| db[f];
@@ -236,33 +215,36 @@ pub(crate) fn common_plane_in(
     let up_b = |f: u32| cb[f as usize];
     let up_a = |f: u32| -ca[f as usize];
     let mut edge = (f64::NEG_INFINITY, Vec3::z(), (0, 0));
-    // The antagonist's edges that can, as a bit set (all of them beyond 128 edges), made on first need.
-    let mut viable_b: Option<u128> = None;
+    // The antagonist's edges that can (all of them beyond 128 edges), listed on first need.
+    let mut listed = false;
     for (i, (ea, arc_a)) in a.edges.iter().zip(a.arcs).enumerate() {
         let [fa0, fa1] = ea.faces;
         let (na0, na1) = (&a.normals[fa0 as usize], &a.normals[fa1 as usize]);
         if !arc_reaches(up_a(fa0), up_a(fa1), || (*na0, *na1), arc_a, &u, need) {
             continue;
         }
-        let viable = *viable_b.get_or_insert_with(|| {
-            if b.edges.len() > 128 {
-                return u128::MAX;
-            }
-            let mut mask = 0u128;
+        if !listed {
+            listed = true;
+            viable.clear();
+            let all = b.edges.len() > 128;
             for (j, (eb, arc_b)) in b.edges.iter().zip(b.arcs).enumerate() {
                 let [fb0, fb1] = eb.faces;
                 let ends = || (-b.normals[fb0 as usize], -b.normals[fb1 as usize]);
-                if arc_reaches(up_b(fb0), up_b(fb1), ends, arc_b, &u, need) {
-                    mask |= 1 << j;
+                if all || arc_reaches(up_b(fb0), up_b(fb1), ends, arc_b, &u, need) {
+                    viable.push(EdgeB {
+                        j: j as u32,
+                        nb0: b.normals[fb0 as usize],
+                        nb1: b.normals[fb1 as usize],
+                        arc: *arc_b,
+                        q: b.vertices[eb.vertices[0] as usize],
+                    });
                 }
             }
-            mask
-        });
+        }
         let pa = a.vertices[ea.vertices[0] as usize];
-        for j in Indices::new(viable, b.edges.len()) {
-            let (eb, arc_b) = (&b.edges[j], &b.arcs[j]);
+        for e in viable.iter() {
             // Arcs (na0, na1) of A and (−nb0, −nb1) of B on the Gauss map of A − B.
-            let (nb0, nb1) = (&b.normals[eb.faces[0] as usize], &b.normals[eb.faces[1] as usize]);
+            let (nb0, nb1, arc_b) = (&e.nb0, &e.nb1, &e.arc);
             let cba = -nb0.dot(arc_a);
             let dba = -nb1.dot(arc_a);
             let adc = na0.dot(arc_b);
@@ -280,12 +262,12 @@ pub(crate) fn common_plane_in(
             if m.dot(&(pa - a.centre)) < 0.0 {
                 m = -m;
             }
-            let s = m.dot(&(b.vertices[eb.vertices[0] as usize] - pa));
+            let s = m.dot(&(e.q - pa));
             if s > alert {
                 return Search::Apart(-m);
             }
             if s > edge.0 {
-                edge = (s, -m, (i as u32, j as u32));
+                edge = (s, -m, (i as u32, e.j));
             }
         }
     }
