@@ -91,6 +91,63 @@ pub fn separation(a: &PolyhedronView, b: &PolyhedronView, n: &Vec3) -> f64 {
 /// without projecting any vertex. When the result is apart (a positive separation), it is exact only if the
 /// closest features are a face and anything or two crossing edges: see [`refine`].
 pub fn common_plane(a: &PolyhedronView, b: &PolyhedronView, alert: f64, hint: Option<&Vec3>) -> Search {
+    common_plane_in(&mut Dots::default(), a, b, alert, hint)
+}
+
+/// The buffers of [`common_plane`], kept from pair to pair (only the entries a pair writes are read): the
+/// dot products of the two shapes' face normals with the line of centres that it reads more than once, in
+/// place up to [`FACES`] faces (no small allocation a thread writes at every pair next to another thread's),
+/// beyond in vectors; and the antagonist's edges that can make an edge pair.
+#[derive(Debug, Clone)]
+pub struct Dots {
+    inline: [[f64; FACES]; 4],
+    heap: [Vec<f64>; 4],
+    viable: Vec<EdgeB>,
+}
+
+impl Default for Dots {
+    fn default() -> Self {
+        Dots { inline: [[0.0; FACES]; 4], heap: Default::default(), viable: Vec::new() }
+    }
+}
+
+/// An edge of the antagonist that can make an edge pair, with what the pair loop reads of it, in one place:
+/// its index, its faces' normals, its arc and its first vertex.
+#[derive(Debug, Clone, Copy)]
+struct EdgeB {
+    j: u32,
+    nb0: Vec3,
+    nb1: Vec3,
+    arc: Vec3,
+    q: Vec3,
+}
+
+/// Faces whose dot products [`Dots`] keeps in place.
+pub const FACES: usize = 64;
+
+/// `n · u` of each normal, in `inline` if they fit, else in `heap`.
+#[inline]
+fn dots<'a>(normals: &[Vec3], u: &Vec3, inline: &'a mut [f64; FACES], heap: &'a mut Vec<f64>) -> &'a [f64] {
+    let out: &mut [f64] = if normals.len() <= FACES {
+        &mut inline[..normals.len()]
+    } else {
+        heap.resize(normals.len(), 0.0);
+        heap
+    };
+    for (o, n) in out.iter_mut().zip(normals) {
+        *o = n.dot(u);
+    }
+    out
+}
+
+/// [`common_plane`] with the buffers `dots`.
+pub(crate) fn common_plane_in(
+    dots_in: &mut Dots,
+    a: &PolyhedronView,
+    b: &PolyhedronView,
+    alert: f64,
+    hint: Option<&Vec3>,
+) -> Search {
     let d = a.centre - b.centre;
     let dist = d.norm();
     let centres = if dist > 0.0 { d / dist } else { Vec3::z() };
@@ -98,22 +155,28 @@ pub fn common_plane(a: &PolyhedronView, b: &PolyhedronView, alert: f64, hint: Op
         return Search::Apart(centres);
     }
     if let Some(n) = hint {
-        if separation(a, b, n) > alert {
+        if apart_along(a, b, n, alert) {
             return Search::Apart(*n);
         }
     }
     let tol = FACE_PREFERENCE * a.radius.min(b.radius);
     let inner = a.inradius + b.inradius;
+    // `n · d` of every face normal of each shape, computed once.
+    let Dots { inline: [da, db, ca, cb], heap: [ha, hb, hca, hcb], viable } = dots_in;
+    let db = dots(b.normals, &d, db, hb);
+    let da = dots(a.normals, &d, da, ha);
+    let dot_b = |f: usize| db[f];
+    let dot_a = |f: usize| da[f];
     // Faces of the antagonist: its vertices are all below the plane, the candidate's lowest is `s` above.
     // The face facing the candidate most is tried first, so that its separation bounds out the others.
     let mut best = (f64::NEG_INFINITY, Vec3::z(), AxisKind::FaceB(0));
-    let first_b = facing(b.normals, &d);
+    let first_b = most(b.normals.len(), dot_b);
     for f in std::iter::once(first_b).chain((0..b.normals.len()).filter(|&f| f != first_b)) {
-        let n = b.normals[f];
-        if n.dot(&d) - inner <= best.0 {
+        if dot_b(f) - inner <= best.0 {
             continue;
         }
-        let s = a.vertices.iter().map(|v| n.dot(v)).fold(f64::INFINITY, f64::min) - b.offsets[f];
+        let n = b.normals[f];
+        let s = lowest(a.vertices, &n) - b.offsets[f];
         if s > alert {
             return Search::Apart(n);
         }
@@ -122,14 +185,15 @@ pub fn common_plane(a: &PolyhedronView, b: &PolyhedronView, alert: f64, hint: Op
             best = (s, n, AxisKind::FaceB(f as u32));
         }
     }
-    let first_a = facing(a.normals, &-d);
+    // `−(m · d)` is `m · (−d)` but for the sign of a zero, which no comparison sees.
+    let first_a = most(a.normals.len(), |f| -dot_a(f));
     let mut best_a = (f64::NEG_INFINITY, Vec3::z(), AxisKind::FaceA(0));
     for f in std::iter::once(first_a).chain((0..a.normals.len()).filter(|&f| f != first_a)) {
-        let m = a.normals[f];
-        if -m.dot(&d) - inner <= best.0.max(best_a.0 - tol) + tol {
+        if -dot_a(f) - inner <= best.0.max(best_a.0 - tol) + tol {
             continue;
         }
-        let s = b.vertices.iter().map(|v| m.dot(v)).fold(f64::INFINITY, f64::min) - a.offsets[f];
+        let m = a.normals[f];
+        let s = lowest(b.vertices, &m) - a.offsets[f];
         if s > alert {
             return Search::Apart(-m);
         }
@@ -143,34 +207,44 @@ pub fn common_plane(a: &PolyhedronView, b: &PolyhedronView, alert: f64, hint: Op
     // An edge pair's axis m (outward of A, towards B) must reach `need` along the centres' line to beat the
     // best face by the preference margin.
     let need = (best.0 + tol + inner) / dist.max(f64::MIN_POSITIVE);
+    let u = -centres;
+    // `n · u` of the faces: for A's normals `−(n · centres)`, for B's negated normals `n · centres`
+    // (exactly: `(−x)(−y) = xy`), up to the sign of a zero.
+    let cb = dots(b.normals, &centres, cb, hcb);
+    let ca = dots(a.normals, &centres, ca, hca);
+    let up_b = |f: u32| cb[f as usize];
+    let up_a = |f: u32| -ca[f as usize];
     let mut edge = (f64::NEG_INFINITY, Vec3::z(), (0, 0));
-    // The antagonist's edges that can, as a bit set (all of them beyond 128 edges), made on first need.
-    let mut viable_b: Option<u128> = None;
+    // The antagonist's edges that can (all of them beyond 128 edges), listed on first need.
+    let mut listed = false;
     for (i, (ea, arc_a)) in a.edges.iter().zip(a.arcs).enumerate() {
-        let (na0, na1) = (a.normals[ea.faces[0] as usize], a.normals[ea.faces[1] as usize]);
-        if !arc_reaches(&na0, &na1, arc_a, &-centres, need) {
+        let [fa0, fa1] = ea.faces;
+        let (na0, na1) = (&a.normals[fa0 as usize], &a.normals[fa1 as usize]);
+        if !arc_reaches(up_a(fa0), up_a(fa1), || (*na0, *na1), arc_a, &u, need) {
             continue;
         }
-        let viable = *viable_b.get_or_insert_with(|| {
-            if b.edges.len() > 128 {
-                return u128::MAX;
-            }
-            let mut mask = 0u128;
+        if !listed {
+            listed = true;
+            viable.clear();
+            let all = b.edges.len() > 128;
             for (j, (eb, arc_b)) in b.edges.iter().zip(b.arcs).enumerate() {
-                let (nb0, nb1) = (b.normals[eb.faces[0] as usize], b.normals[eb.faces[1] as usize]);
-                if arc_reaches(&-nb0, &-nb1, arc_b, &-centres, need) {
-                    mask |= 1 << j;
+                let [fb0, fb1] = eb.faces;
+                let ends = || (-b.normals[fb0 as usize], -b.normals[fb1 as usize]);
+                if all || arc_reaches(up_b(fb0), up_b(fb1), ends, arc_b, &u, need) {
+                    viable.push(EdgeB {
+                        j: j as u32,
+                        nb0: b.normals[fb0 as usize],
+                        nb1: b.normals[fb1 as usize],
+                        arc: *arc_b,
+                        q: b.vertices[eb.vertices[0] as usize],
+                    });
                 }
             }
-            mask
-        });
+        }
         let pa = a.vertices[ea.vertices[0] as usize];
-        for (j, (eb, arc_b)) in b.edges.iter().zip(b.arcs).enumerate() {
-            if j < 128 && viable & (1 << j) == 0 {
-                continue;
-            }
+        for e in viable.iter() {
             // Arcs (na0, na1) of A and (−nb0, −nb1) of B on the Gauss map of A − B.
-            let (nb0, nb1) = (b.normals[eb.faces[0] as usize], b.normals[eb.faces[1] as usize]);
+            let (nb0, nb1, arc_b) = (&e.nb0, &e.nb1, &e.arc);
             let cba = -nb0.dot(arc_a);
             let dba = -nb1.dot(arc_a);
             let adc = na0.dot(arc_b);
@@ -188,12 +262,12 @@ pub fn common_plane(a: &PolyhedronView, b: &PolyhedronView, alert: f64, hint: Op
             if m.dot(&(pa - a.centre)) < 0.0 {
                 m = -m;
             }
-            let s = m.dot(&(b.vertices[eb.vertices[0] as usize] - pa));
+            let s = m.dot(&(e.q - pa));
             if s > alert {
                 return Search::Apart(-m);
             }
             if s > edge.0 {
-                edge = (s, -m, (i as u32, j as u32));
+                edge = (s, -m, (i as u32, e.j));
             }
         }
     }
@@ -210,12 +284,12 @@ pub fn common_plane(a: &PolyhedronView, b: &PolyhedronView, alert: f64, hint: Op
     Search::Plane(CommonPlane { normal: best.1, separation: best.0, kind: best.2, witness: None })
 }
 
-/// The face whose normal is most along `u` (the first of equals).
+/// The index of the largest of `value(0..len)` (the first of equals; 0 when none is above −∞).
 #[inline]
-fn facing(normals: &[Vec3], u: &Vec3) -> usize {
+fn most(len: usize, value: impl Fn(usize) -> f64) -> usize {
     let mut best = (0, f64::NEG_INFINITY);
-    for (f, n) in normals.iter().enumerate() {
-        let c = n.dot(u);
+    for f in 0..len {
+        let c = value(f);
         if c > best.1 {
             best = (f, c);
         }
@@ -223,11 +297,30 @@ fn facing(normals: &[Vec3], u: &Vec3) -> usize {
     best.0
 }
 
+/// The smallest `n · v` over `vertices` (`+∞` when none).
+#[inline]
+fn lowest(vertices: &[Vec3], n: &Vec3) -> f64 {
+    vertices.iter().map(|v| n.dot(v)).fold(f64::INFINITY, f64::min)
+}
+
+/// Whether [`separation`] along `n` exceeds `alert`, stopping at the first vertex of `b` that shows it does
+/// not: `fl(lo − h)` only decreases as `h` grows, so it exceeds `alert` at the highest `h` exactly when it
+/// does at every `h` (a NaN, which the highest leaves out, is left out here too).
+#[inline]
+fn apart_along(a: &PolyhedronView, b: &PolyhedronView, n: &Vec3, alert: f64) -> bool {
+    let o = 0.5 * (a.centre + b.centre);
+    let lo = a.extent(n, &o).0;
+    b.vertices.iter().all(|v| {
+        let h = n.dot(&(v - o));
+        lo - h > alert || h.is_nan()
+    })
+}
+
 /// Whether some `m` on the arc of unit directions from `n0` to `n1` (shorter than a half turn) on the unit
-/// sphere has `m · u > need`; `arc = n1 × n0`.
+/// sphere has `m · u > need`; `arc = n1 × n0`, `e0 = n0 · u` and `e1 = n1 · u` (the ends are only asked for
+/// when these do not settle it).
 #[inline(always)]
-fn arc_reaches(n0: &Vec3, n1: &Vec3, arc: &Vec3, u: &Vec3, need: f64) -> bool {
-    let (e0, e1) = (n0.dot(u), n1.dot(u));
+fn arc_reaches(e0: f64, e1: f64, ends: impl FnOnce() -> (Vec3, Vec3), arc: &Vec3, u: &Vec3, need: f64) -> bool {
     if e0 > need || e1 > need {
         return true;
     }
@@ -245,8 +338,9 @@ fn arc_reaches(n0: &Vec3, n1: &Vec3, arc: &Vec3, u: &Vec3, need: f64) -> bool {
     }
     // That maximum is reached on the arc when the projection lies between n0 and n1 (turning about
     // n0 × n1 = −arc).
+    let (n0, n1) = ends();
     let p = u - arc * (wu / w2);
-    n0.cross(&p).dot(arc) <= 0.0 && p.cross(n1).dot(arc) <= 0.0
+    n0.cross(&p).dot(arc) <= 0.0 && p.cross(&n1).dot(arc) <= 0.0
 }
 
 /// The closest points of the lines of edge `i` of `a` and edge `j` of `b` (not parallel), clamped to the segments), and whether they lie on both segments (within 1e-9 of their lengths).

@@ -32,8 +32,10 @@ pub mod polygon;
 mod tests;
 #[cfg(test)]
 mod tests_detector;
+#[cfg(test)]
+mod tests_reference;
 
-pub use detector::{Detector, Found};
+pub use detector::{Detector, Found, Times};
 pub use narrow::{
     polyhedron_half_space, polyhedron_polyhedron, polyhedron_sphere, sphere_half_space, sphere_polyhedron,
     sphere_sphere,

@@ -11,14 +11,21 @@
 //!
 //! Every point lies half-way between the two surfaces along the normal.
 
-use super::axis::{common_plane, is_exact, refine, AxisKind, CommonPlane, Search};
+use super::axis::{common_plane_in, is_exact, refine, AxisKind, CommonPlane, Dots, Search};
 use super::placed::{Plane, PolyhedronView};
-use super::polygon::{contact_points, reduce_points, Frame, Label, Labelled, CAP};
+use super::polygon::{self, contact_points_in, reduce_points, Frame, Label, Labelled, CAP};
 use super::Manifold;
 use crate::geometry::{Vec2, Vec3};
 
 /// Length tolerance of the polygon work, relative to the smaller radius of the pair.
 pub const EPS: f64 = 1e-9;
+
+/// The buffers of the narrow phase of two polyhedra, reused from pair to pair.
+#[derive(Debug, Clone, Default)]
+pub struct Scratch {
+    dots: Dots,
+    polygon: polygon::Scratch,
+}
 
 /// Contact of candidate polyhedron `a` and antagonist polyhedron `b` with a gap at most `alert` (m); `hint`
 /// is the previous step's normal of the pair, if any (a cheap first test, see [`super::axis`]).
@@ -28,50 +35,64 @@ pub fn polyhedron_polyhedron(
     alert: f64,
     hint: Option<&Vec3>,
 ) -> Option<Manifold> {
-    polyhedron_polyhedron_axis(a, b, alert, hint).0
+    let mut m = Manifold::new(Vec3::z());
+    polyhedron_polyhedron_into(a, b, alert, hint, &mut Scratch::default(), &mut m).0.then_some(m)
 }
 
-/// [`polyhedron_polyhedron`], with the axis to remember for the next step: the normal when in contact, else
-/// the axis found to separate the two.
-pub(crate) fn polyhedron_polyhedron_axis(
+/// [`polyhedron_polyhedron`] into `m` (meaningful when the first value returned is true: a contact), with
+/// the axis to remember for the next step: the normal when in contact, else the axis found to separate the
+/// two; `scratch` holds the polygon work's buffers.
+pub(crate) fn polyhedron_polyhedron_into(
     a: &PolyhedronView,
     b: &PolyhedronView,
     alert: f64,
     hint: Option<&Vec3>,
-) -> (Option<Manifold>, Vec3) {
-    let mut plane = match common_plane(a, b, alert, hint) {
-        Search::Apart(axis) => return (None, axis),
+    scratch: &mut Scratch,
+    m: &mut Manifold,
+) -> (bool, Vec3) {
+    let mut plane = match common_plane_in(&mut scratch.dots, a, b, alert, hint) {
+        Search::Apart(axis) => return (false, axis),
         Search::Plane(p) => p,
     };
     // Apart along an axis that may not be the closest direction: GJK first.
     if plane.separation > 0.0 && !is_exact(a, b, &plane) {
         match refine(a, b, alert, plane) {
-            Search::Apart(axis) => return (None, axis),
+            Search::Apart(axis) => return (false, axis),
             Search::Plane(p) => plane = p,
         }
     }
-    let (m, met) = on_plane(a, b, alert, &plane);
+    let met = on_plane(a, b, alert, &plane, &mut scratch.polygon, m);
     if !met && plane.separation > 0.0 && plane.kind != AxisKind::Closest {
         // The projections missed each other although the axis looked exact: ask GJK.
         match refine(a, b, alert, plane) {
-            Search::Apart(axis) => return (None, axis),
-            Search::Plane(p) if p.kind == AxisKind::Closest => return (on_plane(a, b, alert, &p).0, p.normal),
+            Search::Apart(axis) => return (false, axis),
+            Search::Plane(p) if p.kind == AxisKind::Closest => {
+                on_plane(a, b, alert, &p, &mut scratch.polygon, m);
+                return (m.len > 0, p.normal);
+            }
             Search::Plane(_) => {}
         }
     }
-    (m, plane.normal)
+    (m.len > 0, plane.normal)
 }
 
-/// The contact points of `a` and `b` on the common plane `plane`, and whether the features' projections met.
-fn on_plane(a: &PolyhedronView, b: &PolyhedronView, alert: f64, plane: &CommonPlane) -> (Option<Manifold>, bool) {
+/// The contact points of `a` and `b` on the common plane `plane`, into `m`, and whether the features'
+/// projections met.
+fn on_plane(
+    a: &PolyhedronView,
+    b: &PolyhedronView,
+    alert: f64,
+    plane: &CommonPlane,
+    scratch: &mut polygon::Scratch,
+    m: &mut Manifold,
+) -> bool {
     let n = plane.normal;
-    let mut m = Manifold::new(n);
+    *m = Manifold::new(n);
     let eps = EPS * a.radius.min(b.radius);
     let frame = Frame { o: 0.5 * (a.centre + b.centre), t1: m.t1, t2: m.t2, n, eps };
     // Every vertex that could have a gap within the alert distance against a flat opposite surface.
     let band = (alert - plane.separation).max(0.0) + eps;
-    let met = contact_points(a, b, &frame, band, alert, plane.witness, |x, gap| m.push(x, gap));
-    ((m.len > 0).then_some(m), met)
+    contact_points_in(scratch, a, b, &frame, band, alert, plane.witness, |x, gap| m.push(x, gap))
 }
 
 /// A vertex near a wall.

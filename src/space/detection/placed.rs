@@ -149,31 +149,143 @@ pub(crate) fn place(
     edges: &mut Vec<Edge3>,
     arcs: &mut Vec<Vec3>,
 ) -> Bounds {
+    let (v0, f0, e0) = (vertices.len(), normals.len(), edges.len());
+    edge_topology(p, scratch, edges);
+    vertices.resize(v0 + p.vertices.len(), Vec3::zeros());
+    normals.resize(f0 + p.faces.len(), Vec3::zeros());
+    offsets.resize(f0 + p.faces.len(), 0.0);
+    arcs.resize(edges.len(), Vec3::zeros());
+    place_into(p, pose, &edges[e0..], &mut vertices[v0..], &mut normals[f0..], &mut offsets[f0..], &mut arcs[e0..])
+}
+
+/// The world placement of `p` at `pose` written into `vertices` (as many as the shape's), `normals` and
+/// `offsets` (one per face) and `arcs` (one per edge of `edges`, the shape's [`edge_topology`]).
+pub(crate) fn place_into(
+    p: &Polyhedron,
+    pose: &Pose,
+    edges: &[Edge3],
+    vertices: &mut [Vec3],
+    normals: &mut [Vec3],
+    offsets: &mut [f64],
+    arcs: &mut [Vec3],
+) -> Bounds {
     let rot = pose.rotation.to_rotation_matrix();
     let (mut lo, mut hi) = (pose.position, pose.position);
-    let mut radius: f64 = 0.0;
-    for v in &p.vertices {
-        radius = radius.max(v.norm());
-        let w = pose.position + rot * v;
-        lo = lo.inf(&w);
-        hi = hi.sup(&w);
-        vertices.push(w);
+    // The largest squared norm, then its root: the root is monotonic and correctly rounded, so this is the
+    // largest norm to the bit.
+    let mut radius2: f64 = 0.0;
+    for (v, w) in p.vertices.iter().zip(vertices.iter_mut()) {
+        radius2 = radius2.max(v.norm_squared());
+        *w = pose.position + rot * v;
+        lo = lo.inf(w);
+        hi = hi.sup(w);
     }
-    let n0 = normals.len();
     let mut inradius = f64::INFINITY;
-    for f in &p.faces {
+    for ((f, n), o) in p.faces.iter().zip(normals.iter_mut()).zip(offsets.iter_mut()) {
         inradius = inradius.min(f.offset);
-        let n = rot * f.normal;
-        normals.push(n);
-        offsets.push(f.offset + n.dot(&pose.position));
+        *n = rot * f.normal;
+        *o = f.offset + n.dot(&pose.position);
     }
-    let e0 = edges.len();
-    edge_topology(p, scratch, edges);
-    for e in &edges[e0..] {
-        let (f0, f1) = (n0 + e.faces[0] as usize, n0 + e.faces[1] as usize);
-        arcs.push(normals[f1].cross(&normals[f0]));
+    for (e, arc) in edges.iter().zip(arcs.iter_mut()) {
+        *arc = normals[e.faces[1] as usize].cross(&normals[e.faces[0] as usize]);
     }
-    Bounds { lo, hi, radius, inradius }
+    Bounds { lo, hi, radius: radius2.sqrt(), inradius }
+}
+
+/// The edge topology ([`edge_topology`]) of each distinct set of face loops met, made once and kept: every
+/// polyhedron of a detection looks its loops up here instead of sorting its edges again (cuboids all share
+/// one entry). An entry is found by a hash of the loops and always checked against the loops themselves, so
+/// a shape dropped and another made at the same address cannot take a stale entry.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Topologies {
+    /// The loops of every entry, flattened: for each face its vertex count, then its vertices.
+    loops: Vec<u32>,
+    entries: Vec<Topology>,
+    /// Edges of every entry.
+    pub(crate) edges: Vec<Edge3>,
+    /// First entry of each hash; later ones are chained by [`Topology::next`].
+    index: std::collections::HashMap<u64, u32>,
+    scratch: Vec<(u32, u32, u32)>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Topology {
+    loops: (u32, u32),
+    edges: (u32, u32),
+    next: u32,
+}
+
+/// The most entries kept; beyond, the cache starts again (shapes that keep changing).
+const MAX_TOPOLOGIES: usize = 1 << 16;
+
+impl Topologies {
+    /// The entry of `p`'s face loops, trying `last` (an entry index from an earlier call) first.
+    pub(crate) fn entry(&mut self, p: &Polyhedron, last: u32) -> u32 {
+        if (last as usize) < self.entries.len() && self.matches(last, p) {
+            return last;
+        }
+        let mut h = 0xcbf2_9ce4_8422_2325u64;
+        let mut eat = |x: u32| h = (h ^ u64::from(x)).wrapping_mul(0x0100_0000_01b3);
+        for f in &p.faces {
+            eat(f.vertices.len() as u32);
+            f.vertices.iter().for_each(|&v| eat(v));
+        }
+        let mut k = self.index.get(&h).copied().unwrap_or(u32::MAX);
+        while k != u32::MAX {
+            if self.matches(k, p) {
+                return k;
+            }
+            k = self.entries[k as usize].next;
+        }
+        if self.entries.len() >= MAX_TOPOLOGIES {
+            self.loops.clear();
+            self.entries.clear();
+            self.edges.clear();
+            self.index.clear();
+        }
+        let (l0, e0) = (self.loops.len() as u32, self.edges.len() as u32);
+        for f in &p.faces {
+            self.loops.push(f.vertices.len() as u32);
+            self.loops.extend_from_slice(&f.vertices);
+        }
+        edge_topology(p, &mut self.scratch, &mut self.edges);
+        let k = self.entries.len() as u32;
+        let next = self.index.insert(h, k).unwrap_or(u32::MAX);
+        self.entries.push(Topology {
+            loops: (l0, self.loops.len() as u32),
+            edges: (e0, self.edges.len() as u32),
+            next,
+        });
+        k
+    }
+
+    /// Number of entries.
+    pub(crate) fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// The range of entry `k`'s edges in [`Self::edges`].
+    pub(crate) fn edges_of(&self, k: u32) -> (u32, u32) {
+        self.entries[k as usize].edges
+    }
+
+    fn matches(&self, k: u32, p: &Polyhedron) -> bool {
+        let (l0, l1) = self.entries[k as usize].loops;
+        let loops = &self.loops[l0 as usize..l1 as usize];
+        let mut at = 0;
+        for f in &p.faces {
+            let n = f.vertices.len();
+            if loops.len() < at + 1 + n || loops[at] as usize != n {
+                return false;
+            }
+            // Element by element: the loops are short, a call to `memcmp` costs more.
+            if loops[at + 1..at + 1 + n].iter().zip(&f.vertices).any(|(a, b)| a != b) {
+                return false;
+            }
+            at += 1 + n;
+        }
+        at == loops.len()
+    }
 }
 
 /// A polyhedron placed in the world with its own buffers.

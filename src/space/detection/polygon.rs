@@ -72,14 +72,20 @@ impl Frame {
 }
 
 impl Feature {
-    /// The feature of `view`: its lowest vertices along `f.n` when `lower` (the candidate), else its highest.
-    pub fn new(view: &PolyhedronView, f: &Frame, lower: bool, band: f64) -> Self {
+    /// An empty feature (to be filled by [`Self::fill`]).
+    fn empty() -> Self {
+        Feature { len: 0, id: [0; CAP], p: [Vec2::zeros(); CAP], h: [0.0; CAP], hull: [0; CAP], hull_len: 0, sign: 1.0 }
+    }
+
+    /// Makes this the feature of `view`: its lowest vertices along `f.n` when `lower` (the candidate), else
+    /// its highest. Only the first `len` entries of the arrays are written and read.
+    fn fill(&mut self, view: &PolyhedronView, f: &Frame, lower: bool, band: f64) {
         let sign = if lower { 1.0 } else { -1.0 };
         // Depth of a vertex below the extreme, counted into the shape.
         let depth = |v: &Vec3| sign * f.n.dot(&(v - f.o));
         let extreme = view.vertices.iter().map(depth).fold(f64::INFINITY, f64::min);
-        let mut s =
-            Feature { len: 0, id: [0; CAP], p: [Vec2::zeros(); CAP], h: [0.0; CAP], hull: [0; CAP], hull_len: 0, sign };
+        let s = self;
+        (s.len, s.hull_len, s.sign) = (0, 0, sign);
         for (k, v) in view.vertices.iter().enumerate() {
             let d = depth(v) - extreme;
             if d > band {
@@ -101,7 +107,6 @@ impl Feature {
             s.h[slot] = f.n.dot(&(v - f.o));
         }
         s.build_hull(f.eps);
-        s
     }
 
     /// Andrew's monotone chain; points within `eps` of a hull edge's line are dropped, so a hull of 1 or 2
@@ -207,6 +212,7 @@ fn segment_distance2(x: &Vec2, a: &Vec2, b: &Vec2) -> (f64, f64) {
 }
 
 /// A fixed-capacity list of 2D points.
+#[derive(Clone, Copy)]
 struct Points {
     p: [Vec2; CAP2],
     len: usize,
@@ -226,13 +232,13 @@ impl Points {
 }
 
 /// The convex intersection of the two hulls (polygon, segment or point, each within `eps`), as its vertices.
-fn intersect(a: &Feature, b: &Feature, eps: f64, out: &mut Points) {
+fn intersect(a: &Feature, b: &Feature, eps: f64, out: &mut Points, bufs: &mut [Points; 2]) {
     let (na, nb) = (a.hull_len, b.hull_len);
     if na == 0 || nb == 0 {
         return;
     }
     if na < nb {
-        return intersect(b, a, eps, out);
+        return intersect(b, a, eps, out, bufs);
     }
     match (na, nb) {
         (_, 1) => {
@@ -283,13 +289,13 @@ fn intersect(a: &Feature, b: &Feature, eps: f64, out: &mut Points) {
         }
         _ => {
             // Sutherland–Hodgman: a clipped by each edge of b, between two buffers in turn.
-            let mut bufs = [Points::new(), Points::new()];
+            (bufs[0].len, bufs[1].len) = (0, 0);
             for k in 0..na {
                 bufs[0].push(a.hp(k));
             }
             let mut c = 0;
             for k in 0..nb {
-                let [b0, b1] = &mut bufs;
+                let [b0, b1] = &mut *bufs;
                 let (cur, next) = if c == 0 { (&*b0, b1) } else { (&*b1, b0) };
                 let (u, v) = (b.hp(k), b.hp((k + 1) % nb));
                 let e = v - u;
@@ -361,6 +367,35 @@ struct Candidate {
     hb: f64,
 }
 
+/// The buffers of [`contact_points`], reused from one pair to the next (only the parts each step writes are
+/// read, so they are never cleared).
+#[derive(Clone)]
+pub struct Scratch {
+    fa: Feature,
+    fb: Feature,
+    pts: Points,
+    bufs: [Points; 2],
+    c: [Candidate; MAX_CANDIDATES],
+}
+
+impl Default for Scratch {
+    fn default() -> Self {
+        Scratch {
+            fa: Feature::empty(),
+            fb: Feature::empty(),
+            pts: Points::new(),
+            bufs: [Points::new(), Points::new()],
+            c: [Candidate { p: Vec2::zeros(), label: (3, 0, 0, 0, 0), ha: 0.0, hb: 0.0 }; MAX_CANDIDATES],
+        }
+    }
+}
+
+impl std::fmt::Debug for Scratch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Scratch")
+    }
+}
+
 /// The contact points of candidate `a` and antagonist `b` on the plane `f`: features within `band` of the
 /// plane, their intersection, candidates kept when their gap is at most `alert`, reduced to four; `witness`
 /// is the pair of points realising the separation, when known. Calls `emit(position, gap)` in label order;
@@ -372,14 +407,30 @@ pub fn contact_points(
     band: f64,
     alert: f64,
     witness: Option<(Vec3, Vec3)>,
+    emit: impl FnMut(Vec3, f64),
+) -> bool {
+    contact_points_in(&mut Scratch::default(), a, b, f, band, alert, witness, emit)
+}
+
+/// [`contact_points`] in the buffers `scratch`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn contact_points_in(
+    scratch: &mut Scratch,
+    a: &PolyhedronView,
+    b: &PolyhedronView,
+    f: &Frame,
+    band: f64,
+    alert: f64,
+    witness: Option<(Vec3, Vec3)>,
     mut emit: impl FnMut(Vec3, f64),
 ) -> bool {
-    let fa = Feature::new(a, f, true, band);
-    let fb = Feature::new(b, f, false, band);
+    let Scratch { fa, fb, pts, bufs, c } = scratch;
+    fa.fill(a, f, true, band);
+    fb.fill(b, f, false, band);
+    let (fa, fb) = (&*fa, &*fb);
     let eps = f.eps;
-    let mut pts = Points::new();
-    intersect(&fa, &fb, eps, &mut pts);
-    let mut c = [Candidate { p: Vec2::zeros(), label: (3, 0, 0, 0, 0), ha: 0.0, hb: 0.0 }; MAX_CANDIDATES];
+    pts.len = 0;
+    intersect(fa, fb, eps, pts, bufs);
     let mut len = 0;
     let mut add = |p: Vec2, hw: Option<(f64, f64)>, c: &mut [Candidate]| {
         if len == MAX_CANDIDATES || c[..len].iter().any(|q| (q.p - p).norm_squared() <= eps * eps) {
@@ -402,27 +453,27 @@ pub fn contact_points(
         len += 1;
     };
     for &p in &pts.p[..pts.len] {
-        add(p, None, &mut c);
+        add(p, None, c);
     }
     if pts.len > 0 {
         // Vertices inside their own hull (a feature that is not flat) inside the other's: the hull vertices
         // inside the other hull are already corners of the intersection.
-        for (s, o) in [(&fa, &fb), (&fb, &fa)] {
+        for (s, o) in [(fa, fb), (fb, fa)] {
             for k in 0..s.len {
                 if !s.hull[..s.hull_len].contains(&(k as u8)) && o.contains(&s.p[k], eps) {
-                    add(s.p[k], None, &mut c);
+                    add(s.p[k], None, c);
                 }
             }
         }
         if let Some((wa, wb)) = witness {
             let p = f.project(&(0.5 * (wa + wb)));
             if fa.contains(&p, eps) && fb.contains(&p, eps) {
-                add(p, Some((f.n.dot(&(wa - f.o)), f.n.dot(&(wb - f.o)))), &mut c);
+                add(p, Some((f.n.dot(&(wa - f.o)), f.n.dot(&(wb - f.o)))), c);
             }
         }
     } else if fa.hull_len > 0 && fb.hull_len > 0 {
         // Missed by rounding: one point half-way between the nearest points of the two hulls.
-        let (pa, pb) = nearest(&fa, &fb);
+        let (pa, pb) = nearest(fa, fb);
         let (ha, hb) = (a.entry(&f.lift(&pa), &f.n), b.exit(&f.lift(&pb), &f.n));
         if (ha - hb).is_finite() {
             c[0] = Candidate { p: 0.5 * (pa + pb), label: (3, 0, 0, 0, 0), ha, hb };
