@@ -7,9 +7,9 @@
 //! `quad`
 //! policy, θ = 1/2, dt 2e-4 s, μ 0.8 between grains and with the walls; the grains start on a lattice with a
 //! random orientation each, 5 cm cells, and fall). Prints a line every 50 steps (time, contacts, sweeps,
-//! steps at the cap, the ms per step of detection and solve) and the totals. With THREADS 2 the contact solve
-//! (problems of at least 512 rows) sweeps its two halves side by side (the numbers are those of one thread); the
-//! team's record is printed.
+//! steps at the cap, the ms per step of detection and solve) and the totals. With THREADS 2 the detection shares
+//! its pairs between two threads and the contact solve (problems of at least 512 rows) sweeps its two halves side
+//! by side (the numbers are those of one thread); the teams' records are printed.
 
 use ballast::geometry::{Pose, Solid, Vec3};
 use ballast::nscd::contact::ContactLaw;
@@ -95,6 +95,10 @@ fn main() -> ballast::Result<()> {
     );
     // The final state's fingerprint: equal on one thread and two.
     let fingerprint = sys.bodies.pose.iter().map(|p| p.position.x + p.position.y + p.position.z).sum::<f64>();
-    println!("threads {threads}: team {:?}; sum of centroid coordinates {fingerprint:.17e}", sys.team_stats());
+    println!(
+        "threads {threads}: solve's team {:?}; detection's team {:?}; sum of centroid coordinates {fingerprint:.17e}",
+        sys.team_stats(),
+        sys.detection_team_stats()
+    );
     Ok(())
 }

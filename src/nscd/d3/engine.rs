@@ -20,7 +20,8 @@
 //!   construction, renormalised) and refuses a non-finite value, a fixed or unknown body, naming it.
 //! - **Threads**: the contact solve of a problem of at least `nscd.split_min_rows` rows (default 512) is the
 //!   shared domain split (two halves along x swept side by side, then the interface), on two threads when asked;
-//!   the numbers do not depend on the count. The detection runs on one thread.
+//!   the detection's narrow phase shares the pairs between the two threads; the numbers do not depend on the
+//!   count.
 //! - **Coordination**: [`super::measure::coordination`] — per mobile body, the bodies (mobile or fixed) it
 //!   touches with a total normal force `Σ r_n > 0` over the pair's contact points of the last step (a pair
 //!   counts once); the mean over the mobile bodies that have at least two (rattlers excluded), 0 if none has.

@@ -205,16 +205,22 @@ impl System3 {
         }
     }
 
-    /// The threads of the contact solve: problems of at least `nlgs.split_min_rows` rows are split in two halves
-    /// along x swept side by side ([`crate::nscd::method::split`]), on two threads when `threads ≥ 2`; the
-    /// order of the updates does not depend on the count, so neither do the numbers.
+    /// The threads of the step, 1 or 2: the detection's narrow phase shares the pairs between two threads
+    /// ([`crate::space::detection`]), and problems of at least `nlgs.split_min_rows` rows are split in two halves
+    /// along x swept side by side ([`crate::nscd::method::split`]); neither changes the numbers.
     pub fn set_threads(&mut self, threads: usize) {
         self.threads = threads;
+        self.detector.set_threads(threads);
     }
 
     /// What the split solve's two-thread team did so far (joins side by side, taken back, in turn).
     pub fn team_stats(&self) -> crate::team::TeamStats {
         self.split.team_stats()
+    }
+
+    /// What the detection's two-thread team did so far.
+    pub fn detection_team_stats(&self) -> crate::team::TeamStats {
+        self.detector.team_stats()
     }
 
     /// Sets the law between materials `i` and `j` (both ways).
@@ -617,7 +623,7 @@ impl System3 {
         }
         self.memory.clear();
         self.contacts.clear();
-        self.detector = Detector::default();
+        self.detector = Detector::with_threads(self.threads);
         Ok(())
     }
 }
