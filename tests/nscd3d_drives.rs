@@ -276,7 +276,8 @@ fn the_sleeper_example_balances_vertical_momentum() {
 }
 
 /// The example run by the run loop straight, and stopped after 70 steps then resumed: the same bytes in every
-/// file (the springs' impulses are part of the checkpoint), and the cycle rows of the sleeper (two cycles).
+/// file (the springs' impulses are part of the checkpoint), the cycle rows of the sleeper (two cycles), and the
+/// run's figures drawn from its folder.
 #[test]
 fn the_sleeper_example_runs_stops_and_resumes_to_the_same_bytes() {
     use ballast::open::open;
@@ -306,5 +307,15 @@ fn the_sleeper_example_runs_stops_and_resumes_to_the_same_bytes() {
     }
     let cycles = std::fs::read_to_string(whole.join("cycles.csv")).unwrap();
     assert_eq!(cycles.lines().count(), 3, "a header and two cycles:\n{cycles}");
+    // The figures of a 3D run, from its folder alone.
+    let drawn = ballast::report::draw_run_figures(&whole).unwrap();
+    let stems: Vec<String> =
+        drawn.written.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    assert_eq!(stems, ["energies", "overlaps", "settlement_cycles", "vertical_cut"], "{drawn:?}");
+    for stem in &drawn.written {
+        for ext in ["png", "svg"] {
+            assert!(stem.with_extension(ext).metadata().unwrap().len() > 1000, "{stem:?}.{ext}");
+        }
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -2,11 +2,13 @@
 //! --figures` at the end of a run, the studies), each as `<stem>.png` + `<stem>.svg` in the folder: the top of
 //! the crate, above the engines, the run loop and the settlement driver, whose files it reads.
 //! [`draw_run_figures`] dispatches on the folder: an accelerated run (a folder with `settlement.csv`,
-//! [`settlement`]), else the engine `final.json` names ([`plane`]: NSCD and planar MD; [`md`]: 3D MD).
+//! [`settlement`]), else the engine `final.json` names ([`plane`]: NSCD and planar MD; [`md`]: 3D MD; [`d3`]:
+//! 3D NSCD).
 //!
 //! A figure whose data the folder does not hold (no cycles, an older run without `contacts.csv`) is skipped
 //! and said so in [`RunFigures::skipped`].
 
+pub mod d3;
 pub mod md;
 pub mod plane;
 pub mod settlement;
@@ -58,11 +60,7 @@ pub fn draw_run_figures(dir: &Path) -> Result<RunFigures> {
     match fin.engine.as_str() {
         "nscd" | "md2d" => plane::nscd_figures(dir, None),
         "md" => md::md_figures(dir),
-        "nscd3d" => Err(Error::Scene(format!(
-            "{}: figures of 3D NSCD runs are not built yet (the run's files are: series.csv, contacts.csv, the .vtp \
-             snapshots for ParaView)",
-            dir.display()
-        ))),
+        "nscd3d" => d3::nscd3d_figures(dir),
         other => Err(Error::Scene(format!("{}: unknown engine '{other}'", dir.join(layout::FINAL).display()))),
     }
 }

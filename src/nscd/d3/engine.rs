@@ -18,8 +18,9 @@
 //!   first three only (`EXTRAPOLATED = 3`: a polyhedron turns by rolling events, not by a creep a law can follow,
 //!   as in 2D). [`Engine::set_configuration`] builds the quaternion from the rotation vector (unit by
 //!   construction, renormalised) and refuses a non-finite value, a fixed or unknown body, naming it.
-//! - **Threads**: one. [`Engine::set_threads`] accepts any count and changes nothing: the 3D step has no split
-//!   solve yet, and the numbers would not depend on it.
+//! - **Threads**: the contact solve of a problem of at least `nscd.split_min_rows` rows (default 512) is the
+//!   shared domain split (two halves along x swept side by side, then the interface), on two threads when asked;
+//!   the numbers do not depend on the count. The detection runs on one thread.
 //! - **Coordination**: [`super::measure::coordination`] — per mobile body, the bodies (mobile or fixed) it
 //!   touches with a total normal force `Σ r_n > 0` over the pair's contact points of the last step (a pair
 //!   counts once); the mean over the mobile bodies that have at least two (rattlers excluded), 0 if none has.
@@ -27,11 +28,9 @@
 //! - **Potential energy** (when the equilibrium rule asks): `−Σ m g · x` over the mobile bodies.
 //! - **Body sizes**: the radius of the sphere of the body's volume, `(3V/4π)^(1/3)` — the 3D analogue of the
 //!   2D engines' `√(A/π)` and the MD engine's sphere radius, the contract's scale; infinite for a half-space.
-//! - **Relaxation**: not built for the 3D engine. [`Engine::relax`] returns [`Error::Scene`] saying so and
-//!   leaves the system unchanged: a settlement driver that reaches a landing stops there with that message,
-//!   rather than landing on an unrelaxed configuration. The 2D engines' mass-metric projection
-//!   ([`crate::plane::relax`]) carries over (rotation variables in the principal frame, the normal rows of
-//!   [`super::contact::gen_dir`] as the gaps' gradients), but it is not written nor tested yet.
+//! - **Relaxation**: the 2D engines' mass-metric projection carried over to 3D ([`crate::space::relax`]: the
+//!   centroids and rotation vectors in the principal frames, the moments of inertia as their masses, the gaps'
+//!   gradients through SO(3)'s right Jacobian), written back by [`System3::place`].
 
 use super::measure::{self, Coordination};
 use super::rows::{CycleRow3, CycleState3, SeriesRow3, CYCLE3_COLUMNS, SERIES3_COLUMNS};
@@ -78,12 +77,9 @@ impl Engine for System3 {
         self.params.dt
     }
 
-    /// One thread whatever is asked (module doc).
-    fn set_threads(&mut self, _threads: usize) {}
-
-    /// One: the 3D step has no two-thread path yet, so the run's summary says one whatever was asked.
-    fn threads_used(&self, _asked: usize) -> usize {
-        1
+    /// The split contact solve's threads (module doc).
+    fn set_threads(&mut self, threads: usize) {
+        System3::set_threads(self, threads);
     }
 
     fn body_count(&self) -> usize {
@@ -286,17 +282,19 @@ impl Engine for System3 {
         self.place(&c.bodies, &x, &rotations)
     }
 
-    /// Not built for the 3D engine (module doc): an [`Error::Scene`] saying so; the system is unchanged.
     fn anchored_bodies(&self) -> Vec<usize> {
         crate::space::springs::anchored(&self.springs)
     }
 
+    /// The mass-metric projection of [`crate::space::relax`], written back as a configuration (velocities
+    /// zeroed, imposed components at their values now, contact memory forgotten).
     fn relax(&mut self, settings: &RelaxSettings) -> Result<RelaxReport> {
-        settings.check()?;
-        Err(Error::Scene(
-            "relaxation: not built for the 3D NSCD engine (a settlement driver cannot land a jump on it yet; run \
-             its cycles computed)"
-                .into(),
-        ))
+        let (report, poses) = crate::space::relax::project(&self.bodies, settings)?;
+        let bodies = self.mobile_bodies();
+        let x: Vec<Vec3> = bodies.iter().map(|&i| poses[i].position).collect();
+        let rotations: Vec<nalgebra::Quaternion<f64>> =
+            bodies.iter().map(|&i| poses[i].rotation.into_inner()).collect();
+        self.place(&bodies, &x, &rotations)?;
+        Ok(report)
     }
 }

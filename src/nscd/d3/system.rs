@@ -28,7 +28,8 @@ use super::contact::ContactRow3;
 use super::spring::SpringRow3;
 use crate::geometry::{Pose, Vec3};
 use crate::nscd::contact::ContactLaw;
-use crate::nscd::method::{apply_impulses, solve_nlgs, NlgsReport, NlgsSettings};
+use crate::nscd::method::split::SplitWorkspace;
+use crate::nscd::method::{apply_impulses, solve_nlgs_split, NlgsReport, NlgsSettings};
 use crate::space::bodies::{advance, Bodies, Dofs6};
 use crate::space::detection::Detector;
 use crate::space::loads::LoadKind;
@@ -168,6 +169,12 @@ pub struct System3 {
     mobile: Vec<bool>,
     #[serde(skip)]
     spring_rows: Vec<SpringRow3>,
+    /// The domain-split solve's buffers and two-thread team ([`crate::nscd::method::split`]).
+    #[serde(skip)]
+    split: SplitWorkspace<ContactRow3, SpringRow3>,
+    /// Threads of the split solve (0 or 1: one); not part of the state (the numbers do not depend on it).
+    #[serde(skip)]
+    threads: usize,
 }
 
 impl System3 {
@@ -193,7 +200,21 @@ impl System3 {
             u: Vec::new(),
             mobile: Vec::new(),
             spring_rows: Vec::new(),
+            split: SplitWorkspace::default(),
+            threads: 1,
         }
+    }
+
+    /// The threads of the contact solve: problems of at least `nlgs.split_min_rows` rows are split in two halves
+    /// along x swept side by side ([`crate::nscd::method::split`]), on two threads when `threads ≥ 2`; the
+    /// order of the updates does not depend on the count, so neither do the numbers.
+    pub fn set_threads(&mut self, threads: usize) {
+        self.threads = threads;
+    }
+
+    /// What the split solve's two-thread team did so far (joins side by side, taken back, in turn).
+    pub fn team_stats(&self) -> crate::team::TeamStats {
+        self.split.team_stats()
     }
 
     /// Sets the law between materials `i` and `j` (both ways).
@@ -347,8 +368,17 @@ impl System3 {
             self.spring_rows.push(SpringRow3::new(s, start, &self.poses_m, &self.bodies.inv_m, h, theta));
         }
         apply_impulses(&mut self.u, &self.bodies.inv_m, &self.rows, &self.spring_rows);
-        let report =
-            solve_nlgs(&self.params.nlgs, &mut self.u, &self.bodies.inv_m, &mut self.rows, &mut self.spring_rows);
+        let poses_m = &self.poses_m;
+        let report = solve_nlgs_split(
+            &self.params.nlgs,
+            &mut self.split,
+            self.threads,
+            |i| poses_m[i].position.x,
+            &mut self.u,
+            &self.bodies.inv_m,
+            &mut self.rows,
+            &mut self.spring_rows,
+        );
         let solve_seconds = clock.elapsed().as_secs_f64();
         // 4. Update, checked before it is kept.
         for i in 0..n {
