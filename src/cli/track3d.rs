@@ -59,31 +59,35 @@ pub enum Track3dCommand {
         loading: LoadingArgs,
     },
     /// Loads a deposited sample and runs the cycles: the sleeper's settlement per cycle (cycles.csv),
-    /// series.csv, summary.json, VTK snapshots; with --accelerate, through the settlement driver.
-    Settle {
-        /// A deposited sample (`sample.toml` of `ballast track3d sample`).
-        #[arg(long, value_name = "FILE")]
-        sample: PathBuf,
-        /// Output directory (the loaded scene is written there as `loaded.toml`).
-        #[arg(long, value_name = "DIR")]
-        out: PathBuf,
-        #[command(flatten)]
-        loading: LoadingArgs,
-        /// VTK snapshot (bodies and contacts) every this many cycles; 0: none.
-        #[arg(long, value_name = "CYCLES", default_value_t = 10)]
-        snapshot_every: u64,
-        /// Wall-clock seconds between checkpoints.
-        #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
-        checkpoint_every: f64,
-        /// Continue a killed run from its checkpoint.
-        #[arg(long)]
-        resume: bool,
-        #[command(flatten)]
-        accelerate: AccelerateArgs,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-    },
+    /// series.csv, summary.json, VTK snapshots, figures; with --accelerate, through the settlement driver.
+    Settle(Box<SettleArgs>),
+}
+
+/// The arguments of `track3d settle`.
+#[derive(Debug, clap::Args)]
+pub struct SettleArgs {
+    /// A deposited sample (`sample.toml` of `ballast track3d sample`).
+    #[arg(long, value_name = "FILE")]
+    sample: PathBuf,
+    /// Output directory (the loaded scene is written there as `loaded.toml`).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    #[command(flatten)]
+    loading: LoadingArgs,
+    /// VTK snapshot (bodies and contacts) every this many cycles; 0: none.
+    #[arg(long, value_name = "CYCLES", default_value_t = 10)]
+    snapshot_every: u64,
+    /// Wall-clock seconds between checkpoints.
+    #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
+    checkpoint_every: f64,
+    /// Continue a killed run from its checkpoint.
+    #[arg(long)]
+    resume: bool,
+    #[command(flatten)]
+    accelerate: AccelerateArgs,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// Settings of the loaded stage.
@@ -216,16 +220,9 @@ pub fn main(cmd: Track3dCommand) -> Result<(), Failure> {
             track3d::load(&sample, &loading.loading(), &out).map_err(as_flag)?;
             println!("wrote {}", out.display());
         }
-        Track3dCommand::Settle {
-            sample,
-            out,
-            loading,
-            snapshot_every,
-            checkpoint_every,
-            resume,
-            accelerate,
-            quiet,
-        } => {
+        Track3dCommand::Settle(args) => {
+            let SettleArgs { sample, out, loading, snapshot_every, checkpoint_every, resume, accelerate, quiet } =
+                *args;
             let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume };
             let loading = loading.loading();
             if let Some(acc) = accelerate.accelerate()? {

@@ -10,17 +10,18 @@
 //! - [`settle`] (§4): load a sample and run its cycles: `cycles.csv` (settlement per cycle), `series.csv`,
 //!   `summary.json`, VTK snapshots every few cycles;
 //! - [`settle_accelerated`]: the same loaded scene through the settlement driver (Karrech et al. 2007, Fig. 10),
-//!   as the 2D [`super::saussine::settle_accelerated`]. The driver lands its jumps with `Engine::relax`, which the
-//!   3D NSCD engine does not have yet: until it does the run stops at the first landing with "relaxation: not
-//!   built for the 3D NSCD engine".
+//!   as the 2D [`super::saussine::settle_accelerated`]; its jumps land through the 3D engine's relaxation
+//!   (`crate::space::relax`).
 //!
-//! The 3D engine runs on one thread (it has no split solve), and has no figures yet: the runs write none.
+//! The runs go on [`crate::run::default_threads`] threads (the 3D contact solve splits in two halves on two; the
+//! numbers do not depend on it) and end with the 3D figures (`crate::report`: energies, overlaps, settlement per
+//! cycle, a vertical cut with the force chains).
 
 use super::{output_error, run_scene, write_file, Accelerate, RunDisplay};
 use crate::error::Result;
 use crate::io;
 use crate::io::layout;
-use crate::run::{Prior, RunOptions, RunOutcome};
+use crate::run::{default_threads, Prior, RunOptions, RunOutcome};
 use crate::scenarios::track3d::{loaded_scene, measure_sample, sample_scene, LoadingSpec, SampleReport, SampleSpec};
 use crate::scene::{Scene3, SceneFile};
 use std::path::{Path, PathBuf};
@@ -66,7 +67,7 @@ pub fn sample(spec: &SampleSpec, out: &Path, resume: bool, display: &dyn RunDisp
         let opts = RunOptions {
             checkpoint_every_s: 300.0,
             resume: prior == Prior::Checkpointed,
-            threads: 1,
+            threads: default_threads(),
             ..RunOptions::default()
         };
         run_scene(&deposit, &dir, &opts, display, &format!("sample {}", spec.seed))?;
@@ -128,7 +129,7 @@ fn write_loaded(sample: &Path, scene: &Scene3, out: &Path, resume: bool, what: &
 
 /// §4 in 3D: loads the sample at `sample` and runs its cycles in `out` (the loaded scene written there as
 /// `loaded.toml`): `cycles.csv` (the sleeper's settlement per cycle), `series.csv`, `summary.json`,
-/// `final.json`, VTK snapshots every `opts.snapshot_every` cycles, checkpoints. The run is labelled `settle`.
+/// `final.json`, VTK snapshots every `opts.snapshot_every` cycles, checkpoints, figures. The run is labelled `settle`.
 ///
 /// # Errors
 /// [`crate::Error::Scene`] for an unreadable sample, an invalid loading or checkpoint; else as
@@ -147,7 +148,8 @@ pub fn settle(
         checkpoint_every_s: opts.checkpoint_every_s,
         resume: opts.resume,
         vtk_every: opts.snapshot_every.saturating_mul(per_cycle),
-        threads: 1,
+        figures: true,
+        threads: default_threads(),
         ..RunOptions::default()
     };
     run_scene(&path, out, &run, display, "settle")
@@ -156,12 +158,11 @@ pub fn settle(
 /// §4 accelerated: [`settle`]'s loaded scene with the `[settlement]` table of `accelerate` (the sleeper as the
 /// settlement body; the relaxation's tolerance by default 1 % of the smallest grain's inradius, as in 2D)
 /// written as `OUT/loaded.toml` and run through [`crate::open::settle_file`]: `settlement.csv`, `jumps.csv`,
-/// `summary.json`.
+/// `summary.json`, the settlement figures.
 ///
 /// # Errors
 /// [`crate::Error::Scene`] for an unreadable sample, an invalid loading or settings; else as
-/// [`crate::settlement::Accelerated::run`] — on this engine, until `System3::relax` is built, the first landing's
-/// "relaxation: not built for the 3D NSCD engine".
+/// [`crate::settlement::Accelerated::run`].
 pub fn settle_accelerated(
     sample: &Path,
     loading: &LoadingSpec,
@@ -183,7 +184,8 @@ pub fn settle_accelerated(
     let run = RunOptions {
         checkpoint_every_s: opts.checkpoint_every_s,
         resume: opts.resume,
-        threads: 1,
+        figures: true,
+        threads: default_threads(),
         ..RunOptions::default()
     };
     accelerate.run_scene(&path, out, &run, progress)

@@ -84,6 +84,10 @@ pub const FRAME: &str = "frame";
 /// Gap (m) between the grains' turned boxes at the start, and between them and the walls.
 pub const CLEARANCE: f64 = 0.002;
 
+/// Mixed into the seed of the grains' orientations, so that they are not drawn from the grains' own stream
+/// ("track3d" in ASCII).
+const ORIENTATIONS: u64 = 0x0074_7261_636b_3364;
+
 /// Sublayer stiffness per unit area (N/m³) carried over from the 2D paper's pads: `4100 / 0.01 / (0.02 × 1)`.
 pub const STIFFNESS_PER_AREA: f64 = 4100.0 / 0.01 / 0.02;
 /// Sublayer damping per unit area (N·s/m³) carried over from the 2D paper's pads: `80 / 0.01 / (0.02 × 1)`.
@@ -326,7 +330,7 @@ pub fn sample_scene(spec: &SampleSpec) -> Result<Scene3> {
 
     // Grains: each turned at random, laid by its turned hull's axis-aligned box in rows along x, rows side by
     // side along y, layers up z, the boxes CLEARANCE apart.
-    let mut rng = ChaCha8Rng::seed_from_u64(spec.seed ^ 0x7472_6163_6b33_64);
+    let mut rng = ChaCha8Rng::seed_from_u64(spec.seed ^ ORIENTATIONS);
     let c = CLEARANCE;
     let (mut x, mut y, mut z) = (-hl + c, -hw + c, c);
     let (mut row_depth, mut layer_height) = (0.0f64, 0.0f64);
