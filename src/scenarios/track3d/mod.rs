@@ -16,7 +16,8 @@
 //!   `x = y = 0`; the pads' top faces are at `z = 0` at the start.
 //! - **Section** ([`SampleSpec::track`]): 2 000 grains in a box 0.6 m along the track (one sleeper spacing) by
 //!   0.4 m across (a slice of the sleeper's length under a rail seat). With the grains' mean hull volume
-//!   (≈ 1.3e-5 m³) this is a layer of about 0.18 m at a solid fraction of 0.6. [`SampleSpec::scaled`] keeps the
+//!   (1.17e-5 m³) this is a layer of about 0.2 m (0.21 m at the whole-layer solid fraction of 0.46 measured on
+//!   the 200-grain section). [`SampleSpec::scaled`] keeps the
 //!   layer's thickness for `n` grains: the box's area scaled by `n / 2000` at the same aspect ratio, each side at
 //!   least [`SampleSpec::min_side`] (one largest grain and its clearance).
 //! - **Grains**: [`super::grains3d`] with its defaults — hulls of 12–30 points on random ellipsoids, sieve sizes
@@ -25,9 +26,9 @@
 //!   the pads and the sleeper (the paper's), restitution 0 (the paper's, "dense granular packing").
 //! - **Loose start**: the grains, in the drawn (random) order and each turned by a uniformly random rotation,
 //!   are laid in rows along `x`, rows side by side along `y`, layers up `z`, each by the axis-aligned box of its
-//!   turned hull, the boxes [`CLEARANCE`] apart and from the walls (the 2D generator's rows in 3D; a lattice of
-//!   the largest grain's bounding sphere stood about four times as tall as the layer, these rows about twice).
-//!   They start at rest.
+//!   turned hull, the boxes [`CLEARANCE`] apart and from the walls (the 2D generator's rows in 3D, tighter than a
+//!   lattice of the largest grain's bounding sphere). They start at rest. The default section's loose column
+//!   stands 0.93 m high (seed 1), about five times the deposited layer: its top grains land at about 4 m/s.
 //! - **Walls**: four fixed half-spaces through the box's sides, frictionless ("frame", μ = 0 with everything):
 //!   the sublayer alone carries the weight (no Janssen share on the walls, as the 2D sample's smooth side walls;
 //!   the test checks the balance), and the walls stand for the rest of the track, not for a rough mould.
@@ -40,7 +41,7 @@
 //!   there a 20 mm pad per 1 m of depth (0.02 m²) carries `k_N` = 4100 N per unit strain and `ν` = 80 N·s on
 //!   a spring of rest length 10 mm, i.e. `k = k_N / L0 / area` = 2.05e7 N/m³ (Pa per metre of compression) and
 //!   `c = ν / L0 / area` = 4.0e5 N·s/m³. A 3D pad of top area `a` gets `k_N = k a L0` and `ν = c a L0`. Under
-//!   the default layer (≈ 2.9 kPa) the pads sink ≈ 0.14 mm (1.4 % strain).
+//!   the default layer (≈ 2.6 kPa) the pads sink ≈ 0.13 mm (1.3 % strain).
 //! - **Deposit**: dt = 2e-4 s (the 2D sample's), θ = 1/2, `quad` 1e-4 with at most 2 000 sweeps (the setting
 //!   of the 200-grain deposit of BENCHMARKS.md; [`SampleSpec::tolerance`], [`SampleSpec::max_iterations`]),
 //!   alert distance 1 mm; it ends at equilibrium, when the kinetic
