@@ -313,8 +313,9 @@ fn bad_flags_are_named_on_one_line() {
     let sample = s.path.to_str().unwrap();
     let out = dir.join("x.toml");
     let out = out.to_str().unwrap();
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 6] = [
         (&["track3d", "sample", "--grains", "0", "--out", out], "--grains:"),
+        (&["track3d", "sample", "--grains", "10", "--tolerance", "2", "--out", out], "--tolerance:"),
         (&["track3d", "sample", "--grains", "10", "--dt=-1", "--out", out], "--dt:"),
         (&["track3d", "load", "--sample", sample, "--out", out, "--cycles", "0"], "--cycles:"),
         (&["track3d", "load", "--sample", sample, "--out", out, "--sleeper-width", "3"], "--sleeper-width:"),

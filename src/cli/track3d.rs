@@ -36,6 +36,12 @@ pub enum Track3dCommand {
         /// Longest deposit (s); it ends earlier at equilibrium.
         #[arg(long, default_value_t = SampleSpec::default().max_duration)]
         max_duration: f64,
+        /// Tolerance of the deposit's solver (`quad` policy).
+        #[arg(long, default_value_t = SampleSpec::default().tolerance)]
+        tolerance: f64,
+        /// Most solver sweeps per step of the deposit.
+        #[arg(long, default_value_t = SampleSpec::default().max_iterations)]
+        max_iterations: usize,
         /// Output directory.
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
@@ -152,7 +158,7 @@ impl LoadingArgs {
 
 /// The spec fields of this command's library calls and their flags (the shared ones, `dt`, `cycles`, …, are
 /// mapped by `flags.rs` too).
-const FLAGS: [(&str, &str); 14] = [
+const FLAGS: [(&str, &str); 15] = [
     ("grains", "--grains"),
     ("dt", "--dt"),
     ("max_duration", "--max-duration"),
@@ -160,6 +166,7 @@ const FLAGS: [(&str, &str); 14] = [
     ("criterion", "--criterion"),
     ("tolerance", "--tolerance"),
     ("min_iterations", "--min-iterations"),
+    ("max_iterations", "--max-iterations"),
     ("sleeper_width", "--sleeper-width"),
     ("sleeper_length", "--sleeper-length"),
     ("mean_pressure", "--mean-pressure"),
@@ -208,11 +215,12 @@ fn print_sample(s: &Sample) {
 
 pub fn main(cmd: Track3dCommand) -> Result<(), Failure> {
     match cmd {
-        Track3dCommand::Sample { seed, grains, dt, max_duration, out, resume, quiet } => {
+        Track3dCommand::Sample { seed, grains, dt, max_duration, tolerance, max_iterations, out, resume, quiet } => {
             if grains == 0 {
                 return Err(input("--grains: must be at least 1, got 0".into()));
             }
-            let spec = SampleSpec { dt, max_duration, ..SampleSpec::track(seed).scaled(grains) };
+            let spec =
+                SampleSpec { dt, max_duration, tolerance, max_iterations, ..SampleSpec::track(seed).scaled(grains) };
             let sample = track3d::sample(&spec, &out, resume, &Bars::single(quiet)).map_err(as_flag)?;
             print_sample(&sample);
         }

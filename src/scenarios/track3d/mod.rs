@@ -17,9 +17,9 @@
 //! - **Section** ([`SampleSpec::track`]): 2 000 grains in a box 0.6 m along the track (one sleeper spacing) by
 //!   0.4 m across (a slice of the sleeper's length under a rail seat). With the grains' mean hull volume
 //!   (1.17e-5 m³) this is a layer of about 0.2 m (0.21 m at the whole-layer solid fraction of 0.46 measured on
-//!   the 200-grain section). [`SampleSpec::scaled`] keeps the
-//!   layer's thickness for `n` grains: the box's area scaled by `n / 2000` at the same aspect ratio, each side at
-//!   least [`SampleSpec::min_side`] (one largest grain and its clearance).
+//!   the 200-grain section). [`SampleSpec::scaled`] keeps the layer's thickness for `n` grains: the box's area
+//!   scaled by `n / 2000` at the same aspect ratio, each side at least [`SampleSpec::min_side`] (one longest
+//!   grain and its clearance).
 //! - **Grains**: [`super::grains3d`] with its defaults — hulls of 12–30 points on random ellipsoids, sieve sizes
 //!   25–50 mm uniform by mass, elongation ≤ 1.5, flatness ≥ 0.6 —, seeded by [`SampleSpec::seed`]; density
 //!   2700 kg/m³ (granite; the 2D paper's 2367 kg/m³ is its cement prisms), friction μ = 0.5 with each other,
@@ -44,10 +44,9 @@
 //!   the default layer (≈ 2.6 kPa) the pads sink ≈ 0.13 mm (1.3 % strain).
 //! - **Deposit**: dt = 2e-4 s (the 2D sample's), θ = 1/2, `quad` 1e-4 with at most 2 000 sweeps (the setting
 //!   of the 200-grain deposit of BENCHMARKS.md; [`SampleSpec::tolerance`], [`SampleSpec::max_iterations`]),
-//!   alert distance 1 mm; it ends at equilibrium, when the kinetic
-//!   energy of the mobile bodies has stayed below [`SampleSpec::rest_energy`] = 1e-10 J per grain (an rms speed
-//!   of about 7e-5 m/s for a 40 g grain) for [`SampleSpec::rest_steps`] = 500 steps (0.1 s), or after
-//!   [`SampleSpec::max_duration`] = 3 s.
+//!   alert distance 1 mm; it ends at equilibrium, when the kinetic energy of the mobile bodies has stayed below
+//!   [`SampleSpec::rest_energy`] = 1e-10 J per grain (an rms speed of 8e-5 m/s for the mean grain, 32 g) for
+//!   [`SampleSpec::rest_steps`] = 500 steps (0.1 s), or after [`SampleSpec::max_duration`] = 3 s.
 
 mod loading;
 mod measure;
