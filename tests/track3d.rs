@@ -237,6 +237,27 @@ fn settle_two_cycles_writes_two_rows_of_positive_settlement() {
     assert!(out.join("loaded.toml").exists() && out.join("summary.json").exists());
 }
 
+/// A settle run killed mid-way (a checkpoint left at step 60 of 100) and continued with `resume` writes the
+/// cycles of the run made straight, byte for byte.
+#[test]
+fn a_stopped_settle_resumes_to_the_same_cycles() {
+    let (dir, s) = sample();
+    let spec = LoadingSpec { cycles: 2, dt: LOAD_DT, ..LoadingSpec::default() };
+    let opts = SettleOptions { snapshot_every: 0, checkpoint_every_s: 0.0, resume: false };
+    let straight = dir.join("straight");
+    study::settle(&s.path, &spec, &straight, &opts, &Quiet).unwrap();
+    let resumed = dir.join("resumed");
+    std::fs::create_dir_all(&resumed).unwrap();
+    study::load(&s.path, &spec, &resumed.join("loaded.toml")).unwrap();
+    let stop = ballast::run::RunOptions { stop_after: Some(60), checkpoint_every_s: 0.0, ..Default::default() };
+    let loaded = ballast::open::open(&resumed.join("loaded.toml"), &stop).unwrap();
+    loaded.run(&resumed, &stop, &mut |_| {}).unwrap();
+    assert!(resumed.join("checkpoint.json").exists());
+    study::settle(&s.path, &spec, &resumed, &SettleOptions { resume: true, ..opts }, &Quiet).unwrap();
+    let cycles = |d: &std::path::Path| std::fs::read(d.join("cycles.csv")).unwrap();
+    assert_eq!(cycles(&straight), cycles(&resumed));
+}
+
 fn accelerate() -> Accelerate {
     Accelerate {
         cycles: [1, 2, 2],
