@@ -26,7 +26,7 @@ const LOAD_DT: f64 = 1e-3;
 
 /// The sample: 24 grains (seed 3) in a 0.12 × 0.1 m box on 4 × 3 pads of 25 mm (the full section's rules on a
 /// box two grains deep), deposited once into a scratch folder; for a test of seconds, dt = 5e-4 s, `quad` 1e-3
-/// and a 100-step rest window (the defaults: 2e-4 s, 1e-4, 500 steps).
+/// and a 100-step rest window (the defaults: 2e-4 s, 1e-3, 500 steps).
 fn sample() -> &'static (PathBuf, Sample) {
     static SAMPLE: OnceLock<(PathBuf, Sample)> = OnceLock::new();
     SAMPLE.get_or_init(|| {

@@ -42,11 +42,15 @@
 //!   a spring of rest length 10 mm, i.e. `k = k_N / L0 / area` = 2.05e7 N/m³ (Pa per metre of compression) and
 //!   `c = ν / L0 / area` = 4.0e5 N·s/m³. A 3D pad of top area `a` gets `k_N = k a L0` and `ν = c a L0`. Under
 //!   the default layer (≈ 2.6 kPa) the pads sink ≈ 0.13 mm (1.3 % strain).
-//! - **Deposit**: dt = 2e-4 s (the 2D sample's), θ = 1/2, `quad` 1e-4 with at most 2 000 sweeps (the setting
-//!   of the 200-grain deposit of BENCHMARKS.md; [`SampleSpec::tolerance`], [`SampleSpec::max_iterations`]),
-//!   alert distance 1 mm; it ends at equilibrium, when the kinetic energy of the mobile bodies has stayed below
-//!   [`SampleSpec::rest_energy`] = 1e-10 J per grain (an rms speed of 8e-5 m/s for the mean grain, 32 g) for
-//!   [`SampleSpec::rest_steps`] = 500 steps (0.1 s), or after [`SampleSpec::max_duration`] = 3 s.
+//! - **Deposit**: dt = 2e-4 s (the 2D sample's), θ = 1/2, `quad` **1e-3** with at most 2 000 sweeps
+//!   ([`SampleSpec::tolerance`], [`SampleSpec::max_iterations`]), alert distance 1 mm. Measured on the 200-grain
+//!   section (seed 1): `quad` 1e-4 made 256 sweeps per step with 194 steps at the cap, 7 395 steps to rest;
+//!   1e-3 made 50 sweeps per step, none at the cap, 5 920 steps, and the same layer (213 vs 211 mm high, solid
+//!   fraction 0.455 vs 0.461, coordination 4.41 vs 4.51) with half the largest overlap (0.23 vs 0.43 mm). The
+//!   deposit's end state is what counts, and the equilibrium stop guarantees it is at rest: it ends when the
+//!   kinetic energy of the mobile bodies has stayed below [`SampleSpec::rest_energy`] = 1e-10 J per grain (an
+//!   rms speed of 8e-5 m/s for the mean grain, 32 g) for [`SampleSpec::rest_steps`] = 500 steps (0.1 s), or
+//!   after [`SampleSpec::max_duration`] = 3 s.
 
 mod loading;
 mod measure;
@@ -160,7 +164,7 @@ impl SampleSpec {
             seed,
             dt: 2e-4,
             max_duration: 3.0,
-            tolerance: 1e-4,
+            tolerance: 1e-3,
             max_iterations: 2000,
             rest_energy: 1e-10,
             rest_steps: 500,
