@@ -8,6 +8,7 @@
 //! - `deposit`: the scene of a loose pentagon deposit ([`deposit`]);
 //! - `saussine …`: the experiments of Saussine et al. (2006) ([`saussine`]);
 //! - `compare`: NSCD versus MD on the same loaded sample ([`compare`]);
+//! - `track3d …`: the 3D track section ([`track3d`]);
 //! - `karrech …`, `luding …`: the ready-made MD tests ([`md_tests`]).
 
 mod cluster;
@@ -18,6 +19,7 @@ mod flags;
 mod md_tests;
 mod run;
 mod saussine;
+mod track3d;
 
 use ballast::run::{Progress, RunOutcome, Status};
 use ballast::studies::campaigns::StudyReport;
@@ -50,6 +52,9 @@ enum Command {
     /// NSCD versus soft-contact MD on the same loaded 2D sample: MD at each overlap ratio,
     /// replicas from perturbed starts, side by side; compare.csv, compare.md, settlement figure.
     Compare(Box<compare::CompareArgs>),
+    /// The 3D track section: ballast grains deposited on a sprung sublayer, a sleeper under cyclic load.
+    #[command(subcommand)]
+    Track3d(Box<track3d::Track3dCommand>),
     /// The MD sample of Karrech et al. (2007), Table 1: deposit, cyclic plate load.
     #[command(subcommand)]
     Karrech(md_tests::KarrechCommand),
@@ -93,6 +98,7 @@ pub fn main() -> ExitCode {
         Command::Deposit(args) => deposit::main(args),
         Command::Saussine(cmd) => saussine::main(*cmd),
         Command::Compare(args) => compare::main(*args),
+        Command::Track3d(cmd) => track3d::main(*cmd),
         Command::Karrech(cmd) => md_tests::karrech_main(cmd),
         Command::Luding(cmd) => md_tests::luding_main(cmd),
     };

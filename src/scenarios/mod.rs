@@ -18,6 +18,7 @@ pub mod karrech;
 pub mod luding;
 pub mod md_bed;
 pub mod saussine;
+pub mod track3d;
 
 pub use deposit::{pentagon_deposit, DepositSpec};
 

@@ -51,6 +51,7 @@ pub mod replica_tasks;
 pub mod replicas;
 pub mod saussine;
 pub mod tasks;
+pub mod track3d;
 
 pub use display::{run_loaded, run_scene, Quiet, RunDisplay};
 
