@@ -10,9 +10,9 @@
 //! - **Weight**: `Σ m |g|` over the mobile bodies (grains and pads); **sublayer reaction**: the springs' impulses
 //!   along their axes, vertical component; **wall reaction**: the vertical component of the contact impulses
 //!   from the fixed walls (zero for smooth vertical walls, reported as a check).
-//! - **Surface**: the box divided into square bins one largest sieve size wide (at least one per side), the
-//!   highest grain vertex in each bin; the surface height is their mean. **Pad top**: the mean height of the
-//!   pads' top faces. **Layer height** `H` = surface − pad top.
+//! - **Surface**: the box divided into bins about as wide as the largest grain's bounding sphere (a whole number
+//!   per side, at least one), the highest grain vertex in each bin; the surface height is their mean. **Pad
+//!   top**: the mean height of the pads' top faces. **Layer height** `H` = surface − pad top.
 //! - **Solid fraction**: `Σ V_grain / (L W H)`, the grains' volume over the box's inner area times the layer
 //!   height (the whole layer: its wall and surface voids lower it by a few per cent against a window inside).
 //! - **Coordination** ([`crate::nscd::d3::measure::coordination`]): the mean number of bodies (grains, pads,
@@ -135,7 +135,7 @@ pub fn measure_sample(scene: &Scene3) -> Result<SampleReport> {
     let weight: f64 = m3::mobile_bodies(&sys).iter().map(|&i| info[i].mass * g).sum();
     let volume: f64 = grains.iter().map(|&i| info[i].solid.mass_properties().0).sum();
 
-    // Surface: the highest vertex per bin one largest sieve size wide.
+    // Surface: the highest vertex per bin, the bins about one largest bounding diameter wide.
     let (length, width) = (x1 - x0, y1 - y0);
     let d = grains.iter().map(|&i| 2.0 * info[i].solid.radius()).fold(0.0, f64::max);
     let bin = |size: f64| ((size / d.max(1e-9)).floor() as usize).max(1);
