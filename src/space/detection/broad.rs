@@ -200,7 +200,7 @@ impl Broad3 {
         (self.calls, self.builds)
     }
 
-    /// As [`Grid3::pairs_with`] (the same lists), the grid run only when a box has left the box it had at
+    /// As `Grid3::pairs_with` (the same lists), the grid run only when a box has left the box it had at
     /// the last run enlarged by `margin` (m, on every side; the margin of a new run).
     pub fn pairs_with(
         &mut self,
