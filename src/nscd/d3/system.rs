@@ -172,7 +172,7 @@ pub struct System3 {
     /// The domain-split solve's buffers and two-thread team ([`crate::nscd::method::split`]).
     #[serde(skip)]
     split: SplitWorkspace<ContactRow3, SpringRow3>,
-    /// Threads of the split solve (0 or 1: one); not part of the state (the numbers do not depend on it).
+    /// Threads of the step (0 or 1: one); not part of the state (the numbers do not depend on it).
     #[serde(skip)]
     threads: usize,
 }
