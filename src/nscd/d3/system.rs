@@ -295,9 +295,14 @@ impl System3 {
             }
         }
         // 1. Free velocity: gravity, the loads at t_m, the explicit gyroscopic term; imposed components take
-        //    their values at the end of the step.
+        //    their values at the end of the step. The intermediate configuration q_m (step 2) first: the imposed
+        //    spin is turned into its frame.
         self.u_begin.clear();
         self.u_begin.extend_from_slice(&self.bodies.u);
+        self.poses_m.clear();
+        for i in 0..n {
+            self.poses_m.push(advance(&self.bodies.pose[i], &self.u_begin[i], (1.0 - theta) * h));
+        }
         self.u.clear();
         self.u.extend_from_slice(&self.bodies.u);
         let g = self.params.gravity;
@@ -330,14 +335,9 @@ impl System3 {
             }
             // The imposed spin in the principal frame of the end of the step is not known before the step; it
             // is taken in the frame at q_m, where the contacts are (the difference is O(h) in a turning body).
-            let pose_m = advance(&self.bodies.pose[i], &self.u_begin[i], (1.0 - theta) * h);
-            info.impose(u, &pose_m, t_f);
+            info.impose(u, &self.poses_m[i], t_f);
         }
-        // 2. Intermediate configuration and detection.
-        self.poses_m.clear();
-        for i in 0..n {
-            self.poses_m.push(advance(&self.bodies.pose[i], &self.u_begin[i], (1.0 - theta) * h));
-        }
+        // 2. Detection at the intermediate configuration.
         let clock = std::time::Instant::now();
         self.mobile.clear();
         self.mobile.extend((0..n).map(|i| self.bodies.is_free(i)));
