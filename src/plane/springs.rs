@@ -69,24 +69,25 @@ pub const CRUSHED: f64 = 0.1;
 pub fn crushed(springs: &[Spring], q: &[[f64; 3]]) -> Option<(usize, String)> {
     springs.iter().enumerate().find_map(|(k, s)| {
         let l = s.length(q);
-        (l < CRUSHED * s.rest_length).then(|| {
-            (
-                s.a,
-                format!(
-                    "spring {k} crushed to {l:.3e} m, below {CRUSHED} of its {:.3e} m rest length (law (17) turns over \
-                     at zero length)",
-                    s.rest_length
-                ),
-            )
-        })
+        (l < CRUSHED * s.rest_length).then(|| (s.a, crushed_message(k, l, s.rest_length)))
     })
+}
+
+/// What a crushed spring `k` of length `l` and rest length `rest` (m) says ([`crushed`]; the 3D springs' too).
+pub(crate) fn crushed_message(k: usize, l: f64, rest: f64) -> String {
+    format!("spring {k} crushed to {l:.3e} m, below {CRUSHED} of its {rest:.3e} m rest length (law (17) turns over at zero length)")
 }
 
 /// The bodies tied to a fixed anchor by a spring (the sublayer pads), sorted,
 /// each once: their positions follow the springs' load, not a trend of their
 /// own ([`crate::engine::Engine::anchored_bodies`]).
 pub fn anchored(springs: &[Spring]) -> Vec<usize> {
-    let mut bodies: Vec<usize> = springs.iter().filter(|s| s.b.is_none()).map(|s| s.a).collect();
+    anchored_ends(springs.iter().map(|s| (s.a, s.b.is_none())))
+}
+
+/// The first ends `a` of the `(a, to an anchor)` springs tied to an anchor, sorted, each once (2D and 3D).
+pub(crate) fn anchored_ends(ends: impl Iterator<Item = (usize, bool)>) -> Vec<usize> {
+    let mut bodies: Vec<usize> = ends.filter(|e| e.1).map(|e| e.0).collect();
     bodies.sort_unstable();
     bodies.dedup();
     bodies

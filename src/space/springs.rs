@@ -111,25 +111,13 @@ impl Spring3 {
 pub fn crushed(springs: &[Spring3], poses: &[Pose]) -> Option<(usize, String)> {
     springs.iter().enumerate().find_map(|(k, s)| {
         let l = s.state(poses).length;
-        (l < CRUSHED * s.rest_length).then(|| {
-            (
-                s.a,
-                format!(
-                    "spring {k} crushed to {l:.3e} m, below {CRUSHED} of its {:.3e} m rest length (law (17) turns over \
-                     at zero length)",
-                    s.rest_length
-                ),
-            )
-        })
+        (l < CRUSHED * s.rest_length).then(|| (s.a, crate::plane::springs::crushed_message(k, l, s.rest_length)))
     })
 }
 
 /// The bodies tied to a world anchor by a spring (the sublayer pads), sorted, each once.
 pub fn anchored(springs: &[Spring3]) -> Vec<usize> {
-    let mut bodies: Vec<usize> = springs.iter().filter(|s| s.b.is_none()).map(|s| s.a).collect();
-    bodies.sort_unstable();
-    bodies.dedup();
-    bodies
+    crate::plane::springs::anchored_ends(springs.iter().map(|s| (s.a, s.b.is_none())))
 }
 
 #[cfg(test)]
