@@ -158,6 +158,15 @@ impl Row for ContactRow3 {
 
     #[inline(always)]
     fn visit<const UPDATE: bool>(&mut self, u: &mut [Dofs6], inv_m: &[Dofs6], omega: f64, norms: &mut SweepNorms) {
+        if self.p == [0.0; 3] {
+            // An open point that stays open (most of a packing's points within the alert distance): its normal
+            // velocity alone decides it, and nothing changes — the law, the update and the norms all give zero.
+            let (ua, ub) = (&u[self.a as usize], &u[self.b as usize]);
+            let un = dot6(&self.h_a[0], ua) - dot6(&self.h_b[0], ub);
+            if un >= self.s_open || self.c_closed - un <= 0.0 {
+                return;
+            }
+        }
         let v = self.local_velocity(u);
         let wp = self.w_times(&self.p);
         let u0 = [v[0] - wp[0], v[1] - wp[1] + self.shift_t[0], v[2] - wp[2] + self.shift_t[1]];

@@ -81,11 +81,12 @@ const SLIP_TOL: f64 = 1e-12;
 /// A block whose condition exceeds ~1e13 is singular for the sticking system.
 pub fn solve(w: &Delassus3, u_free: [f64; 3], s_open: f64, c_closed: f64, mu: f64) -> [f64; 3] {
     let m = &w.m;
-    if !(u_free.iter().chain(m.iter().flatten()).all(|x| x.is_finite()) && c_closed.is_finite()) {
-        return [0.0; 3];
-    }
     let r = c_closed - u_free[0];
     if u_free[0] >= s_open || r <= 0.0 {
+        return [0.0; 3];
+    }
+    // After the open exit (it returns the same zero): a NaN `U_N` or `c` fails both of its tests.
+    if !(u_free.iter().chain(m.iter().flatten()).all(|x| x.is_finite()) && c_closed.is_finite()) {
         return [0.0; 3];
     }
     if m[0][0] <= 0.0 {
