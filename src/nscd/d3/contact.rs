@@ -1,6 +1,7 @@
 //! The 3D contact point as a row of the shared NSCD method ([`crate::nscd::method::Row`]): Signorini with the
 //! gap prediction and restitution thresholds of the 2D row (`crate::nscd::contact`, Saussine et al. 2006 §2.3,
-//! §2.8), and exact Coulomb friction on the 3D cone ([`super::cone::solve`]) over the 3×3 Delassus block.
+//! §2.8), and exact Coulomb friction on the 3D cone ([`super::cone::solve_near`], the slip searched from the row's last
+//! one) over the 3×3 Delassus block.
 //!
 //! A contact point `p` with local frame `(n, t₁, t₂)` (n from the antagonist towards the candidate) maps a body's
 //! generalised velocity `u = (v, ω)` — `ω` in the body's principal frame, `R` its rotation — to the relative
@@ -9,33 +10,43 @@
 //! positively, the antagonist's negatively: `U = H*_a u_a − H*_b u_b`, and an impulse `P` adds `M⁻¹ H_a P` to
 //! `u_a` and subtracts `M⁻¹ H_b P` from `u_b`. The Delassus block is `W = H*_a M_a⁻¹ H_a + H*_b M_b⁻¹ H_b`.
 
-use super::cone::{project_cone, solve, Delassus3};
+use super::cone::{project_cone, solve_near, Delassus3};
 use crate::geometry::{Pose, Vec3};
 use crate::nscd::contact::ContactLaw;
 use crate::nscd::method::{Row, SweepNorms};
 use crate::space::bodies::Dofs6;
 
-/// The solver's record of one 3D contact point: contiguous, everything one visit needs.
+/// The solver's record of one 3D contact point: contiguous, everything one visit needs, the fields an open
+/// point's visit reads (bodies, thresholds, impulse, the normal rows) in its first 120 bytes — two cache lines,
+/// the record being aligned on them. The rows of `H*` are stored by their parts: a direction `d` of the frame
+/// gives `h_d = (d, ρ × Rᵀ d)` on each body (the module doc), whose first half is the same `d` on both.
 #[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
 pub struct ContactRow3 {
     /// Candidate body.
     pub a: u32,
     /// Antagonist body.
     pub b: u32,
-    /// Rows of `H*` of the candidate: normal, first and second tangent.
-    pub h_a: [Dofs6; 3],
-    /// Rows of `H*` of the antagonist.
-    pub h_b: [Dofs6; 3],
-    /// The local Delassus block (1/kg).
-    pub w: Delassus3,
-    /// Its entries, for `W P`.
-    pub wm: [[f64; 3]; 3],
-    /// Impulse `(P_N, P_T1, P_T2)` (N·s).
-    pub p: [f64; 3],
     /// The contact stays open when `U_0N ≥ s_open` (m/s): `−g_m / h` for a gap `g_m > 0` at `q_m`, else 0.
     pub s_open: f64,
     /// The normal velocity enforced once closed (m/s): `max(s_open, −e_n U_N⁻)`.
     pub c_closed: f64,
+    /// Impulse `(P_N, P_T1, P_T2)` (N·s).
+    pub p: [f64; 3],
+    /// The normal `n` (world).
+    pub n: [f64; 3],
+    /// `ρ_a × R_aᵀ n`: the candidate's angular part of the normal row (m).
+    pub an_a: [f64; 3],
+    /// `ρ_b × R_bᵀ n`: the antagonist's (m).
+    pub an_b: [f64; 3],
+    /// The tangents `t₁`, `t₂` (world).
+    pub t: [[f64; 3]; 2],
+    /// The candidate's angular parts of the tangent rows (m).
+    pub at_a: [[f64; 3]; 2],
+    /// The antagonist's (m).
+    pub at_b: [[f64; 3]; 2],
+    /// The local Delassus block (1/kg), symmetric.
+    pub w: Delassus3,
     /// `e_t U_T⁻` (m/s), added to the tangential velocity the law acts on.
     pub shift_t: [f64; 2],
     /// Coulomb friction coefficient.
@@ -43,6 +54,11 @@ pub struct ContactRow3 {
 }
 
 pub use crate::space::bodies::{dot6, gen_dir};
+
+#[inline(always)]
+fn dot3(x: &[f64; 3], y: &[f64]) -> f64 {
+    x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
+}
 
 impl ContactRow3 {
     /// The row of a contact at point `point` (world) with the frame `frame = [n, t₁, t₂]` between candidate
@@ -72,54 +88,64 @@ impl ContactRow3 {
         let s_open = if gap > 0.0 { -gap / h } else { 0.0 };
         let c_closed =
             if law.restitution_n > 0.0 && minus[0] < 0.0 { s_open.max(-law.restitution_n * minus[0]) } else { s_open };
+        let lin = |k: usize| [frame[k].x, frame[k].y, frame[k].z];
+        let ang = |h: &[Dofs6; 3], k: usize| [h[k][3], h[k][4], h[k][5]];
         Self {
             a,
             b,
-            h_a,
-            h_b,
-            w: Delassus3::new(wm),
-            wm,
-            p: [0.0; 3],
             s_open,
             c_closed,
+            p: [0.0; 3],
+            n: lin(0),
+            an_a: ang(&h_a, 0),
+            an_b: ang(&h_b, 0),
+            t: [lin(1), lin(2)],
+            at_a: [ang(&h_a, 1), ang(&h_a, 2)],
+            at_b: [ang(&h_b, 1), ang(&h_b, 2)],
+            w: Delassus3::new(wm),
             shift_t: [law.restitution_t * minus[1], law.restitution_t * minus[2]],
             mu: law.friction,
         }
+    }
+
+    /// The normal relative velocity `U_N` (m/s).
+    #[inline(always)]
+    fn normal_velocity(&self, ua: &Dofs6, ub: &Dofs6) -> f64 {
+        let dv = [ua[0] - ub[0], ua[1] - ub[1], ua[2] - ub[2]];
+        dot3(&self.n, &dv) + dot3(&self.an_a, &ua[3..]) - dot3(&self.an_b, &ub[3..])
     }
 
     /// The relative velocity `H*_a u_a − H*_b u_b` in the local frame (m/s).
     #[inline(always)]
     pub fn local_velocity(&self, u: &[Dofs6]) -> [f64; 3] {
         let (ua, ub) = (&u[self.a as usize], &u[self.b as usize]);
-        std::array::from_fn(|k| dot6(&self.h_a[k], ua) - dot6(&self.h_b[k], ub))
-    }
-
-    /// `W x`.
-    #[inline(always)]
-    fn w_times(&self, x: &[f64; 3]) -> [f64; 3] {
-        std::array::from_fn(|i| self.wm[i][0] * x[0] + self.wm[i][1] * x[1] + self.wm[i][2] * x[2])
+        let dv = [ua[0] - ub[0], ua[1] - ub[1], ua[2] - ub[2]];
+        let tangent = |k: usize| dot3(&self.t[k], &dv) + dot3(&self.at_a[k], &ua[3..]) - dot3(&self.at_b[k], &ub[3..]);
+        [self.normal_velocity(ua, ub), tangent(0), tangent(1)]
     }
 
     /// Adds `sign · M⁻¹ H p` to the candidate and subtracts it from the antagonist.
     #[inline(always)]
     fn apply(&self, u: &mut [Dofs6], inv_m: &[Dofs6], p: [f64; 3], sign: f64) {
-        for (body, h, s) in [(self.a, &self.h_a, sign), (self.b, &self.h_b, -sign)] {
+        let (n, t) = (&self.n, &self.t);
+        let force: [f64; 3] = std::array::from_fn(|d| sign * (n[d] * p[0] + t[0][d] * p[1] + t[1][d] * p[2]));
+        for (body, an, at, s) in [(self.a, &self.an_a, &self.at_a, 1.0), (self.b, &self.an_b, &self.at_b, -1.0)] {
             let (ub, im) = (&mut u[body as usize], &inv_m[body as usize]);
-            for d in 0..6 {
-                ub[d] += s * im[d] * (h[0][d] * p[0] + h[1][d] * p[1] + h[2][d] * p[2]);
+            for d in 0..3 {
+                ub[d] += s * im[d] * force[d];
+                ub[d + 3] += s * sign * im[d + 3] * (an[d] * p[0] + at[0][d] * p[1] + at[1][d] * p[2]);
             }
         }
     }
 }
 
-/// The norms of one 3D contact whose impulse goes from `p` to `q` (N·s) under its block `wm`
+/// The norms of one 3D contact whose impulse goes from `p` to `q` (N·s) under its block `w`, with `wp = W p`
 /// ([`SweepNorms::add`]): `ΔU = W (q − p)`, `P̄ = ½ (p + q)`, and the midpoint averages of `P·WP` and `|WP|²`.
 #[inline(always)]
-fn add_norms(norms: &mut SweepNorms, wm: &[[f64; 3]; 3], p: [f64; 3], q: [f64; 3], changed: bool) {
-    let w = |x: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| wm[i][0] * x[0] + wm[i][1] * x[1] + wm[i][2] * x[2]) };
+fn add_norms(norms: &mut SweepNorms, w: &Delassus3, p: [f64; 3], wp: [f64; 3], q: [f64; 3], changed: bool) {
     let d3 = |x: &[f64; 3], y: &[f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
-    let dp: [f64; 3] = std::array::from_fn(|k| q[k] - p[k]);
-    let (du, wp, wq) = (w(&dp), w(&p), w(&q));
+    let du = w.apply(std::array::from_fn(|k| q[k] - p[k]));
+    let wq: [f64; 3] = std::array::from_fn(|k| wp[k] + du[k]);
     let pm: [f64; 3] = std::array::from_fn(|k| 0.5 * (p[k] + q[k]));
     let wqq = d3(&q, &wq);
     norms.add(
@@ -161,17 +187,16 @@ impl Row for ContactRow3 {
         if self.p == [0.0; 3] {
             // An open point that stays open (most of a packing's points within the alert distance): its normal
             // velocity alone decides it, and nothing changes — the law, the update and the norms all give zero.
-            let (ua, ub) = (&u[self.a as usize], &u[self.b as usize]);
-            let un = dot6(&self.h_a[0], ua) - dot6(&self.h_b[0], ub);
+            let un = self.normal_velocity(&u[self.a as usize], &u[self.b as usize]);
             if un >= self.s_open || self.c_closed - un <= 0.0 {
                 return;
             }
         }
         let v = self.local_velocity(u);
-        let wp = self.w_times(&self.p);
-        let u0 = [v[0] - wp[0], v[1] - wp[1] + self.shift_t[0], v[2] - wp[2] + self.shift_t[1]];
         let p = self.p;
-        let mut q = solve(&self.w, u0, self.s_open, self.c_closed, self.mu);
+        let wp = self.w.apply(p);
+        let u0 = [v[0] - wp[0], v[1] - wp[1] + self.shift_t[0], v[2] - wp[2] + self.shift_t[1]];
+        let mut q = solve_near(&self.w, u0, self.s_open, self.c_closed, self.mu, p);
         if omega != 1.0 {
             q = project_cone(std::array::from_fn(|k| p[k] + omega * (q[k] - p[k])), self.mu);
         }
@@ -181,6 +206,6 @@ impl Row for ContactRow3 {
             self.p = q;
             self.apply(u, inv_m, dp, 1.0);
         }
-        add_norms(norms, &self.wm, p, q, changed);
+        add_norms(norms, &self.w, p, wp, q, changed);
     }
 }
