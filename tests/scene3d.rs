@@ -457,9 +457,12 @@ fn simulation_and_nscd_sections() {
     );
     expect(&edit("[nscd]", "[nscd]\ntheta = 0.2"), &["nscd.theta: must be in [0.5, 1], got 0.2"]);
     expect(
-        &edit("[nscd]", "[nscd]\nsolver = \"apgd\""),
-        &["nscd.solver: 'apgd' is not built for 3D NSCD yet (only 'nlgs')"],
+        &edit("[nscd]", "[nscd]\nsolver = \"interior_point\""),
+        &["nscd.solver: 'interior_point' solves the step as a linear complementarity problem"],
     );
+    let accelerated = edit("[nscd]", "[nscd]\nsolver = \"apgd\"");
+    let sys = Scene3::from_toml_str(&accelerated).unwrap().build().unwrap();
+    assert_eq!(sys.params.nlgs.solver, ballast::nscd::method::Solver::Apgd, "apgd is taken in 3D");
     expect(&edit("[nscd]", "[nscd]\non_stall = \"stop\""), &["nscd.on_stall: 'stop' is not built for 3D NSCD yet"]);
     expect(&edit("alert_distance = 1.0e-3", "alert_distance = -1.0"), &["nscd.alert_distance: must be non-negative"]);
     // The settings that apply are taken as given.

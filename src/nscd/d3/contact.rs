@@ -10,9 +10,10 @@
 //! positively, the antagonist's negatively: `U = H*_a u_a − H*_b u_b`, and an impulse `P` adds `M⁻¹ H_a P` to
 //! `u_a` and subtracts `M⁻¹ H_b P` from `u_b`. The Delassus block is `W = H*_a M_a⁻¹ H_a + H*_b M_b⁻¹ H_b`.
 
-use super::cone::{project_cone, solve_near, Delassus3};
+use super::cone::{project_cone, project_disc, solve_near, Delassus3};
 use crate::geometry::{Pose, Vec3};
 use crate::nscd::contact::ContactLaw;
+use crate::nscd::method::apgd::ConeRow;
 use crate::nscd::method::{Row, SweepNorms};
 use crate::space::bodies::Dofs6;
 
@@ -207,5 +208,119 @@ impl Row for ContactRow3 {
             self.apply(u, inv_m, dp, 1.0);
         }
         add_norms(norms, &self.w, p, wp, q, changed);
+    }
+}
+
+/// The largest eigenvalue of a symmetric 3×3 block (1/kg), in closed form (the trigonometric solution of the
+/// characteristic cubic).
+fn lambda_max3(m: &[[f64; 3]; 3]) -> f64 {
+    let off = m[0][1] * m[0][1] + m[0][2] * m[0][2] + m[1][2] * m[1][2];
+    let q = (m[0][0] + m[1][1] + m[2][2]) / 3.0;
+    let dev = [m[0][0] - q, m[1][1] - q, m[2][2] - q];
+    let p = ((dev[0] * dev[0] + dev[1] * dev[1] + dev[2] * dev[2] + 2.0 * off) / 6.0).sqrt();
+    if p.is_nan() || p <= 0.0 {
+        return q; // a multiple of the identity (or not finite: q carries it)
+    }
+    let b = |i: usize, j: usize| if i == j { dev[i] / p } else { m[i][j] / p };
+    let det = b(0, 0) * (b(1, 1) * b(2, 2) - b(1, 2) * b(1, 2)) - b(0, 1) * (b(0, 1) * b(2, 2) - b(1, 2) * b(0, 2))
+        + b(0, 2) * (b(0, 1) * b(1, 2) - b(1, 1) * b(0, 2));
+    let phi = (0.5 * det).clamp(-1.0, 1.0).acos() / 3.0;
+    q + 2.0 * p * phi.cos()
+}
+
+/// The 3D contact in the accelerated projected gradient ([`crate::nscd::method::apgd`]): `(P_N, P_T1, P_T2)`
+/// projected on `P_N ≥ 0` and the disc `|P_T| ≤ g_α` (the 2D row's interval turned about the normal).
+impl ConeRow for ContactRow3 {
+    type Impulse = [f64; 3];
+
+    #[inline(always)]
+    fn impulse(&self) -> [f64; 3] {
+        self.p
+    }
+
+    #[inline(always)]
+    fn set_impulse(&mut self, p: [f64; 3]) {
+        self.p = p;
+    }
+
+    #[inline(always)]
+    fn normal(&self) -> f64 {
+        self.p[0]
+    }
+
+    #[inline(always)]
+    fn mu(&self) -> f64 {
+        self.mu
+    }
+
+    #[inline(always)]
+    fn local_velocity(&self, u: &[Dofs6]) -> [f64; 3] {
+        ContactRow3::local_velocity(self, u)
+    }
+
+    #[inline(always)]
+    fn gradient(&self, v: [f64; 3], c: f64) -> [f64; 3] {
+        [v[0] - c, v[1] + self.shift_t[0], v[2] + self.shift_t[1]]
+    }
+
+    /// `c_closed` for a contact whose `U_0N < s_open`, `s_open` otherwise (`c_closed` when the two agree).
+    #[inline]
+    fn label(&self, u: &[Dofs6]) -> f64 {
+        if self.s_open >= self.c_closed {
+            return self.c_closed;
+        }
+        let u0n = ContactRow3::local_velocity(self, u)[0] - self.w.apply(self.p)[0];
+        if u0n < self.s_open {
+            self.c_closed
+        } else {
+            self.s_open
+        }
+    }
+
+    #[inline(always)]
+    fn diagonal(&self) -> [f64; 3] {
+        [self.w.m[0][0], self.w.m[1][1], self.w.m[2][2]]
+    }
+
+    fn lambda_max(&self) -> f64 {
+        lambda_max3(&self.w.m)
+    }
+
+    #[inline(always)]
+    fn project(&self, x: [f64; 3], tresca: Option<f64>) -> [f64; 3] {
+        project_disc(x, tresca.unwrap_or(self.mu * x[0].max(0.0)))
+    }
+
+    #[inline(always)]
+    fn add_impulse_of(&self, u: &mut [Dofs6], inv_m: &[Dofs6], p: [f64; 3], sign: f64) {
+        self.apply(u, inv_m, p, sign);
+    }
+
+    #[inline(always)]
+    fn add_norms(&self, norms: &mut SweepNorms, p: [f64; 3], q: [f64; 3], changed: bool) {
+        add_norms(norms, &self.w, p, self.w.apply(p), q, changed);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The closed form against the characteristic polynomial and nalgebra's symmetric eigensolver.
+    #[test]
+    fn the_largest_eigenvalue_of_a_block() {
+        let blocks = [
+            [[2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]],
+            [[3.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 2.0]],
+            [[4.0, 1.0, -0.5], [1.0, 3.0, 0.25], [-0.5, 0.25, 1.0]],
+            [[1e-3, 2e-4, 0.0], [2e-4, 5e-4, 1e-4], [0.0, 1e-4, 5e-4]],
+            [[1.0, 1.0, 1.0], [1.0, 1.0, 1.0], [1.0, 1.0, 1.0]],
+        ];
+        for m in blocks {
+            let expected = nalgebra::Matrix3::from_fn(|i, j| m[i][j]).symmetric_eigenvalues().max();
+            let got = lambda_max3(&m);
+            // Round-off of a dozen operations on entries of the block's size.
+            assert!((got - expected).abs() <= 1e-12 * expected.abs().max(m[0][0]), "{m:?}: {got} vs {expected}");
+        }
     }
 }

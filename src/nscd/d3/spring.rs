@@ -5,6 +5,7 @@
 //! `law17_affine` / `law17_solve`); for θ = 1/2 a linear spring is integrated by the trapezoidal rule.
 
 use crate::geometry::Pose;
+use crate::nscd::method::apgd::AffineRow;
 use crate::nscd::method::{Row, SweepNorms};
 use crate::nscd::sublayer::{add_scalar_norms, law17_affine, law17_solve};
 use crate::space::bodies::{dot6, Dofs6};
@@ -128,5 +129,48 @@ impl Row for SpringRow3 {
             self.apply(u, inv_m, dp, 1.0);
         }
         add_scalar_norms(norms, self.w, p_old, p, dp);
+    }
+}
+
+/// The 3D sublayer spring in the accelerated projected gradient: a term of the quadratic, as the 2D one.
+impl AffineRow for SpringRow3 {
+    #[inline(always)]
+    fn impulse(&self) -> f64 {
+        self.p
+    }
+
+    #[inline(always)]
+    fn set_impulse(&mut self, p: f64) {
+        self.p = p;
+    }
+
+    #[inline(always)]
+    fn axial_velocity(&self, u: &[Dofs6]) -> f64 {
+        SpringRow3::axial_velocity(self, u)
+    }
+
+    fn h_alpha(&self) -> f64 {
+        self.h_alpha
+    }
+
+    fn h_beta(&self) -> f64 {
+        self.h_beta
+    }
+
+    fn w(&self) -> f64 {
+        self.w
+    }
+
+    fn compression_only(&self) -> bool {
+        self.compression_only
+    }
+
+    fn solve_affine(&self, u0: f64) -> f64 {
+        law17_solve(self.h_alpha, self.h_beta, self.w, u0, self.compression_only)
+    }
+
+    #[inline(always)]
+    fn add_impulse_of(&self, u: &mut [Dofs6], inv_m: &[Dofs6], p: f64, sign: f64) {
+        self.apply(u, inv_m, p, sign);
     }
 }

@@ -28,8 +28,9 @@ use super::contact::ContactRow3;
 use super::spring::SpringRow3;
 use crate::geometry::{Pose, Vec3};
 use crate::nscd::contact::ContactLaw;
+use crate::nscd::method::apgd::{solve_apgd_with, ApgdOptions, ApgdWorkspace};
 use crate::nscd::method::split::SplitWorkspace;
-use crate::nscd::method::{apply_impulses, solve_nlgs_split, NlgsReport, NlgsSettings};
+use crate::nscd::method::{apply_impulses, solve_nlgs_split, NlgsReport, NlgsSettings, Solver};
 use crate::space::bodies::{advance, Bodies, Dofs6};
 use crate::space::detection::Detector;
 use crate::space::loads::LoadKind;
@@ -172,6 +173,9 @@ pub struct System3 {
     /// The domain-split solve's buffers and two-thread team ([`crate::nscd::method::split`]).
     #[serde(skip)]
     split: SplitWorkspace<ContactRow3, SpringRow3>,
+    /// Buffers of the accelerated solver (`solver = "apgd"`).
+    #[serde(skip)]
+    apgd: ApgdWorkspace<ContactRow3>,
     /// Threads of the step (0 or 1: one); not part of the state (the numbers do not depend on it).
     #[serde(skip)]
     threads: usize,
@@ -201,6 +205,7 @@ impl System3 {
             mobile: Vec::new(),
             spring_rows: Vec::new(),
             split: SplitWorkspace::default(),
+            apgd: ApgdWorkspace::default(),
             threads: 1,
         }
     }
@@ -278,6 +283,9 @@ impl System3 {
         }
         if !p.gravity.iter().all(|g| g.is_finite()) {
             return Err(Error::Scene("simulation.gravity: must be finite".into()));
+        }
+        if p.nlgs.solver == Solver::InteriorPoint {
+            return Err(Error::Scene("nscd.solver: 'interior_point' is 2D only: use 'nlgs' or 'apgd' in 3D".into()));
         }
         Ok(())
     }
@@ -375,16 +383,30 @@ impl System3 {
         }
         apply_impulses(&mut self.u, &self.bodies.inv_m, &self.rows, &self.spring_rows);
         let poses_m = &self.poses_m;
-        let report = solve_nlgs_split(
-            &self.params.nlgs,
-            &mut self.split,
-            self.threads,
-            |i| poses_m[i].position.x,
-            &mut self.u,
-            &self.bodies.inv_m,
-            &mut self.rows,
-            &mut self.spring_rows,
-        );
+        let settings = &self.params.nlgs;
+        let report = match settings.solver {
+            Solver::Apgd => solve_apgd_with(
+                // The accelerated solver has one cap: an extended step gets the larger (as in 2D).
+                &NlgsSettings { max_iterations: settings.sweep_cap(), ..*settings },
+                &ApgdOptions::default(),
+                &mut self.apgd,
+                &mut self.u,
+                &self.bodies.inv_m,
+                &mut self.rows,
+                &mut self.spring_rows,
+            ),
+            // `check` refuses the interior point (a polyhedral cone's LCP, 2D only) before a step runs.
+            Solver::Nlgs | Solver::InteriorPoint => solve_nlgs_split(
+                settings,
+                &mut self.split,
+                self.threads,
+                |i| poses_m[i].position.x,
+                &mut self.u,
+                &self.bodies.inv_m,
+                &mut self.rows,
+                &mut self.spring_rows,
+            ),
+        };
         let solve_seconds = clock.elapsed().as_secs_f64();
         // 4. Update, checked before it is kept.
         for i in 0..n {

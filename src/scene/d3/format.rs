@@ -18,8 +18,8 @@ pub struct Scene3 {
     /// `[simulation]`: engine (`"nscd"`), `dimension = 3`, time step, duration, gravity (3 components), seed,
     /// equilibrium stop.
     pub simulation: Simulation,
-    /// `[nscd]`: the 2D scene's settings (optional); `solver` other than `"nlgs"` and `on_stall = "stop"` are
-    /// refused (not built for 3D).
+    /// `[nscd]`: the 2D scene's settings (optional); `solver = "interior_point"` (2D only) and
+    /// `on_stall = "stop"` are refused.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub nscd: Option<NscdSection>,
     /// `[output]` (optional).

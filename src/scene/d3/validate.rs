@@ -107,8 +107,12 @@ fn check_shared(scene: &Scene3) -> Result<(f64, NlgsSettings)> {
         }
     }
     let nlgs = checked.nlgs;
-    if nlgs.solver != Solver::Nlgs {
-        return err(format!("nscd.solver: '{}' is not built for 3D NSCD yet (only 'nlgs')", nlgs.solver.name()));
+    if nlgs.solver == Solver::InteriorPoint {
+        return err(
+            "nscd.solver: 'interior_point' solves the step as a linear complementarity problem, which only the 2D \
+             friction cone allows: use 'nlgs' or 'apgd' in 3D"
+                .into(),
+        );
     }
     if nlgs.on_stall == OnStall::Stop {
         return err("nscd.on_stall: 'stop' is not built for 3D NSCD yet: use 'accept' or 'extend'".into());

@@ -62,7 +62,8 @@
 //! ([`ConeRow`]) gives its impulse as a vector, its local velocity, gradient, threshold label, the diagonal and
 //! largest eigenvalue of its Delassus block, and its projection on the law's convex set (in 2D `P_N ≥ 0`,
 //! `|P_T| ≤ g_α`: an interval; in 3D a disc); a spring ([`AffineRow`]) its axial velocity and affine law. The
-//! 2D rows implement both (`crate::nscd::contact`, `crate::nscd::sublayer`).
+//! 2D rows implement both (`crate::nscd::contact`, `crate::nscd::sublayer`), and so do the 3D ones
+//! (`crate::nscd::d3::contact`, `crate::nscd::d3::spring`).
 //!
 //! Files: this one (the traits, the options and the iteration), `stages.rs` (the workspace and each stage of
 //! an iteration).
