@@ -4,21 +4,26 @@
 use super::*;
 use crate::scene::SceneFile;
 
-/// §3.2: the loaded sample under each convergence policy and tolerance.
+/// §3.2: the loaded sample under each convergence policy and tolerance; `L` is
+/// the loading: 2D ([`LoadingSpec`], [`convergence`]) or the 3D track section's
+/// ([`crate::studies::track3d::ConvergenceSpec`], [`crate::studies::track3d::convergence`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct ConvergenceSpec {
-    /// The deposited sample (`sample.toml` of [`crate::studies::saussine::sample`]).
+pub struct ConvergenceSpec<L = LoadingSpec> {
+    /// The deposited sample (`sample.toml` of [`crate::studies::saussine::sample`]
+    /// or [`crate::studies::track3d::sample`]).
     pub sample: PathBuf,
-    /// The runs as `(policy, tolerance)`; empty: the paper's table ([`PAPER_POLICIES`]).
+    /// The runs as `(policy, tolerance)`; empty: in 2D the paper's table
+    /// ([`PAPER_POLICIES`]), in 3D an error.
     pub policies: Vec<(String, f64)>,
-    /// The setting the others are compared with, `(policy, tolerance)`, one of
-    /// the runs; `None`: the tightest tolerance of the `strict` policy among the
-    /// runs, else the tightest tolerance of any policy (the first listed of equals).
+    /// The setting the others are compared with, `(policy, tolerance)`: in 2D one
+    /// of the runs, in 3D run after them when it is not; `None`: the tightest
+    /// tolerance of the `strict` policy among the runs, else the tightest
+    /// tolerance of any policy (the first listed of equals).
     pub reference: Option<(String, f64)>,
     /// The replicas of each setting ([`Replicas::default`]: one, today's single run).
     pub replicas: Replicas,
     /// The loading of every run (its criterion and tolerance replaced by each run's).
-    pub loading: LoadingSpec,
+    pub loading: L,
 }
 
 impl ConvergenceSpec {

@@ -12,9 +12,8 @@ use crate::studies::campaigns::{
     convergence_summary, label_number, not_summarized, reference_of, replica_labels, run_written, StudyOptions,
     StudyReport,
 };
-use crate::studies::replicas::{Replicas, Start};
+use crate::studies::replicas::Start;
 use crate::studies::RunDisplay;
-use std::path::PathBuf;
 
 /// The settings of the 3D convergence study by default (`POLICY:TOLERANCE`): the track section's loaded runs
 /// use `quad` 1e-4 ([`LoadingSpec::track`]), the 2D engine's default stopping rule is `energy` 1.66e-5, and
@@ -25,22 +24,9 @@ pub const DEFAULT_POLICIES: [(&str, f64); 3] = [("quad", 1e-3), ("energy", 1.66e
 pub const DEFAULT_REFERENCE: (&str, f64) = ("quad", 1e-5);
 
 /// The 3D convergence study: the loaded sample under each convergence policy and tolerance, from
-/// [`Replicas::count`] starts each.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ConvergenceSpec {
-    /// The deposited section (`sample.toml` of [`super::sample`]).
-    pub sample: PathBuf,
-    /// The settings as `(policy, tolerance)`, at least one.
-    pub policies: Vec<(String, f64)>,
-    /// The setting the others are compared with, `(policy, tolerance)`: run after the others when it is not
-    /// one of them; `None`: the tightest tolerance of the `strict` policy among the runs, else the tightest of
-    /// any policy (the first listed of equals).
-    pub reference: Option<(String, f64)>,
-    /// The replicas of each setting (perturbed starts, seating cycles).
-    pub replicas: Replicas,
-    /// The loading of every run (its criterion and tolerance replaced by each run's).
-    pub loading: LoadingSpec,
-}
+/// [`crate::studies::replicas::Replicas::count`] starts each (the 2D study's spec with the 3D loading; at least one policy, the reference
+/// run after them when it is not one of them).
+pub type ConvergenceSpec = crate::studies::campaigns::ConvergenceSpec<LoadingSpec>;
 
 impl ConvergenceSpec {
     /// The study's settings: [`Self::policies`], then the reference if it is not among them.
@@ -63,8 +49,9 @@ impl ConvergenceSpec {
     /// setting from the sample.
     ///
     /// # Errors
-    /// [`Error::Scene`] naming `replicas`, `perturbation.distance_m`, `policies`, `sample` (unreadable), or the
-    /// loading's field (`criterion`, `tolerance`, `cycles`, …).
+    /// [`Error::Scene`] naming `replicas`, `perturbation.distance_m`, `policies` (none, or one whose policy or
+    /// tolerance is invalid), `reference` (likewise), `sample` (unreadable), or the loading's field (`cycles`,
+    /// `dt`, …).
     pub fn check(&self) -> Result<()> {
         self.scenes().map(drop)
     }
@@ -79,17 +66,24 @@ impl ConvergenceSpec {
         self.settings()
             .iter()
             .map(|(policy, tol)| {
-                loaded_scene(
-                    &sample,
-                    &LoadingSpec { criterion: policy.clone(), tolerance: *tol, ..self.loading.clone() },
-                )
+                let loading = LoadingSpec { criterion: policy.clone(), tolerance: *tol, ..self.loading.clone() };
+                loaded_scene(&sample, &loading).map_err(|e| match e {
+                    // The setting's own fields: named as the policy or reference they came from.
+                    Error::Scene(m) if m.starts_with("criterion:") || m.starts_with("tolerance:") => {
+                        let from =
+                            if self.policies.contains(&(policy.clone(), *tol)) { "policies" } else { "reference" };
+                        Error::Scene(format!("{from}: {policy}:{tol:e}: {m}"))
+                    }
+                    e => e,
+                })
             })
             .collect()
     }
 }
 
-/// The 3D convergence study (`ballast track3d convergence`): for each setting `(policy, tolerance)` of
-/// [`ConvergenceSpec::settings`] and each replica `r`, the sample loaded with that criterion and tolerance
+/// The 3D convergence study (`ballast track3d convergence`): for each setting `(policy, tolerance)` (the
+/// policies, then the reference when it is not among them) and each replica `r`, the sample loaded with that
+/// criterion and tolerance
 /// (replica `r ≥ 1` perturbed, [`crate::studies::replicas::perturb_scene3`]), written as
 /// `DIR/scenes/<run>.toml` and run in `DIR/runs/<run>/` (`<run>` is `<policy>_<tolerance>/replica-<r>`, or
 /// `<policy>_<tolerance>` with one replica), `study.jobs` at a time; then, as the 2D study,
