@@ -28,6 +28,12 @@
 //! 95 % interval; the figures show the replicas' means with their 95 % bands,
 //! and `settlement_ensemble` the mean settlement per cycle of each setting.
 //!
+//! The runner of the written scenes (`run_written`), the per-run columns and
+//! the convergence summary (`convergence_summary`) are generic over the
+//! engine's `cycles.csv` row (`StudyCycle`): the 3D track section's studies
+//! ([`crate::studies::track3d::convergence`], [`crate::studies::track3d::settle_replicas`])
+//! run on them.
+//!
 //! Layout: `DIR/scenes/<run>.toml` and `DIR/runs/<run>/` (`<run>` is
 //! `<setting>/replica-<r>` with several replicas), each run folder with its
 //! `replica.json`. A run that diverges is
