@@ -93,13 +93,14 @@ fn perturbed_starts_move_the_mobile_bodies_within_the_ball() {
 
 /// Three replicas of two cycles: `settlement_ensemble.csv` (and the rows returned) are the mean, sample standard
 /// deviation and Student 95 % interval of the three `cycles.csv`, total and accrued since cycle 1; each replica's
-/// start and record are in its folder, and replicas 0 and 1 settle differently.
+/// start, record and snapshots are in its folder, and replicas 0 and 1 settle differently.
 #[test]
 fn the_ensemble_of_three_replicas_is_their_statistics() {
     let (dir, s) = sample();
     let out = dir.join("replicas");
     let reps = replicas(3, 1e-6, 1);
-    let r = study::settle_replicas(&s.path, &loading(2), &out, &no_snapshots(), &reps, Some(2), &Quiet).unwrap();
+    let opts = SettleOptions { snapshot_every: 1, ..no_snapshots() };
+    let r = study::settle_replicas(&s.path, &loading(2), &out, &opts, &reps, Some(2), &Quiet).unwrap();
     assert!(r.failed.is_empty() && r.summarized, "{:?}", r.failed);
     let runs: Vec<Vec<CycleRow3>> =
         (0..3).map(|k| read_cycles(&replica_dir(&out, k).join("cycles.csv")).unwrap()).collect();
@@ -110,6 +111,8 @@ fn the_ensemble_of_three_replicas_is_their_statistics() {
             serde_json::from_str(&std::fs::read_to_string(replica_dir(&out, k).join(REPLICA_FILE)).unwrap()).unwrap();
         assert_eq!(record["replica"], k);
         assert!(out.join(format!("scenes/replica-{k}.toml")).is_file());
+        let vtk = std::fs::read_dir(replica_dir(&out, k).join("vtk")).unwrap().count();
+        assert!(vtk >= 2, "replica {k}: {vtk} VTK files for a snapshot every cycle of two");
     }
     let table: Vec<SettlementEnsembleRow> = ballast::io::read_csv(&out.join("settlement_ensemble.csv")).unwrap();
     assert_eq!(table, r.rows);

@@ -68,7 +68,7 @@ pub enum Track3dCommand {
     /// Loads a deposited sample and runs the cycles: the sleeper's settlement per cycle (cycles.csv),
     /// series.csv, summary.json, VTK snapshots, figures; with --accelerate, through the settlement driver.
     /// With --replicas R > 1: R runs from perturbed starts side by side in DIR/runs/replica-<r>/ (their
-    /// starts in DIR/scenes/, no VTK snapshots), and DIR/settlement_ensemble.csv (mean, sd, 95 % CI per cycle).
+    /// starts in DIR/scenes/), and DIR/settlement_ensemble.csv (mean, sd, 95 % CI per cycle).
     Settle(Box<SettleArgs>),
     /// The cycles of a sample with each convergence policy and tolerance, from R starts each: convergence.csv
     /// (sweeps per step, steps at the cap, wall time per cycle, overlaps, settlement; the ensemble of each

@@ -403,13 +403,14 @@ pub(super) fn run_jobs(
         io::write_json(&job.dir(out).join(REPLICA_FILE), &record)?;
     }
     let labels: Vec<String> = jobs.iter().map(|j| j.label.clone()).collect();
-    run_written(&labels, first, study, display, failed, crate::plane::rows::read_cycles)
+    run_written(&labels, first, study, 0, display, failed, crate::plane::rows::read_cycles)
 }
 
 /// Runs the study's runs `labels` (task `first + j` is run `j`) that `study.tasks` selects, `study.jobs` at a
 /// time, each from its scene `DIR/scenes/<label>.toml` (written by the caller) in `DIR/runs/<label>/`; the
 /// failed runs are added to `failed`. Then, for an invocation that writes the summary, reads back the outcome
-/// of every run from its folder (its `cycles.csv` by `read_cycles`).
+/// of every run from its folder (its `cycles.csv` by `read_cycles`). A VTK snapshot every `vtk_every` steps of
+/// each run (0: none).
 ///
 /// # Errors
 /// An invalid scene or checkpoint; with the summary, a run without a finished run (named).
@@ -417,6 +418,7 @@ pub(crate) fn run_written<C: StudyCycle>(
     labels: &[String],
     first: u64,
     study: &StudyOptions,
+    vtk_every: u64,
     display: &dyn RunDisplay,
     failed: &mut Vec<(String, String)>,
     read_cycles: fn(&Path) -> Result<Vec<C>>,
@@ -440,6 +442,7 @@ pub(crate) fn run_written<C: StudyCycle>(
                 let opts = RunOptions {
                     checkpoint_every_s: study.checkpoint_every_s,
                     resume: prior == Prior::Checkpointed,
+                    vtk_every,
                     figures: true,
                     threads: run_threads(side_by_side),
                     ..RunOptions::default()

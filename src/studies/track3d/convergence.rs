@@ -117,7 +117,7 @@ pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn R
         }
     }
     let mut failed = Vec::new();
-    let Some(outcomes) = run_written(&labels, 0, study, display, &mut failed, read_cycles)? else {
+    let Some(outcomes) = run_written(&labels, 0, study, 0, display, &mut failed, read_cycles)? else {
         return Ok(not_summarized(&study.out, failed));
     };
     let iterations = (spec.loading.min_iterations, spec.loading.max_iterations);

@@ -157,7 +157,7 @@ pub fn settle(
 ) -> Result<RunOutcome> {
     let scene = loaded(sample, loading)?;
     let path = write_loaded(sample, &scene, out, opts.resume, "")?;
-    let per_cycle = (1.0 / (loading.frequency * loading.dt)).round().max(1.0) as u64;
+    let per_cycle = super::saussine::steps_per_cycle(loading.frequency, loading.dt);
     let run = RunOptions {
         checkpoint_every_s: opts.checkpoint_every_s,
         resume: opts.resume,

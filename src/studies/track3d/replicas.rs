@@ -10,7 +10,7 @@ use crate::scenarios::track3d::LoadingSpec;
 use crate::scene::Scene3;
 use crate::studies::campaigns::{run_dir, run_written, scene_path, StudyOptions};
 use crate::studies::replicas::{perturb_scene3, Replicas, Start, REPLICA_FILE};
-use crate::studies::saussine::{finish_replicas, SettleReplicas};
+use crate::studies::saussine::{finish_replicas, steps_per_cycle, SettleReplicas};
 use crate::studies::{output_error, RunDisplay};
 use std::path::Path;
 
@@ -49,8 +49,8 @@ pub(super) fn write_start(out: &Path, label: &str, scene: &Scene3, source: &Path
 /// as it is and replica `r ≥ 1` with every mobile body moved by at most `replicas.perturbation.distance_m`
 /// ([`perturb_scene3`]); the starts written as `OUT/scenes/replica-<r>.toml`, the runs side by side, `jobs` at a
 /// time (`None`: one per core; one alone runs on [`crate::run::default_threads`] threads), each in
-/// `OUT/runs/replica-<r>/` with `cycles.csv`, `series.csv`, `summary.json`, figures (no VTK snapshots:
-/// `opts.snapshot_every` is not used) and [`REPLICA_FILE`]. `opts.resume` skips the finished replicas and
+/// `OUT/runs/replica-<r>/` with `cycles.csv`, `series.csv`, `summary.json`, figures, VTK snapshots every
+/// `opts.snapshot_every` cycles and [`REPLICA_FILE`]. `opts.resume` skips the finished replicas and
 /// resumes the checkpointed ones. Then `OUT/settlement_ensemble.csv` (per cycle: mean, standard deviation and
 /// 95 % interval of the settlement at the load minimum, [`crate::studies::replicas::CycleSettlement`] for
 /// [`CycleRow3`], and of the settlement accrued since cycle `replicas.seating_cycles`) and the figure
@@ -87,7 +87,8 @@ pub fn settle_replicas(
         write_start(out, label, &scene, sample, &Start { replica: r, perturbation: replicas.perturbation })?;
     }
     let mut failed = Vec::new();
-    run_written(&labels, 0, &study, display, &mut failed, read_cycles)?;
+    let vtk_every = opts.snapshot_every.saturating_mul(steps_per_cycle(loading.frequency, loading.dt));
+    run_written(&labels, 0, &study, vtk_every, display, &mut failed, read_cycles)?;
     let failures: Vec<Option<String>> =
         labels.iter().map(|l| failed.iter().find(|(f, _)| f == l).map(|(_, e)| e.clone())).collect();
     let read = |path: &Path| read_cycles(path).map_err(output_error);
