@@ -266,13 +266,15 @@ fn bad_replica_flags_are_named_on_one_line() {
     let out = out.to_str().unwrap();
     let settle = ["track3d", "settle", "--sample", sample, "--out", out, "--quiet"];
     let conv = ["track3d", "convergence", "--sample", sample, "--out", out, "--quiet"];
-    let cases: [(&[&str], &[&str], &str); 10] = [
+    let cases: [(&[&str], &[&str], &str); 12] = [
         (&settle, &["--replicas", "0"], "--replicas:"),
         (&settle, &["--replicas", "2", "--perturb=-1"], "--perturb:"),
         (&settle, &["--replicas", "2", "--perturb", "nan"], "--perturb:"),
         (&settle, &["--replicas", "2", "--jobs", "0"], "--jobs:"),
         (&conv, &["--replicas", "0"], "--replicas:"),
         (&conv, &["--jobs", "0"], "--jobs:"),
+        (&conv, &["--checkpoint-every", "nan"], "--checkpoint-every:"),
+        (&settle, &["--replicas", "2", "--checkpoint-every=-1"], "--checkpoint-every:"),
         (&conv, &["--policies", "quad"], "--policies:"),
         (&conv, &["--policies", "fast:1e-3"], "--policies:"),
         (&conv, &["--reference", "quad:x"], "--reference:"),

@@ -305,9 +305,7 @@ pub fn main(cmd: Track3dCommand) -> Result<(), Failure> {
         }
         Track3dCommand::Convergence(args) => {
             let ConvergenceArgs { sample, policies: given, reference, replicas, loading, study } = *args;
-            if study.jobs == Some(0) {
-                return Err(input("--jobs: must be at least 1".into()));
-            }
+            study.options().check().map_err(as_flag)?;
             let spec = ConvergenceSpec {
                 sample,
                 policies: policies(&given)?,

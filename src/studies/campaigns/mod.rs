@@ -110,6 +110,14 @@ impl StudyOptions {
         }
     }
 
+    /// Checks the options (as every study does before its first run).
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming `checkpoint_every_s` (negative or not finite) or `jobs` (0).
+    pub fn check(&self) -> Result<()> {
+        self.threads().map(drop)
+    }
+
     /// The runs at once (the pool's threads).
     pub(super) fn threads(&self) -> Result<usize> {
         if !(self.checkpoint_every_s.is_finite() && self.checkpoint_every_s >= 0.0) {
