@@ -11,7 +11,7 @@
 //!   `summary.json`, VTK snapshots every few cycles;
 //! - [`settle_accelerated`]: the same loaded scene through the settlement driver (Karrech et al. 2007, Fig. 10),
 //!   as the 2D [`super::saussine::settle_accelerated`]; its jumps land through the 3D engine's relaxation
-//!   (`crate::space::relax`).
+//!   (`crate::space::relax`);
 //! - [`settle_replicas`] (`replicas.rs`): [`settle`] from several starts, replica 0 the sample as it is and the
 //!   others with every mobile body moved by at most a small distance ([`crate::studies::replicas::perturb_scene3`]),
 //!   side by side, and the ensemble's settlement per cycle with its 95 % interval (`settlement_ensemble.csv`), as
