@@ -7,50 +7,18 @@
 //! line).
 
 mod scratch;
+mod track3d_common;
 
 use ballast::geometry::{Solid, Vec3};
 use ballast::nscd::d3::rows::read_cycles;
 use ballast::nscd::d3::system::System3;
 use ballast::scenarios::track3d::{self, LoadingSpec, SampleReport, SampleSpec, GRAIN_PREFIX, PAD_PREFIX, SLEEPER};
 use ballast::scene::{Scene3, SceneFile};
-use ballast::studies::track3d::{self as study, Sample, SettleOptions};
+use ballast::studies::track3d::{self as study, SettleOptions};
 use ballast::studies::{Accelerate, Quiet};
-use std::path::PathBuf;
-use std::process::Command;
-use std::sync::OnceLock;
+use track3d_common::{ballast, named, refused, sample, GRAINS, LOAD_DT};
 
-const GRAINS: usize = 24;
 const G: f64 = 9.81;
-/// The loaded runs' step (s): 50 steps per cycle, for a test of seconds.
-const LOAD_DT: f64 = 1e-3;
-
-/// The sample: 24 grains (seed 3) in a 0.12 × 0.1 m box on 4 × 3 pads of 25 mm (the full section's rules on a
-/// box two grains deep), deposited once into a scratch folder; for a test of seconds, dt = 5e-4 s, `quad` 1e-3
-/// and a 100-step rest window (the defaults: 2e-4 s, 1e-3, 500 steps).
-fn sample() -> &'static (PathBuf, Sample) {
-    static SAMPLE: OnceLock<(PathBuf, Sample)> = OnceLock::new();
-    SAMPLE.get_or_init(|| {
-        let dir = scratch::path("sample");
-        let spec = SampleSpec {
-            length: 0.12,
-            width: 0.1,
-            pad_size: 0.025,
-            dt: 5e-4,
-            tolerance: 1e-3,
-            max_iterations: 1000,
-            rest_steps: 100,
-            ..SampleSpec::track(3).scaled(GRAINS)
-        };
-        let s = study::sample(&spec, &dir, false, &Quiet).expect("the deposit runs to equilibrium");
-        (dir, s)
-    })
-}
-
-/// The bodies of `scene` named `prefix` + digits.
-fn named(scene: &Scene3, prefix: &str) -> Vec<usize> {
-    let is = |n: &str| n.strip_prefix(prefix).is_some_and(|r| !r.is_empty() && r.chars().all(|c| c.is_ascii_digit()));
-    scene.bodies.iter().enumerate().filter(|(_, b)| is(&b.name)).map(|(i, _)| i).collect()
-}
 
 /// World vertices of polyhedron body `i`.
 fn vertices(sys: &System3, i: usize) -> Vec<Vec3> {
@@ -321,11 +289,6 @@ fn bad_specs_name_their_field() {
     bad_loading(LoadingSpec { dt: 0.0, ..d }, "dt");
 }
 
-fn ballast(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_ballast")).args(args).output().unwrap();
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stderr).into_owned())
-}
-
 /// The command line refuses bad input on one line naming the flag, exit code 2.
 #[test]
 fn bad_flags_are_named_on_one_line() {
@@ -343,10 +306,7 @@ fn bad_flags_are_named_on_one_line() {
         (&["track3d", "load", "--sample", sample, "--out", out, "--mean-pressure", "inf"], "--mean-pressure:"),
     ];
     for (args, flag) in cases {
-        let (code, err) = ballast(args);
-        assert_eq!(code, 2, "{args:?}: {err}");
-        assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
-        assert!(err.starts_with(&format!("error: {flag}")), "{args:?}: {err}");
+        refused(args, flag);
     }
     let (code, err) = ballast(&["track3d", "load", "--sample", "/nonexistent/sample.toml", "--out", out]);
     assert_eq!(code, 2, "{err}");

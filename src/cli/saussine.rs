@@ -243,7 +243,7 @@ pub struct ReplicaArgs {
     /// starts with every mobile body moved by at most --perturb; 1: the single run.
     #[arg(long, value_name = "R", default_value_t = Replicas::default().count)]
     pub replicas: u64,
-    /// Largest displacement of a body at a replica's start (m), uniform in the disc.
+    /// Largest displacement of a body at a replica's start (m), uniform in the disc (2D) or the ball (3D).
     #[arg(long, value_name = "DIST", default_value_t = DEFAULT_PERTURBATION_M)]
     pub perturb: f64,
     /// Seed of the perturbations (replica r draws from stream r of it).
@@ -373,12 +373,12 @@ impl StudyArgs {
 }
 
 /// `--policies`: POLICY:TOLERANCE pairs.
-fn policies(given: &[String]) -> Result<Vec<(String, f64)>, Failure> {
+pub(crate) fn policies(given: &[String]) -> Result<Vec<(String, f64)>, Failure> {
     given.iter().map(|p| policy("--policies", p)).collect()
 }
 
 /// One POLICY:TOLERANCE pair of `option`.
-fn policy(option: &str, p: &str) -> Result<(String, f64), Failure> {
+pub(crate) fn policy(option: &str, p: &str) -> Result<(String, f64), Failure> {
     let (name, tol) = p
         .split_once(':')
         .ok_or_else(|| input(format!("{option}: expected POLICY:TOLERANCE (e.g. quad:1e-6), got '{p}'")))?;

@@ -6,14 +6,15 @@
 //!   the layer (`sample.json`);
 //! - `load`: write the loaded scene (the sleeper on the layer under `F = A + B cos(2π f t − φ)`);
 //! - `settle`: load a sample and run N cycles (`cycles.csv`), or with `--accelerate` through the settlement
-//!   driver.
+//!   driver, or with `--replicas R` from R perturbed starts side by side (`settlement_ensemble.csv`);
+//! - `convergence`: one loaded run per convergence policy × tolerance × replica (`convergence.csv`).
 //!
 //! The library's messages name its spec fields; [`as_flag`] turns those of this command into its flags.
 
-use super::saussine::AccelerateArgs;
-use super::{input, Bars, Failure};
+use super::saussine::{policies, policy, print_replicas, AccelerateArgs, ReplicaArgs, StudyArgs};
+use super::{input, print_study, Bars, Failure};
 use ballast::scenarios::track3d::{LoadingSpec, SampleSpec};
-use ballast::studies::track3d::{self, Sample, SettleOptions};
+use ballast::studies::track3d::{self, ConvergenceSpec, Sample, SettleOptions};
 use ballast::Error;
 use clap::Subcommand;
 use std::path::PathBuf;
@@ -66,7 +67,35 @@ pub enum Track3dCommand {
     },
     /// Loads a deposited sample and runs the cycles: the sleeper's settlement per cycle (cycles.csv),
     /// series.csv, summary.json, VTK snapshots, figures; with --accelerate, through the settlement driver.
+    /// With --replicas R > 1: R runs from perturbed starts side by side in DIR/runs/replica-<r>/ (their
+    /// starts in DIR/scenes/), and DIR/settlement_ensemble.csv (mean, sd, 95 % CI per cycle).
     Settle(Box<SettleArgs>),
+    /// The cycles of a sample with each convergence policy and tolerance, from R starts each: convergence.csv
+    /// (sweeps per step, steps at the cap, wall time per cycle, overlaps, settlement; the ensemble of each
+    /// setting and its difference from the reference's with Welch's 95 % interval) and figures.
+    /// (--criterion and --tolerance are replaced by those of each run.)
+    Convergence(Box<ConvergenceArgs>),
+}
+
+/// The arguments of `track3d convergence`.
+#[derive(Debug, clap::Args)]
+pub struct ConvergenceArgs {
+    /// A deposited sample (`sample.toml` of `ballast track3d sample`).
+    #[arg(long, value_name = "FILE")]
+    sample: PathBuf,
+    /// Runs as POLICY:TOLERANCE, comma separated.
+    #[arg(long, value_delimiter = ',', default_value = "quad:1e-3,energy:1.66e-5,quad:1e-4")]
+    policies: Vec<String>,
+    /// The setting the others' mean settlements are compared with, POLICY:TOLERANCE (run after them when it is
+    /// not one of them).
+    #[arg(long, value_name = "POLICY:TOL", default_value = "quad:1e-5")]
+    reference: String,
+    #[command(flatten)]
+    replicas: ReplicaArgs,
+    #[command(flatten)]
+    loading: LoadingArgs,
+    #[command(flatten)]
+    study: StudyArgs,
 }
 
 /// The arguments of `track3d settle`.
@@ -86,9 +115,15 @@ pub struct SettleArgs {
     /// Wall-clock seconds between checkpoints.
     #[arg(long, value_name = "SECONDS", default_value_t = 300.0)]
     checkpoint_every: f64,
-    /// Continue a killed run from its checkpoint.
+    /// Continue a killed run from its checkpoint (with --replicas: skip the finished replicas, resume the
+    /// checkpointed ones).
     #[arg(long)]
     resume: bool,
+    #[command(flatten)]
+    replicas: ReplicaArgs,
+    /// Replicas run at once (default: the number of cores; one alone runs on every core).
+    #[arg(long)]
+    jobs: Option<usize>,
     #[command(flatten)]
     accelerate: AccelerateArgs,
     /// No progress bar.
@@ -158,7 +193,7 @@ impl LoadingArgs {
 
 /// The spec fields of this command's library calls and their flags (the shared ones, `dt`, `cycles`, …, are
 /// mapped by `flags.rs` too).
-const FLAGS: [(&str, &str); 15] = [
+const FLAGS: [(&str, &str); 21] = [
     ("grains", "--grains"),
     ("dt", "--dt"),
     ("max_duration", "--max-duration"),
@@ -174,6 +209,12 @@ const FLAGS: [(&str, &str); 15] = [
     ("frequency", "--frequency"),
     ("stiffness_factor", "--stiffness-factor"),
     ("sample", "--sample"),
+    ("replicas", "--replicas"),
+    ("perturbation.distance_m", "--perturb"),
+    ("jobs", "--jobs"),
+    ("policies", "--policies"),
+    ("reference", "--reference"),
+    ("checkpoint_every_s", "--checkpoint-every"),
 ];
 
 /// An input error of the library with its leading spec field replaced by this command's flag; other errors as
@@ -229,11 +270,30 @@ pub fn main(cmd: Track3dCommand) -> Result<(), Failure> {
             println!("wrote {}", out.display());
         }
         Track3dCommand::Settle(args) => {
-            let SettleArgs { sample, out, loading, snapshot_every, checkpoint_every, resume, accelerate, quiet } =
-                *args;
+            let SettleArgs {
+                sample,
+                out,
+                loading,
+                snapshot_every,
+                checkpoint_every,
+                resume,
+                replicas,
+                jobs,
+                accelerate,
+                quiet,
+            } = *args;
             let opts = SettleOptions { snapshot_every, checkpoint_every_s: checkpoint_every, resume };
             let loading = loading.loading();
-            if let Some(acc) = accelerate.accelerate()? {
+            let replicas = replicas.replicas();
+            replicas.check().map_err(as_flag)?;
+            if replicas.count > 1 {
+                if accelerate.accelerate()?.is_some() {
+                    return Err(input("--replicas: not with --accelerate on the 3D section".into()));
+                }
+                let r = track3d::settle_replicas(&sample, &loading, &out, &opts, &replicas, jobs, &Bars::group(quiet))
+                    .map_err(as_flag)?;
+                print_replicas(&r);
+            } else if let Some(acc) = accelerate.accelerate()? {
                 let bar = super::cycle_bar(quiet);
                 let mut show = |p: &ballast::settlement::AccelerationProgress| super::show_cycles(&bar, p);
                 let s = track3d::settle_accelerated(&sample, &loading, &acc, &out, &opts, &mut show).map_err(as_flag);
@@ -242,6 +302,20 @@ pub fn main(cmd: Track3dCommand) -> Result<(), Failure> {
             } else {
                 track3d::settle(&sample, &loading, &out, &opts, &Bars::single(quiet)).map_err(as_flag)?;
             }
+        }
+        Track3dCommand::Convergence(args) => {
+            let ConvergenceArgs { sample, policies: given, reference, replicas, loading, study } = *args;
+            study.options().check().map_err(as_flag)?;
+            let spec = ConvergenceSpec {
+                sample,
+                policies: policies(&given)?,
+                reference: Some(policy("--reference", &reference)?),
+                replicas: replicas.replicas(),
+                loading: loading.loading(),
+            };
+            spec.check().map_err(as_flag)?;
+            let bars = Bars::group(study.quiet);
+            study.run((spec.task_count(), 0), |o| track3d::convergence(&spec, o, &bars), |r| &r.failed, print_study)?;
         }
     }
     Ok(())

@@ -4,21 +4,26 @@
 use super::*;
 use crate::scene::SceneFile;
 
-/// §3.2: the loaded sample under each convergence policy and tolerance.
+/// §3.2: the loaded sample under each convergence policy and tolerance; `L` is
+/// the loading: 2D ([`LoadingSpec`], [`convergence`]) or the 3D track section's
+/// ([`crate::studies::track3d::ConvergenceSpec`], [`crate::studies::track3d::convergence`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct ConvergenceSpec {
-    /// The deposited sample (`sample.toml` of [`crate::studies::saussine::sample`]).
+pub struct ConvergenceSpec<L = LoadingSpec> {
+    /// The deposited sample (`sample.toml` of [`crate::studies::saussine::sample`]
+    /// or [`crate::studies::track3d::sample`]).
     pub sample: PathBuf,
-    /// The runs as `(policy, tolerance)`; empty: the paper's table ([`PAPER_POLICIES`]).
+    /// The runs as `(policy, tolerance)`; empty: in 2D the paper's table
+    /// ([`PAPER_POLICIES`]), in 3D an error.
     pub policies: Vec<(String, f64)>,
-    /// The setting the others are compared with, `(policy, tolerance)`, one of
-    /// the runs; `None`: the tightest tolerance of the `strict` policy among the
-    /// runs, else the tightest tolerance of any policy (the first listed of equals).
+    /// The setting the others are compared with, `(policy, tolerance)`: in 2D one
+    /// of the runs, in 3D run after them when it is not; `None`: the tightest
+    /// tolerance of the `strict` policy among the runs, else the tightest
+    /// tolerance of any policy (the first listed of equals).
     pub reference: Option<(String, f64)>,
     /// The replicas of each setting ([`Replicas::default`]: one, today's single run).
     pub replicas: Replicas,
     /// The loading of every run (its criterion and tolerance replaced by each run's).
-    pub loading: LoadingSpec,
+    pub loading: L,
 }
 
 impl ConvergenceSpec {
@@ -38,7 +43,7 @@ impl ConvergenceSpec {
 }
 
 /// The reference setting of [`ConvergenceSpec::reference`] among `runs`: its index.
-fn reference_of(runs: &[(String, f64)], given: Option<&(String, f64)>) -> Result<usize> {
+pub(crate) fn reference_of(runs: &[(String, f64)], given: Option<&(String, f64)>) -> Result<usize> {
     if let Some((p, t)) = given {
         return runs.iter().position(|(q, u)| q == p && u == t).ok_or_else(|| {
             Error::Scene(format!("reference: {p}:{t:e} is not among the runs of the policies asked for"))
@@ -92,9 +97,31 @@ pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn R
     let Some(outcomes) = run_jobs(&jobs, 0, study, display, &mut failed)? else {
         return Ok(not_summarized(&study.out, failed));
     };
-    let r = spec.replicas.count as usize;
+    let iterations = (base.min_iterations, base.max_iterations);
     let seating = spec.replicas.seating_cycles.min(spec.loading.cycles);
-    let per_setting: Vec<Vec<&Outcome>> = outcomes.chunks(r).map(|c| c.iter().collect()).collect();
+    convergence_summary(&study.out, &runs, reference, &outcomes, &spec.replicas, seating, iterations, failed)
+}
+
+/// The summary of a convergence study in `out` (2D or 3D: [`StudyCycle`]) once its runs ended: `outcomes`
+/// are the runs of the settings `runs` (`(policy, tolerance)`, each `replicas.count` runs in a row), the
+/// setting `reference` the one the others are compared with, `seating` the seating cycle, `iterations` the
+/// runs' `(min_iterations, max_iterations)`: `convergence.csv` and the figures of [`convergence`].
+///
+/// # Errors
+/// An output that cannot be written.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn convergence_summary<C: StudyCycle>(
+    out: &Path,
+    runs: &[(String, f64)],
+    reference: usize,
+    outcomes: &[Outcome<C>],
+    replicas: &Replicas,
+    seating: u64,
+    (min_iterations, max_iterations): (usize, usize),
+    failed: Vec<(String, String)>,
+) -> Result<StudyReport> {
+    let r = replicas.count as usize;
+    let per_setting: Vec<Vec<&Outcome<C>>> = outcomes.chunks(r).map(|c| c.iter().collect()).collect();
     let summaries: Vec<Option<SettlementSummary>> =
         per_setting.iter().map(|o| SettlementSummary::of(&cycles_of(o), seating)).collect();
     let (rp, rt) = &runs[reference];
@@ -105,11 +132,10 @@ pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn R
         let ensemble = ensemble_columns(&per_setting[i], seating);
         let versus = ReferenceColumns::of(&reference_name, summaries[i].as_ref(), summaries[reference].as_ref());
         for (k, o) in per_setting[i].iter().enumerate() {
-            let key = (policy.clone(), *tol, base.min_iterations, base.max_iterations, k);
+            let key = (policy.clone(), *tol, min_iterations, max_iterations, k);
             rows.push((key, run_columns(o), ensemble.clone(), versus.clone()));
         }
     }
-    let out = &study.out;
     let key = ["policy", "tolerance", "min_iterations", "max_iterations", "replica"];
     let rest: Vec<&str> = RUN_COLUMNS.iter().chain(&ENSEMBLE_COLUMNS).chain(&REFERENCE_COLUMNS).copied().collect();
     write_table(&out.join("convergence.csv"), &key, &rest, &rows)?;
@@ -150,7 +176,7 @@ pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn R
         &axes("NLGS iterations per step vs tolerance", "tolerance", "mean sweeps per step", true, false),
         &per_policy,
     )?;
-    let labelled: Vec<(String, Vec<&Outcome>)> =
+    let labelled: Vec<(String, Vec<&Outcome<C>>)> =
         runs.iter().zip(per_setting).map(|((p, t), o)| (format!("{p} {t:e}"), o)).collect();
     settlement_figure(
         out,

@@ -28,6 +28,12 @@
 //! 95 % interval; the figures show the replicas' means with their 95 % bands,
 //! and `settlement_ensemble` the mean settlement per cycle of each setting.
 //!
+//! The runner of the written scenes (`run_written`), the per-run columns and
+//! the convergence summary (`convergence_summary`) are generic over the
+//! engine's `cycles.csv` row (`StudyCycle`): the 3D track section's studies
+//! ([`crate::studies::track3d::convergence`], [`crate::studies::track3d::settle_replicas`])
+//! run on them.
+//!
 //! Layout: `DIR/scenes/<run>.toml` and `DIR/runs/<run>/` (`<run>` is
 //! `<setting>/replica-<r>` with several replicas), each run folder with its
 //! `replica.json`. A run that diverges is
@@ -40,12 +46,13 @@ mod ensemble;
 mod steps;
 
 pub use convergence::{convergence, ConvergenceSpec};
+pub(crate) use convergence::{convergence_summary, reference_of};
 pub use ensemble::{ensemble, EnsembleRow, EnsembleSpec, Spread};
 pub use steps::{steps, StepsSpec};
 
 use super::replicas::{
-    perturb_scene, settlement_ensemble, EnsembleColumns, Estimate, Perturbation, ReferenceColumns, Replicas,
-    SettlementSummary, ENSEMBLE_COLUMNS, REFERENCE_COLUMNS, REPLICA_FILE,
+    perturb_scene, settlement_ensemble, CycleSettlement, EnsembleColumns, Estimate, Perturbation, ReferenceColumns,
+    Replicas, SettlementSummary, ENSEMBLE_COLUMNS, REFERENCE_COLUMNS, REPLICA_FILE,
 };
 use super::saussine::sample;
 use super::tasks::{failures_from_folders, record, Tasks};
@@ -103,8 +110,16 @@ impl StudyOptions {
         }
     }
 
+    /// Checks the options (as every study does before its first run).
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming `checkpoint_every_s` (negative or not finite) or `jobs` (0).
+    pub fn check(&self) -> Result<()> {
+        self.threads().map(drop)
+    }
+
     /// The runs at once (the pool's threads).
-    fn threads(&self) -> Result<usize> {
+    pub(super) fn threads(&self) -> Result<usize> {
         if !(self.checkpoint_every_s.is_finite() && self.checkpoint_every_s >= 0.0) {
             return Err(Error::Scene(format!(
                 "checkpoint_every_s: must be non-negative, got {}",
@@ -188,47 +203,88 @@ pub(super) fn replicate(settings: Vec<Job>, replicas: &Replicas) -> Vec<Job> {
     settings
         .into_iter()
         .flat_map(|job| {
-            (0..replicas.count).map(move |r| Job {
-                label: format!("{}/replica-{r}", job.label),
+            replica_labels(&job.label, replicas).into_iter().enumerate().map(move |(r, label)| Job {
+                label,
                 source: job.source.clone(),
-                replica: r,
+                replica: r as u64,
                 perturbation: replicas.perturbation,
             })
         })
         .collect()
 }
 
-impl Job {
-    pub(super) fn scene(&self, study: &Path) -> PathBuf {
-        study.join("scenes").join(format!("{}.toml", self.label))
-    }
-    pub(super) fn dir(&self, study: &Path) -> PathBuf {
-        study.join("runs").join(&self.label)
+/// The labels of `replicas.count` runs of the setting `label`: the label alone
+/// for one replica, else `<label>/replica-<r>`.
+pub(crate) fn replica_labels(label: &str, replicas: &Replicas) -> Vec<String> {
+    match replicas.count {
+        1 => vec![label.to_string()],
+        n => (0..n).map(|r| format!("{label}/replica-{r}")).collect(),
     }
 }
 
-/// What a finished (or diverged) run left: its report, series and cycles.
-pub(super) struct Outcome {
+impl Job {
+    pub(super) fn scene(&self, study: &Path) -> PathBuf {
+        scene_path(study, &self.label)
+    }
+    pub(super) fn dir(&self, study: &Path) -> PathBuf {
+        run_dir(study, &self.label)
+    }
+}
+
+/// The scene of the run `label` of the study in `study`: `DIR/scenes/<label>.toml`.
+pub(crate) fn scene_path(study: &Path, label: &str) -> PathBuf {
+    study.join("scenes").join(format!("{label}.toml"))
+}
+
+/// The folder of the run `label` of the study in `study`: `DIR/runs/<label>`.
+pub(crate) fn run_dir(study: &Path, label: &str) -> PathBuf {
+    study.join("runs").join(label)
+}
+
+/// What a finished (or diverged) run left: its report, series and cycles
+/// (`C`: the row of its engine's `cycles.csv`, 2D by default).
+pub(crate) struct Outcome<C = CycleRow> {
     pub(super) status: String,
     pub(super) report: Option<RunReport>,
+    /// `series.csv`, read by column name: the 3D engine's has the 2D one's
+    /// columns with their meanings ([`crate::nscd::d3::rows`]).
     pub(super) series: Vec<SeriesRow>,
-    pub(super) cycles: Vec<CycleRow>,
+    pub(super) cycles: Vec<C>,
+}
+
+/// A row of `cycles.csv` as the studies' summaries read it: the settlement at
+/// the load minimum ([`CycleSettlement`]) and averaged over the cycle.
+pub(crate) trait StudyCycle: CycleSettlement + serde::de::DeserializeOwned {
+    /// The settlement averaged over the cycle's steps (m, positive downwards).
+    fn settlement_mean(&self) -> f64;
+}
+
+impl StudyCycle for CycleRow {
+    fn settlement_mean(&self) -> f64 {
+        self.settlement_mean_m
+    }
+}
+
+impl StudyCycle for crate::nscd::d3::rows::CycleRow3 {
+    fn settlement_mean(&self) -> f64 {
+        self.settlement_mean_m
+    }
 }
 
 /// The cycles of the runs `outcomes`.
-pub(super) fn cycles_of<'a>(outcomes: &[&'a Outcome]) -> Vec<&'a [CycleRow]> {
+pub(super) fn cycles_of<'a, C>(outcomes: &[&'a Outcome<C>]) -> Vec<&'a [C]> {
     outcomes.iter().map(|o| o.cycles.as_slice()).collect()
 }
 
 /// The ensemble columns of the replicas `outcomes` of one setting.
-fn ensemble_columns(outcomes: &[&Outcome], seating: u64) -> EnsembleColumns {
+fn ensemble_columns<C: CycleSettlement>(outcomes: &[&Outcome<C>], seating: u64) -> EnsembleColumns {
     SettlementSummary::of(&cycles_of(outcomes), seating)
         .map_or(EnsembleColumns { replicas: outcomes.len(), ..EnsembleColumns::default() }, |s| s.columns())
 }
 
 /// Mean over the runs `outcomes` of `f` of their series rows (row by row, up to
 /// the shortest run), against time, and its 95 % band (none for one run).
-fn mean_curve(outcomes: &[&Outcome], label: String, f: fn(&SeriesRow) -> f64, scale: f64) -> Series {
+fn mean_curve<C>(outcomes: &[&Outcome<C>], label: String, f: fn(&SeriesRow) -> f64, scale: f64) -> Series {
     let n = outcomes.iter().map(|o| o.series.len()).min().unwrap_or(0);
     let mut series = Series { label, ..Series::default() };
     for k in 0..n {
@@ -246,11 +302,11 @@ fn mean_curve(outcomes: &[&Outcome], label: String, f: fn(&SeriesRow) -> f64, sc
 /// The mean settlement per cycle of each setting (`(label, its runs)`), each
 /// with its 95 % band, in `DIR/<name>` (PNG and SVG), behind them the curves
 /// `behind` (e.g. every replica, thin).
-pub(super) fn settlement_figure(
+pub(super) fn settlement_figure<C: CycleSettlement>(
     out: &Path,
     name: &str,
     title: &str,
-    settings: &[(String, Vec<&Outcome>)],
+    settings: &[(String, Vec<&Outcome<C>>)],
     seating: u64,
     behind: &[Series],
 ) -> Result<()> {
@@ -318,7 +374,7 @@ pub(super) fn run_jobs(
     failed: &mut Vec<(String, String)>,
 ) -> Result<Option<Vec<Outcome>>> {
     let out = &study.out;
-    let threads = study.threads()?;
+    study.threads()?; // the options checked before any scene is written
     let runs = |j: usize| study.tasks.runs(first + j as u64);
     for dir in ["scenes", "runs"] {
         io::create_output_dir(&out.join(dir))?;
@@ -354,13 +410,38 @@ pub(super) fn run_jobs(
         io::create_output_dir(&job.dir(out))?;
         io::write_json(&job.dir(out).join(REPLICA_FILE), &record)?;
     }
+    let labels: Vec<String> = jobs.iter().map(|j| j.label.clone()).collect();
+    run_written(&labels, first, study, 0, display, failed, crate::plane::rows::read_cycles)
+}
+
+/// Runs the study's runs `labels` (task `first + j` is run `j`) that `study.tasks` selects, `study.jobs` at a
+/// time, each from its scene `DIR/scenes/<label>.toml` (written by the caller) in `DIR/runs/<label>/`; the
+/// failed runs are added to `failed`. Then, for an invocation that writes the summary, reads back the outcome
+/// of every run from its folder (its `cycles.csv` by `read_cycles`). A VTK snapshot every `vtk_every` steps of
+/// each run (0: none).
+///
+/// # Errors
+/// An invalid scene or checkpoint; with the summary, a run without a finished run (named).
+pub(crate) fn run_written<C: StudyCycle>(
+    labels: &[String],
+    first: u64,
+    study: &StudyOptions,
+    vtk_every: u64,
+    display: &dyn RunDisplay,
+    failed: &mut Vec<(String, String)>,
+    read_cycles: fn(&Path) -> Result<Vec<C>>,
+) -> Result<Option<Vec<Outcome<C>>>> {
+    let out = &study.out;
+    let threads = study.threads()?;
+    let runs = |j: usize| study.tasks.runs(first + j as u64);
     let pool = pool(threads)?;
     let side_by_side = if study.tasks.side_by_side() { threads } else { 1 };
     let results: Vec<Result<()>> = pool.install(|| {
-        jobs.par_iter()
+        labels
+            .par_iter()
             .enumerate()
-            .map(|(j, job)| {
-                let dir = job.dir(out);
+            .map(|(j, label)| {
+                let dir = run_dir(out, label);
                 // summary.json: a diverged run is finished too (and reported as such).
                 let prior = Prior::of(&dir, layout::SUMMARY, study.resume);
                 if !runs(j) || prior == Prior::Finished {
@@ -369,38 +450,38 @@ pub(super) fn run_jobs(
                 let opts = RunOptions {
                     checkpoint_every_s: study.checkpoint_every_s,
                     resume: prior == Prior::Checkpointed,
+                    vtk_every,
                     figures: true,
                     threads: run_threads(side_by_side),
                     ..RunOptions::default()
                 };
-                let result = run_scene(&job.scene(out), &dir, &opts, display, &job.label).map(|_| ());
+                let result = run_scene(&scene_path(out, label), &dir, &opts, display, label).map(|_| ());
                 record(&dir, &result)?;
                 result
             })
             .collect()
     });
-    for (job, result) in jobs.iter().zip(results) {
+    for (label, result) in labels.iter().zip(results) {
         match result {
             Ok(()) => {}
             Err(e) if e.is_input() => return Err(e),
             // A diverged run still wrote its series and summary: kept in the study.
-            Err(e) => failed.push((job.label.clone(), e.to_string())),
+            Err(e) => failed.push((label.clone(), e.to_string())),
         }
     }
     if !study.tasks.summarizes() {
         return Ok(None);
     }
     // The ends recorded in the folders, whichever invocation ran each job.
-    let folders: Vec<(String, PathBuf)> = jobs.iter().map(|j| (j.label.clone(), j.dir(out))).collect();
+    let folders: Vec<(String, PathBuf)> = labels.iter().map(|l| (l.clone(), run_dir(out, l))).collect();
     let ends = failures_from_folders(&folders)?;
     failed.clear();
-    let mut outcomes = Vec::with_capacity(jobs.len());
-    for (job, end) in jobs.iter().zip(ends) {
-        let dir = job.dir(out);
+    let mut outcomes = Vec::with_capacity(labels.len());
+    for ((label, dir), end) in folders.into_iter().zip(ends) {
         let status = match end {
             None => "ok".to_string(),
             Some(e) => {
-                failed.push((job.label.clone(), e.clone()));
+                failed.push((label, e.clone()));
                 format!("failed: {e}")
             }
         };
@@ -409,7 +490,7 @@ pub(super) fn run_jobs(
             .and_then(|t| serde_json::from_str::<RunReport>(&t).ok());
         let series = crate::plane::rows::read_series(&dir.join(layout::SERIES)).unwrap_or_default();
         let cycles_path = dir.join(layout::CYCLES);
-        let cycles = if cycles_path.exists() { crate::plane::rows::read_cycles(&cycles_path)? } else { vec![] };
+        let cycles = if cycles_path.exists() { read_cycles(&cycles_path)? } else { vec![] };
         outcomes.push(Outcome { status, report, series, cycles });
     }
     Ok(Some(outcomes))
@@ -466,7 +547,7 @@ const RUN_COLUMNS: [&str; 12] = [
     "status",
 ];
 
-fn run_columns(o: &Outcome) -> RunColumns {
+fn run_columns<C: StudyCycle>(o: &Outcome<C>) -> RunColumns {
     let nan = f64::NAN;
     let r = o.report.as_ref();
     let last = o.cycles.last();
@@ -479,9 +560,9 @@ fn run_columns(o: &Outcome) -> RunColumns {
         mean_overlap_m: r.map_or(nan, |r| r.mean_overlap_m),
         max_overlap_m: r.map_or(nan, |r| r.max_overlap_m),
         final_total_overlap_m: o.series.last().map_or(nan, |s| s.total_overlap_m),
-        cycles: last.map_or(0, |c| c.cycle),
-        settlement_mean_m: last.map_or(nan, |c| c.settlement_mean_m),
-        settlement_at_min_load_m: last.map_or(nan, |c| c.settlement_at_min_load_m),
+        cycles: last.map_or(0, |c| c.cycle()),
+        settlement_mean_m: last.map_or(nan, |c| c.settlement_mean()),
+        settlement_at_min_load_m: last.map_or(nan, |c| c.settlement_at_min_load()),
         status: o.status.clone(),
     }
 }

@@ -38,9 +38,10 @@ pub struct SettlementEnsembleRow {
 }
 
 /// A row of a run's per-cycle table with the settlement at the cycle's end, the
-/// load minimum: `cycles.csv` of a plain run ([`PlaneCycleRow`]), `settlement.csv`
-/// of an accelerated one ([`SettlementRow`]: computed cycles measured there, the
-/// extrapolated ones on the fitted law).
+/// load minimum: `cycles.csv` of a plain 2D run ([`PlaneCycleRow`]) or of a 3D
+/// NSCD run ([`CycleRow3`]), `settlement.csv` of an accelerated one
+/// ([`SettlementRow`]: computed cycles measured there, the extrapolated ones on
+/// the fitted law).
 pub trait CycleSettlement {
     /// The loading cycle (1 for the first).
     fn cycle(&self) -> u64;
@@ -54,6 +55,23 @@ impl CycleSettlement for PlaneCycleRow {
     }
     fn settlement_at_min_load(&self) -> f64 {
         self.settlement_at_min_load_m
+    }
+}
+
+/// The 3D engine writes the settlement at the cycle's end (`settlement_m`). On
+/// the 3D track section ([`crate::scenarios::track3d::LoadingSpec`]) the load is
+/// `F = A + B cos(2π f t − φ)` with `A = −4 kPa`, `B = −2 kPa` (times the
+/// sleeper's area, downwards) and `φ = −π` by default, so that at the end of
+/// cycle `n` (`t = n / f`, the cycles counted from the loaded run's start) `F = A
+/// − B = −2 kPa`: the load's smallest magnitude (its largest, `A + B`, is at
+/// mid-cycle). With that default phase the cycle's end is the load minimum, as
+/// the trait asks; with another phase it is only the cycle's end.
+impl CycleSettlement for CycleRow3 {
+    fn cycle(&self) -> u64 {
+        self.cycle
+    }
+    fn settlement_at_min_load(&self) -> f64 {
+        self.settlement_m
     }
 }
 

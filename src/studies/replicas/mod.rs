@@ -16,8 +16,10 @@
 //!   same `(seed, r)` always gives the same scene. The bodies draw in the
 //!   scene's order, mobile bodies only. The angle and the velocities are not
 //!   touched. What was done is recorded in each run folder as
-//!   [`REPLICA_FILE`] ([`ReplicaRecord`]). The 3D (MD) scenes have the same
-//!   with a displacement uniform in the ball ([`perturb_md_scene`], [`ball_point`]).
+//!   [`REPLICA_FILE`] ([`ReplicaRecord`]). The 3D scenes have the same with a
+//!   displacement uniform in the ball ([`ball_point`]): MD scenes
+//!   ([`perturb_md_scene`], every sphere) and NSCD scenes of polyhedra
+//!   ([`perturb_scene3`], every mobile body; the 3D track section).
 //! - **Statistics of the mean** ([`Estimate`]): mean, sample standard deviation
 //!   (divisor `R − 1`) and the 95 % confidence interval of the mean,
 //!   `mean ± t_{0.975, R−1} · sd / √R` (Student's t quantile from `statrs`,
@@ -29,8 +31,9 @@
 //!   or more on each side.
 //! - **Seating and accrued settlement** ([`settlement_ensemble`],
 //!   [`SettlementSummary`]): from each replica's `cycles.csv`
-//!   ([`PlaneCycleRow::settlement_at_min_load_m`], the settlement at the load
-//!   minimum of each cycle), the seating is the settlement at cycle `S`
+//!   ([`PlaneCycleRow::settlement_at_min_load_m`] in 2D,
+//!   [`CycleRow3::settlement_m`] in 3D: the settlement at the load minimum of
+//!   each cycle, [`CycleSettlement`]), the seating is the settlement at cycle `S`
 //!   ([`DEFAULT_SEATING_CYCLES`], clipped to the cycles run; `S = 0` is the
 //!   start, where the settlement is 0) and the accrued settlement of cycle
 //!   `n ≥ S` is `settlement(n) − settlement(S)`, computed per replica and then
@@ -53,8 +56,9 @@ pub use ensemble::*;
 pub use stats::*;
 
 use crate::error::{Error, Result};
+use crate::nscd::d3::rows::CycleRow3;
 use crate::plane::rows::PlaneCycleRow;
-use crate::scene::{MdScene, Scene};
+use crate::scene::{MdScene, Scene, Scene3};
 use crate::settlement::SettlementRow;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -216,20 +220,46 @@ pub fn perturb_scene(scene: &mut Scene, perturbation: &Perturbation, replica: u6
 /// # Errors
 /// [`Error::Scene`] for an invalid perturbation ([`Perturbation::check`]).
 pub fn perturb_md_scene(scene: &mut MdScene, perturbation: &Perturbation, replica: u64) -> Result<ReplicaRecord> {
+    perturb_in_ball(scene.bodies.iter_mut().map(|b| &mut b.position), perturbation, replica)
+}
+
+/// [`perturb_scene`] for a 3D NSCD scene (polyhedra, the track section of
+/// [`crate::scenarios::track3d`]): replica `r ≥ 1` moves the position of every
+/// mobile (not fixed) body by a displacement uniform in the ball of radius
+/// [`Perturbation::distance_m`] ([`ball_point`], drawn in the scene's order,
+/// mobile bodies only, from [`Perturbation::rng`]); fixed bodies, orientations,
+/// velocities and spins are not touched; replica 0 is left as it is. The same
+/// `(seed, r)` gives the same scene.
+///
+/// # Errors
+/// [`Error::Scene`] for an invalid perturbation ([`Perturbation::check`]).
+pub fn perturb_scene3(scene: &mut Scene3, perturbation: &Perturbation, replica: u64) -> Result<ReplicaRecord> {
+    let mobile = scene.bodies.iter_mut().filter(|b| !b.is_fixed()).map(|b| &mut b.position);
+    perturb_in_ball(mobile, perturbation, replica)
+}
+
+/// Moves each of `positions` (in order) by a displacement uniform in the ball
+/// of [`Perturbation::distance_m`] drawn from stream `replica`; none for
+/// replica 0. The record of what was done.
+fn perturb_in_ball<'a>(
+    positions: impl Iterator<Item = &'a mut [f64; 3]>,
+    perturbation: &Perturbation,
+    replica: u64,
+) -> Result<ReplicaRecord> {
     perturbation.check()?;
     let mut record = ReplicaRecord::unmoved(perturbation, replica);
     if replica == 0 {
         return Ok(record);
     }
     let mut rng = perturbation.rng(replica);
-    for body in &mut scene.bodies {
+    for position in positions {
         let d = ball_point(&mut rng, perturbation.distance_m);
-        for (p, d) in body.position.iter_mut().zip(d) {
+        for (p, d) in position.iter_mut().zip(d) {
             *p += d;
         }
         record.largest_displacement_m = record.largest_displacement_m.max(d[0].hypot(d[1]).hypot(d[2]));
+        record.bodies_moved += 1;
     }
-    record.bodies_moved = scene.bodies.len();
     Ok(record)
 }
 

@@ -11,11 +11,25 @@
 //!   `summary.json`, VTK snapshots every few cycles;
 //! - [`settle_accelerated`]: the same loaded scene through the settlement driver (Karrech et al. 2007, Fig. 10),
 //!   as the 2D [`super::saussine::settle_accelerated`]; its jumps land through the 3D engine's relaxation
-//!   (`crate::space::relax`).
+//!   (`crate::space::relax`);
+//! - [`settle_replicas`] (`replicas.rs`): [`settle`] from several starts, replica 0 the sample as it is and the
+//!   others with every mobile body moved by at most a small distance ([`crate::studies::replicas::perturb_scene3`]),
+//!   side by side, and the ensemble's settlement per cycle with its 95 % interval (`settlement_ensemble.csv`), as
+//!   the 2D [`super::saussine::settle_replicas`];
+//! - [`convergence`] (`convergence.rs`): one loaded run per convergence policy × tolerance × replica and
+//!   `convergence.csv` (sweeps, steps at the cap, wall time, overlaps, settlement; the ensemble of each setting and
+//!   its difference from a reference setting with Welch's 95 % interval), as the 2D
+//!   [`super::campaigns::convergence`].
 //!
 //! The runs go on [`crate::run::default_threads`] threads (the 3D contact solve splits in two halves on two; the
 //! numbers do not depend on it) and end with the 3D figures (`crate::report`: energies, overlaps, settlement per
 //! cycle, a vertical cut with the force chains).
+
+mod convergence;
+mod replicas;
+
+pub use convergence::{convergence, ConvergenceSpec, DEFAULT_POLICIES, DEFAULT_REFERENCE};
+pub use replicas::settle_replicas;
 
 use super::{output_error, run_scene, write_file, Accelerate, RunDisplay};
 use crate::error::Result;
@@ -143,7 +157,7 @@ pub fn settle(
 ) -> Result<RunOutcome> {
     let scene = loaded(sample, loading)?;
     let path = write_loaded(sample, &scene, out, opts.resume, "")?;
-    let per_cycle = (1.0 / (loading.frequency * loading.dt)).round().max(1.0) as u64;
+    let per_cycle = super::saussine::steps_per_cycle(loading.frequency, loading.dt);
     let run = RunOptions {
         checkpoint_every_s: opts.checkpoint_every_s,
         resume: opts.resume,
