@@ -2,12 +2,14 @@
 //! (angular momentum, its drift under the explicit gyroscopic term and the drift's order), a cube resting on a
 //! floor (the floor carries its weight, the moments balance), a block on an incline (sticking below
 //! `tan α = μ`, sliding above at `g (sin α − μ cos α)`), a column of cubes (each interface carries the weight
-//! above it), a sphere on a polyhedral floor, and a cube dropped on a floor coming to rest without sinking.
+//! above it), a sphere on a polyhedral floor, and a cube dropped on a floor coming to rest without sinking. The
+//! incline and the column also under the accelerated projected gradient (`solver = "apgd"`); the interior
+//! point refused.
 
 use ballast::geometry::{Polyhedron, Pose, Solid, Vec3};
 use ballast::nscd::contact::ContactLaw;
 use ballast::nscd::d3::system::{Params3, System3};
-use ballast::nscd::method::{NlgsSettings, Policy};
+use ballast::nscd::method::{NlgsSettings, Policy, Solver};
 use ballast::space::bodies::BodyInfo;
 use nalgebra::UnitQuaternion;
 
@@ -21,8 +23,18 @@ fn cuboid(half: [f64; 3]) -> Solid {
 /// A system with one material of friction `mu`, gravity `gravity`, a tight solve (`quad` 1e-8, so that the
 /// balances below are judged against the mechanics and not the stopping rule).
 fn system(dt: f64, gravity: Vec3, mu: f64) -> System3 {
-    let nlgs =
-        NlgsSettings { policy: Policy::Quad, tolerance: 1e-8, max_iterations: 20_000, ..NlgsSettings::default() };
+    system_with(dt, gravity, mu, Solver::Nlgs)
+}
+
+/// [`system`] solved by `solver` (Gauss–Seidel, or the accelerated projected gradient: `solver = "apgd"`).
+fn system_with(dt: f64, gravity: Vec3, mu: f64, solver: Solver) -> System3 {
+    let nlgs = NlgsSettings {
+        policy: Policy::Quad,
+        tolerance: 1e-8,
+        max_iterations: 20_000,
+        solver,
+        ..NlgsSettings::default()
+    };
     let mut sys = System3::new(Params3 { dt, gravity, alert_distance: 1e-3, nlgs, ..Params3::default() }, 1);
     sys.set_law(0, 0, ContactLaw { friction: mu, ..ContactLaw::default() });
     sys
@@ -101,17 +113,27 @@ fn a_cube_resting_on_a_floor_is_carried_by_it() {
 /// normal impulse per step is exactly `m g cos α h`, the friction impulse `μ` times it).
 #[test]
 fn a_block_on_an_incline_sticks_below_the_friction_angle_and_slides_above_it() {
+    block_on_an_incline(Solver::Nlgs);
+}
+
+/// The same under APGD (the 3D law's friction disc in its projection): the same closed forms.
+#[test]
+fn apgd_a_block_on_an_incline_sticks_below_the_friction_angle_and_slides_above_it() {
+    block_on_an_incline(Solver::Apgd);
+}
+
+fn block_on_an_incline(solver: Solver) {
     let mu = 0.5;
     let run = |alpha: f64| {
         let gravity = G * Vec3::new(alpha.sin(), 0.0, -alpha.cos());
-        let mut sys = system(1e-3, gravity, mu);
+        let mut sys = system_with(1e-3, gravity, mu, solver);
         floor(&mut sys);
         let half = [0.1, 0.05, 0.02];
         let block = BodyInfo::mobile("block", cuboid(half), 0, RHO).unwrap();
         sys.bodies.push(block, Pose::at(Vec3::new(0.0, 0.0, half[2])), [0.0; 6]);
         let steps = 500;
         for _ in 0..steps {
-            sys.step().unwrap();
+            assert!(sys.step().unwrap().nlgs.converged, "every step meets the tolerance");
         }
         (sys.bodies.u[1][0], steps as f64 * 1e-3)
     };
@@ -130,7 +152,30 @@ fn a_block_on_an_incline_sticks_below_the_friction_angle_and_slides_above_it() {
 /// carries the weight of the cubes from `k` up, `(N − k) m g`; Gauss–Seidel reaches it by iterating.
 #[test]
 fn a_column_of_cubes_carries_the_weight_above_each_interface() {
-    let mut sys = system(1e-3, Vec3::new(0.0, 0.0, -G), 0.3);
+    column_of_cubes(Solver::Nlgs);
+}
+
+/// The same under APGD; the stack needs more than the 50 Gauss–Seidel sweeps APGD starts with (measured 431
+/// sweep-equivalents in the worst step), so the accelerated iterations are what is judged.
+#[test]
+fn apgd_a_column_of_cubes_carries_the_weight_above_each_interface() {
+    let most = column_of_cubes(Solver::Apgd);
+    assert!(most > 50, "at most {most} sweep-equivalents: APGD never ran past its first Gauss–Seidel sweeps");
+}
+
+/// The interior point is a 2D solver (a polyhedral cone's LCP): a 3D system built by hand refuses it before the
+/// first step, naming the key, and keeps its state.
+#[test]
+fn the_interior_point_is_refused_in_3d() {
+    let mut sys = system_with(1e-3, Vec3::new(0.0, 0.0, -G), 0.3, Solver::InteriorPoint);
+    let err = sys.step().unwrap_err().to_string();
+    assert!(err.contains("nscd.solver") && err.contains("interior_point"), "{err}");
+    assert_eq!(sys.steps, 0);
+}
+
+/// The column's check; returns the most sweeps (or sweep-equivalents) a step took.
+fn column_of_cubes(solver: Solver) -> usize {
+    let mut sys = system_with(1e-3, Vec3::new(0.0, 0.0, -G), 0.3, solver);
     floor(&mut sys);
     let (half, n) = (0.05, 5);
     let mut weight = 0.0;
@@ -139,8 +184,11 @@ fn a_column_of_cubes_carries_the_weight_above_each_interface() {
         weight = cube.mass * G;
         sys.bodies.push(cube, Pose::at(Vec3::new(0.0, 0.0, half * (2 * k + 1) as f64)), [0.0; 6]);
     }
+    let mut most = 0;
     for _ in 0..300 {
-        sys.step().unwrap();
+        let stats = sys.step().unwrap();
+        assert!(stats.nlgs.converged, "{stats:?}");
+        most = most.max(stats.nlgs.iterations);
     }
     // The tolerance: quad 1e-8 on the impulses leaves at most ~1e-8 relative per interface once summed over
     // the four points (measured 1e-9); 1e-6 stays far above it and far below one cube's weight.
@@ -155,6 +203,7 @@ fn a_column_of_cubes_carries_the_weight_above_each_interface() {
         let expected = (n - k) as f64 * weight;
         assert!((carried - expected).abs() < 1e-6 * expected, "under cube {k}: {carried} N, expected {expected} N");
     }
+    most
 }
 
 /// A sphere resting on a fixed polyhedral floor (a box) is carried by one point straight under its centre.
