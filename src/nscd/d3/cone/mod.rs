@@ -13,8 +13,9 @@
 //! `P_N = r / D(d)` with `r = c − U_free_N`, `D(d) = W_NN − μ W_NT·d`, and the slip velocity `U_T` must be a
 //! positive multiple of `d`. Multiplied by `D`, the condition `d × U_T = 0` is a trigonometric polynomial of
 //! degree 2 in `θ`, `g(θ)`. Its root is found by Newton in `θ` (the iterate rotated, no trigonometric
-//! functions) from the sticking solution's friction direction; if that fails (no convergence, or a root with
-//! `D ≤ 0` or `U_T` against `d`), all roots are enumerated: on each half circle `g` times `(1 + t²)²` is a
+//! functions) from the row's last slip in the sweeps ([`solve_near`]), else from the sticking solution's
+//! friction direction; if that fails (no convergence, or a root with `D ≤ 0` or `U_T` against `d`), all
+//! roots are enumerated: on each half circle `g` times `(1 + t²)²` is a
 //! quartic in `t = tan(φ/2)`, `|t| ≤ 1`, whose real roots are isolated between the roots of its derivatives
 //! and bracketed; each is polished by the same Newton and checked. LMGC90's `nlgs_3D` instead runs a
 //! Newton on Alart–Curnier's function (`mu_NG_solver_`, ≤ 15 undamped steps) or, in its diagonal resolution,
@@ -121,7 +122,8 @@ pub fn solve_near(
         }
     }
     let s = Slide::new(m, a, r, mu);
-    // Slip direction guess: the last slip, else opposite to the sticking friction, else along the frictionless slip velocity.
+    // Slip direction guess: the last slip, else opposite to the sticking friction, else along the frictionless
+    // slip velocity.
     let sliding_before = previous[0] > 0.0 && len2(previous[1], previous[2]) >= (1.0 - 1e-9) * mu * previous[0];
     let guess = match stick {
         _ if sliding_before => [-previous[1], -previous[2]],
