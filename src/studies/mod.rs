@@ -99,6 +99,23 @@ pub(crate) fn write_file(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).map_err(|e| crate::io::io_error(path, "write", e))
 }
 
+/// Writes `scene` to `path` as TOML under a header line naming the build, the `study` that wrote it and `what`
+/// it is (control characters of `what` shown as `?`); the error names the file.
+pub(crate) fn write_scene_file(
+    path: &Path,
+    scene: &impl crate::scene::SceneFile,
+    study: &str,
+    what: &str,
+) -> Result<()> {
+    let text = format!(
+        "# Written by ballast {} ({study}): {}.\n\n{}",
+        env!("CARGO_PKG_VERSION"),
+        what.replace(char::is_control, "?"),
+        scene.to_toml_string()?
+    );
+    write_file(path, &text)
+}
+
 /// The axes of a line chart.
 pub(crate) fn axes(title: &str, x: &str, y: &str, log_x: bool, log_y: bool) -> Axes {
     Axes { title: title.into(), x_label: x.into(), y_label: y.into(), log_x, log_y }

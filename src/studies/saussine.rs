@@ -23,7 +23,7 @@ use super::replicas::{
     perturb_scene, settlement_ensemble, CycleSettlement, Replicas, SettlementEnsembleRow, Start, REPLICA_FILE,
 };
 use super::tasks::{failures_from_folders, Tasks};
-use super::{output_error, run_scene, write_file, RunDisplay};
+use super::{output_error, run_scene, write_scene_file, RunDisplay};
 use crate::error::{Error, Result};
 use crate::io;
 use crate::io::figures::Series;
@@ -41,13 +41,7 @@ use std::path::{Path, PathBuf};
 /// # Errors
 /// [`Error::Io`] naming the file.
 pub fn write_scene(path: &Path, scene: &Scene, what: &str) -> Result<()> {
-    let text = format!(
-        "# Written by ballast {} (Saussine et al. 2006 experiments): {}.\n\n{}",
-        env!("CARGO_PKG_VERSION"),
-        what.replace(char::is_control, "?"),
-        scene.to_toml_string()?
-    );
-    write_file(path, &text)
+    write_scene_file(path, scene, "Saussine et al. 2006 experiments", what)
 }
 
 /// A deposited sample: its scene and what `sample.json` records.

@@ -31,7 +31,7 @@ mod replicas;
 pub use convergence::{convergence, ConvergenceSpec, DEFAULT_POLICIES, DEFAULT_REFERENCE};
 pub use replicas::settle_replicas;
 
-use super::{output_error, run_scene, write_file, Accelerate, RunDisplay};
+use super::{output_error, run_scene, write_scene_file, Accelerate, RunDisplay};
 use crate::error::Result;
 use crate::io;
 use crate::io::layout;
@@ -45,13 +45,7 @@ use std::path::{Path, PathBuf};
 /// # Errors
 /// [`crate::Error::Io`] naming the file.
 pub fn write_scene(path: &Path, scene: &Scene3, what: &str) -> Result<()> {
-    let text = format!(
-        "# Written by ballast {} (3D track section, Saussine et al. 2006 in 3D): {}.\n\n{}",
-        env!("CARGO_PKG_VERSION"),
-        what.replace(char::is_control, "?"),
-        scene.to_toml_string()?
-    );
-    write_file(path, &text)
+    write_scene_file(path, scene, "3D track section, Saussine et al. 2006 in 3D", what)
 }
 
 /// A deposited section: its scene and what `sample.json` records.
