@@ -109,9 +109,14 @@ impl ContactRow3 {
         }
     }
 
-    /// The normal relative velocity `U_N` (m/s).
+    /// The normal relative velocity `U_N` (m/s), the first component of [`Self::local_velocity`].
     #[inline(always)]
-    fn normal_velocity(&self, ua: &Dofs6, ub: &Dofs6) -> f64 {
+    pub fn normal_velocity(&self, u: &[Dofs6]) -> f64 {
+        self.normal_of(&u[self.a as usize], &u[self.b as usize])
+    }
+
+    #[inline(always)]
+    fn normal_of(&self, ua: &Dofs6, ub: &Dofs6) -> f64 {
         let dv = [ua[0] - ub[0], ua[1] - ub[1], ua[2] - ub[2]];
         dot3(&self.n, &dv) + dot3(&self.an_a, &ua[3..]) - dot3(&self.an_b, &ub[3..])
     }
@@ -122,7 +127,7 @@ impl ContactRow3 {
         let (ua, ub) = (&u[self.a as usize], &u[self.b as usize]);
         let dv = [ua[0] - ub[0], ua[1] - ub[1], ua[2] - ub[2]];
         let tangent = |k: usize| dot3(&self.t[k], &dv) + dot3(&self.at_a[k], &ua[3..]) - dot3(&self.at_b[k], &ub[3..]);
-        [self.normal_velocity(ua, ub), tangent(0), tangent(1)]
+        [self.normal_of(ua, ub), tangent(0), tangent(1)]
     }
 
     /// Adds `sign · M⁻¹ H p` to the candidate and subtracts it from the antagonist.
@@ -188,7 +193,7 @@ impl Row for ContactRow3 {
         if self.p == [0.0; 3] {
             // An open point that stays open (most of a packing's points within the alert distance): its normal
             // velocity alone decides it, and nothing changes — the law, the update and the norms all give zero.
-            let un = self.normal_velocity(&u[self.a as usize], &u[self.b as usize]);
+            let un = self.normal_velocity(u);
             if un >= self.s_open || self.c_closed - un <= 0.0 {
                 return;
             }
@@ -269,7 +274,7 @@ impl ConeRow for ContactRow3 {
         if self.s_open >= self.c_closed {
             return self.c_closed;
         }
-        let u0n = ContactRow3::local_velocity(self, u)[0] - self.w.apply(self.p)[0];
+        let u0n = self.normal_velocity(u) - self.w.apply(self.p)[0];
         if u0n < self.s_open {
             self.c_closed
         } else {

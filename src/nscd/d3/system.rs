@@ -459,7 +459,7 @@ impl System3 {
         let th = self.params.theta * self.params.dt;
         let (mut active, mut sum, mut max) = (0, 0.0, 0.0f64);
         for (row, g) in self.rows.iter().zip(&self.geometry) {
-            let gap_end = g.3 + th * row.local_velocity(&self.u)[0];
+            let gap_end = g.3 + th * row.normal_velocity(&self.u);
             let overlap = (-gap_end).max(0.0);
             if row.p[0] > 0.0 || overlap > 0.0 {
                 active += 1;
