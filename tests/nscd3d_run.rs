@@ -14,7 +14,7 @@ use ballast::nscd::contact::ContactLaw;
 use ballast::nscd::d3::rows::{read_cycles, read_series};
 use ballast::nscd::d3::system::{Params3, StepStats3, System3};
 use ballast::nscd::d3::vtk::polygons_of;
-use ballast::nscd::method::{NlgsSettings, Policy};
+use ballast::nscd::method::{NlgsSettings, OnStall, Policy};
 use ballast::run::{CyclePlan, RunEnd, RunOptions, RunPlan, Runner, Status};
 use ballast::space::bodies::BodyInfo;
 use ballast::Error;
@@ -422,6 +422,60 @@ fn a_diverging_run_stops_naming_the_step_and_the_body() {
     assert_eq!((sys.steps, serde_json::to_string(&sys.bodies).unwrap()), (0, before));
     let err = sys.check_state().unwrap_err().to_string();
     assert!(err.contains("body 2 ('box1')") && err.contains("velocity"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `on_stall = "stop"`: a step whose sweeps stop short of the tolerance ends the run with `Error::Stalled`
+/// naming the step, the sweeps and the criterion; the state is the one before the step (bodies, springs, warm
+/// start), `summary.json` says `"stalled"` and `final.json` holds the last good step. The pile's bottom layer
+/// rests on the floor at the first step, so 3 sweeps cannot bring `quad` to 1e-12; under `accept` the same
+/// steps go on and count as unconverged.
+#[test]
+fn a_stalled_step_stops_the_run_and_keeps_the_last_good_state() {
+    let stalling = |on_stall| {
+        let mut sys = pile(1e-3, true);
+        sys.params.nlgs = NlgsSettings { max_iterations: 3, tolerance: 1e-12, on_stall, ..sys.params.nlgs };
+        sys
+    };
+    // The engine alone: a first step solved to the pile's own tolerance, then a stalling one is refused and
+    // nothing moves, the warm start included.
+    let mut sys = pile(1e-3, true);
+    assert!(sys.step().unwrap().nlgs.converged);
+    sys.params.nlgs = stalling(OnStall::Stop).params.nlgs;
+    let (before, memory) = (serde_json::to_string(&sys.bodies).unwrap(), sys.warm_start().to_vec());
+    assert!(!memory.is_empty(), "the bottom layer touches the floor");
+    let err = sys.step().unwrap_err();
+    let Error::Stalled { step, iterations, criterion, tolerance } = err else { panic!("expected a stall: {err}") };
+    assert_eq!((step, iterations, tolerance), (2, 3, 1e-12));
+    assert!(criterion > tolerance && criterion.is_finite(), "{criterion}");
+    assert_eq!((sys.steps, serde_json::to_string(&sys.bodies).unwrap()), (1, before));
+    assert_eq!(sys.warm_start(), &memory[..]);
+    // A step that converges is kept under `stop`: a lone cube in free fall has no contact to solve.
+    let mut lone = System3::new(Params3 { gravity: Vec3::new(0.0, 0.0, -G), ..stalling(OnStall::Stop).params }, 1);
+    let cube = BodyInfo::mobile("lone", Solid::Polyhedron(Polyhedron::cuboid([HALF; 3]).unwrap()), GRAIN, RHO);
+    lone.bodies.push(cube.unwrap(), Pose::at(Vec3::new(0.0, 0.0, 1.0)), [0.0; 6]);
+    assert!(lone.step().unwrap().nlgs.converged);
+    // The run loop: three steps asked, the first stalls.
+    let dir = scratch::dir("stall");
+    let runner = Runner::from_system(stalling(OnStall::Stop), RunPlan::new(3, 1)).unwrap();
+    let err = runner.run(&dir, &quiet(), &mut |_| {}).unwrap_err();
+    assert!(matches!(err, Error::Stalled { step: 1, iterations: 3, .. }), "{err}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!((report["end"].as_str(), report["steps"].as_u64()), (Some("stalled"), Some(0)));
+    let fin = FinalState::read(&dir.join("final.json")).unwrap();
+    let start = pile(1e-3, true);
+    assert_eq!((fin.step, fin.time), (0, 0.0));
+    for (b, pose) in fin.bodies.iter().zip(&start.bodies.pose) {
+        assert_eq!(b.position, vec![pose.position.x, pose.position.y, pose.position.z], "{}", b.name);
+    }
+    // Accept: the same steps run on, each counted unconverged.
+    let runner = Runner::from_system(stalling(OnStall::Accept), RunPlan::new(3, 1)).unwrap();
+    let outcome = runner.run(&dir, &quiet(), &mut |_| {}).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!((report["end"].as_str(), report["steps"].as_u64()), (Some("finished"), Some(3)), "{outcome:?}");
+    assert_eq!(report["unconverged_steps"].as_u64(), Some(3));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

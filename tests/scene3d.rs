@@ -463,7 +463,9 @@ fn simulation_and_nscd_sections() {
     let accelerated = edit("[nscd]", "[nscd]\nsolver = \"apgd\"");
     let sys = Scene3::from_toml_str(&accelerated).unwrap().build().unwrap();
     assert_eq!(sys.params.nlgs.solver, ballast::nscd::method::Solver::Apgd, "apgd is taken in 3D");
-    expect(&edit("[nscd]", "[nscd]\non_stall = \"stop\""), &["nscd.on_stall: 'stop' is not built for 3D NSCD yet"]);
+    let stopping = edit("[nscd]", "[nscd]\non_stall = \"stop\"");
+    let sys = Scene3::from_toml_str(&stopping).unwrap().build().unwrap();
+    assert_eq!(sys.params.nlgs.on_stall, ballast::nscd::method::OnStall::Stop, "on_stall = stop is taken in 3D");
     expect(&edit("alert_distance = 1.0e-3", "alert_distance = -1.0"), &["nscd.alert_distance: must be non-negative"]);
     // The settings that apply are taken as given.
     let tuned = edit(

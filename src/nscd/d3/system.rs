@@ -30,7 +30,7 @@ use crate::geometry::{Pose, Vec3};
 use crate::nscd::contact::ContactLaw;
 use crate::nscd::method::apgd::{solve_apgd_with, ApgdOptions, ApgdWorkspace};
 use crate::nscd::method::split::SplitWorkspace;
-use crate::nscd::method::{apply_impulses, solve_nlgs_split, NlgsReport, NlgsSettings, Solver};
+use crate::nscd::method::{apply_impulses, solve_nlgs_split, NlgsReport, NlgsSettings, OnStall, Solver};
 use crate::space::bodies::{advance, Bodies, Dofs6};
 use crate::space::detection::Detector;
 use crate::space::loads::LoadKind;
@@ -408,6 +408,16 @@ impl System3 {
             ),
         };
         let solve_seconds = clock.elapsed().as_secs_f64();
+        // A stalled solve under `on_stall = "stop"` ends the run here, the bodies, springs and warm start still
+        // those of the start of the step (as in 2D).
+        if !report.converged && settings.on_stall == OnStall::Stop {
+            return Err(Error::Stalled {
+                step: self.steps + 1,
+                iterations: report.iterations,
+                criterion: report.criterion,
+                tolerance: settings.tolerance,
+            });
+        }
         // 4. Update, checked before it is kept.
         for i in 0..n {
             if self.u[i].iter().any(|x| !x.is_finite()) {

@@ -18,8 +18,7 @@ pub struct Scene3 {
     /// `[simulation]`: engine (`"nscd"`), `dimension = 3`, time step, duration, gravity (3 components), seed,
     /// equilibrium stop.
     pub simulation: Simulation,
-    /// `[nscd]`: the 2D scene's settings (optional); `solver = "interior_point"` (2D only) and
-    /// `on_stall = "stop"` are refused.
+    /// `[nscd]`: the 2D scene's settings (optional); `solver = "interior_point"` (2D only) is refused.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub nscd: Option<NscdSection>,
     /// `[output]` (optional).

@@ -14,9 +14,9 @@
 //! equilibrium = { kinetic_energy = 1e-9 }
 //!
 //! [nscd]                          # the 2D scene's [nscd]: theta, criterion, tolerance, min/max_iterations,
-//! theta = 0.5                     # max_factor, symmetric, relaxation, measure, on_stall ("accept" or
-//! criterion = "quad"              # "extend"), stall_max_iterations, alert_distance, solver ("nlgs" or
-//! tolerance = 1e-6                # "apgd"); "interior_point" (2D only) and on_stall = "stop" are refused
+//! theta = 0.5                     # max_factor, symmetric, relaxation, measure, on_stall ("accept",
+//! criterion = "quad"              # "extend" or "stop"), stall_max_iterations, alert_distance, solver
+//! tolerance = 1e-6                # ("nlgs" or "apgd"); "interior_point" (2D only) is refused
 //! alert_distance = 1e-3
 //!
 //! [output]                        # as in 2D; cycles = { frequency, body, positions }

@@ -7,7 +7,7 @@
 //! The sections the 3D scene shares with the 2D one — `[nscd]`, `[[material]]`, `[[contact]]` — are checked by the
 //! 2D scene's own validation ([`crate::scene::Scene`]) on a probe scene that carries them and one disc, so that
 //! their keys, defaults and messages are the 2D scene's word for word; then what the 3D engine does not build is
-//! refused: `nscd.solver` other than `"nlgs"` and `nscd.on_stall = "stop"`. Imposed velocities, loads and springs
+//! refused: `nscd.solver = "interior_point"`. Imposed velocities, loads and springs
 //! are checked by [`super::drives`].
 
 use super::drives::{check_drives, check_springs, CheckedSpring3};
@@ -15,7 +15,7 @@ use super::format::{BodySpec3, Scene3};
 use crate::error::{clip, Error, Result};
 use crate::geometry::{Polyhedron, Pose, Solid, SolidError, Vec3, MAX_LENGTH, MIN_SIZE};
 use crate::nscd::d3::system::Params3;
-use crate::nscd::nlgs::{NlgsSettings, OnStall, Solver};
+use crate::nscd::nlgs::{NlgsSettings, Solver};
 use crate::scene::common::{check_output, check_simulation};
 use crate::scene::validate::{err, label, num};
 use crate::scene::{Material, Scene, SceneFile};
@@ -113,9 +113,6 @@ fn check_shared(scene: &Scene3) -> Result<(f64, NlgsSettings)> {
              friction cone allows: use 'nlgs' or 'apgd' in 3D"
                 .into(),
         );
-    }
-    if nlgs.on_stall == OnStall::Stop {
-        return err("nscd.on_stall: 'stop' is not built for 3D NSCD yet: use 'accept' or 'extend'".into());
     }
     Ok((checked.theta, nlgs))
 }
