@@ -243,3 +243,25 @@ fn a_dropped_cube_lands_and_rests_without_sinking() {
     assert!(lowest > -1e-6, "the cube sank {lowest} m into the floor");
     assert!(sys.bodies.kinetic_energy() < 1e-12, "still moving: {} J", sys.bodies.kinetic_energy());
 }
+
+/// A cube thrown at the floor at 20 m/s covers 20 mm per 1 ms step, twenty times the alert distance (1 mm).
+/// Its intermediate configurations are 90, 70, … 10 mm above the floor, then 10 mm into it: detected within the
+/// alert distance alone, the floor would first be seen 10 mm deep. The alert distance is raised to twice the
+/// step's travel (`2 h v_max`, as in 2D), so the contact is found while still open and closes at
+/// `U_N = −g_m / h`: the cube stops on the floor without entering it, and rests there.
+#[test]
+fn a_cube_thrown_fast_at_the_floor_stops_on_it() {
+    let mut sys = system(1e-3, Vec3::new(0.0, 0.0, -G), 0.5);
+    floor(&mut sys);
+    let half = 0.02;
+    let cube = BodyInfo::mobile("cube", cuboid([half; 3]), 0, RHO).unwrap();
+    sys.bodies.push(cube, Pose::at(Vec3::new(0.0, 0.0, half + 0.1)), [0.0, 0.0, -20.0, 0.0, 0.0, 0.0]);
+    let mut lowest = f64::INFINITY;
+    for _ in 0..300 {
+        sys.step().unwrap();
+        lowest = lowest.min(sys.bodies.pose[1].position.z - half);
+    }
+    assert!(lowest > -1e-6, "the cube went {lowest} m into the floor");
+    assert!((sys.bodies.pose[1].position.z - half).abs() < 1e-6, "at rest on the floor");
+    assert!(sys.bodies.kinetic_energy() < 1e-12, "still moving: {} J", sys.bodies.kinetic_energy());
+}
