@@ -191,8 +191,33 @@ def convert(args):
         vol, c_scene, _ = mass_properties(hv, tris)
         world = pos + hv @ R.T
         centre = pos + R @ c_scene
-        body = pre.rigidPolyhedron(model=mod, material=lm[mat], center=centre.copy(), color=col,
-                                   generation_type="full", vertices=world.copy(), faces=tris + 1)
+        split = args.split.get(b.get("name"))
+        if split is None:
+            body = pre.rigidPolyhedron(model=mod, material=lm[mat], center=centre.copy(), color=col,
+                                       generation_type="full", vertices=world.copy(), faces=tris + 1)
+        else:
+            # a box cut into nx × ny × nz POLYR contactors of one RBDY3 (same volume, mass and inertia): LMGC90's
+            # Cundall common plane starts from the centre-to-centre direction and turns it by at most 5° per
+            # iteration, so a grain under the edge of a 0.3 × 0.39 × 0.2 m box got the box's side face as its
+            # common plane (a horizontal normal, gaps of −5 to −12 cm); smaller contactors give it a good start
+            assert "box" in b, "--split: boxes only"
+            half = np.array(b["box"]["half"], float)
+            n3 = np.array(split, int)
+            body = pre.avatar(dimension=3)
+            body.addBulk(pre.rigid3d())
+            body.addNode(pre.node(coor=np.zeros(3), number=1))
+            body.defineGroups()
+            body.defineModel(model=mod)
+            body.defineMaterial(material=lm[mat])
+            sub = half / n3
+            for ix in range(n3[0]):
+                for iy in range(n3[1]):
+                    for iz in range(n3[2]):
+                        c = -half + sub * (2 * np.array([ix, iy, iz]) + 1)
+                        sv, st = hull(box_vertices(sub) + c)
+                        body.addContactors(shape="POLYR", color=col, nb_vertices=len(sv), vertices=pos + sv @ R.T,
+                                           nb_faces=len(st), connectivity=st + 1)
+            body.computeRigidProperties()
         if b.get("fixed", False):
             body.imposeDrivenDof(component=[1, 2, 3, 4, 5, 6], dofty="vlocy")
         else:
@@ -540,6 +565,8 @@ def main():
     c.add_argument("scene")
     c.add_argument("out")
     c.add_argument("--alert", type=float, default=None)
+    c.add_argument("--split", action="append", default=[], metavar="NAME=NX,NY,NZ",
+                   help="cut box body NAME into NX×NY×NZ POLYR contactors (see convert)")
     r = sub.add_parser("run")
     r.add_argument("--steps", type=int, default=50)
     r.add_argument("--out", default="lmgc90")
@@ -560,6 +587,7 @@ def main():
     t.add_argument("dir")
     a = p.parse_args()
     if a.cmd == "convert":
+        a.split = {k: [int(x) for x in v.split(",")] for k, v in (x.split("=") for x in a.split)}
         convert(a)
     elif a.cmd == "run":
         run(a)
