@@ -448,7 +448,7 @@ def run(args):
         chipy.SelectProxTactors()
         chipy.RecupRloc(args.rloc_tol)
         chipy.nlgs_3D_SetCheckType(args.norm, args.tol, args.relax)
-        chipy.nlgs_3D_ExPrep(args.storage)
+        chipy.nlgs_3D_ExPrep(args.storage.ljust(30))
         sweeps, iconv = 0, None
         nint = sum(chipy.inter_handler_3D_tgetNb(i) for i in (chipy.PRPRx_ID, chipy.PRPLx_ID))
         for ib in range(args.blocks):
@@ -471,15 +471,21 @@ def run(args):
 
         n_prpr = chipy.inter_handler_3D_tgetNb(chipy.PRPRx_ID)
         n_prpl = chipy.inter_handler_3D_tgetNb(chipy.PRPLx_ID)
-        active = 0
+        active, s_pts, s_loaded, s_fn = 0, 0, 0, 0.0
         for iid in (chipy.PRPRx_ID, chipy.PRPLx_ID):
             for j in range(chipy.inter_handler_3D_tgetNb(iid)):
-                if chipy.inter_handler_3D_tgetRData(iid, j + 1)[13] > 0.0:
+                d = chipy.inter_handler_3D_tgetRData(iid, j + 1)  # coor, t, n, s (12), rlt, rln, rls, …
+                if d[13] > 0.0:
                     active += 1
+                if sleeper is not None and sleeper + 1 in (int(x) for x in chipy.inter_handler_3D_tgetIdBodies(iid, j + 1)):
+                    s_pts += 1
+                    s_loaded += d[13] > 0.0
+                    s_fn += d[13] / dt  # R_N as a force (LMGC90's rln is an impulse over the step)
         conv = chipy.nlgs_3D_GetAllConvergenceNorms() if hasattr(chipy, "nlgs_3D_GetAllConvergenceNorms") else None
         zs = chipy.RBDY3_GetBodyVector("Coor_", sleeper + 1)[2] if sleeper is not None else 0.0
         rows.append((k + 1, chipy.TimeEvolution_GetTime(), n_prpr, n_prpl, active, sweeps,
-                     int(iconv == 0) if iconv is not None else 1, dt_wall, dt_cpu, zs - z0, fsum))
+                     int(iconv == 0) if iconv is not None else 1, dt_wall, dt_cpu, zs - z0, fsum,
+                     s_pts, s_loaded, s_fn))
         if args.verbose:
             print(rows[-1], conv, flush=True)
         if args.max_wall and total > args.max_wall:
@@ -487,7 +493,7 @@ def run(args):
             break
 
     with open(os.path.join(args.out, "steps.csv"), "w") as f:
-        f.write("step,time_s,prprx,prplx,active,sweeps,converged,wall_s,cpu_s,sleeper_dz_m,spring_force_sum_N\n")
+        f.write("step,time_s,prprx,prplx,active,sweeps,converged,wall_s,cpu_s,sleeper_dz_m,spring_force_sum_N,sleeper_points,sleeper_loaded,sleeper_fn_sum_N\n")
         for r in rows:
             f.write(",".join(repr(x) for x in r) + "\n")
     final = []
