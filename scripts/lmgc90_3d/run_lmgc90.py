@@ -43,6 +43,29 @@ CASES = {
 }
 
 
+def ex_solver(chipy, storage, norm, tol, relax, gs_it1, gs_it2, quick_scramble=False):
+    """`chipy.ExSolver(storage, norm, tol, relax, gs_it1, gs_it2)` expanded block for block (module doc), with
+    LMGC90's quick scramble of the contact order before each block when asked; returns the sweeps made and the
+    last check's code (0 converged, -1 a NaN, 1 not converged; None when nothing was checked)."""
+    chipy.nlgs_3D_SetCheckType(norm, tol, relax)
+    chipy.nlgs_3D_ExPrep(storage)
+    sweeps, iconv = 0, None
+    nint = sum(chipy.inter_handler_3D_tgetNb(i) for i in (chipy.PRPRx_ID, chipy.PRPLx_ID))
+    for _ in range(gs_it2):
+        if quick_scramble:
+            chipy.nlgs_3D_QuickScrambleContactOrder()
+        chipy.nlgs_3D_ExIter(gs_it1)
+        sweeps += gs_it1
+        if nint == 0:  # prep_check_nlgs finds nothing to check: ExSolver returns here
+            break
+        iconv = chipy.nlgs_3D_AfterIterCheck()
+        if iconv in (0, -1):
+            break
+    if nint > 0:
+        chipy.nlgs_3D_ExPost()
+    return sweeps, iconv
+
+
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--case", choices=CASES, required=True)
@@ -109,23 +132,7 @@ def main():
         chipy.ComputeFreeVelocity()
         chipy.SelectProxTactors()
         chipy.RecupRloc(c["rloc_tol"])
-        # chipy.ExSolver(storage, norm, tol, relax, gs_it1, gs_it2), block for block
-        chipy.nlgs_3D_SetCheckType(c["norm"], c["tol"], c["relax"])
-        chipy.nlgs_3D_ExPrep(c["storage"])
-        sweeps = 0
-        nint = sum(chipy.inter_handler_3D_tgetNb(i) for i in (chipy.PRPRx_ID, chipy.PRPLx_ID))
-        for ib in range(gs_it2):
-            if quick_scramble:
-                chipy.nlgs_3D_QuickScrambleContactOrder()
-            chipy.nlgs_3D_ExIter(gs_it1)
-            sweeps += gs_it1
-            if nint == 0:  # prep_check_nlgs finds nothing to check: ExSolver returns here
-                break
-            iconv = chipy.nlgs_3D_AfterIterCheck()
-            if iconv in (0, -1):
-                break
-        if nint > 0:
-            chipy.nlgs_3D_ExPost()
+        sweeps, _ = ex_solver(chipy, c["storage"], c["norm"], c["tol"], c["relax"], gs_it1, gs_it2, quick_scramble)
         chipy.UpdateTactBehav()
         chipy.StockRloc()
         chipy.ComputeDof()

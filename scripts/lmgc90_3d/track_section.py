@@ -48,6 +48,9 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from run_lmgc90 import ex_solver  # noqa: E402
+
 try:
     import tomllib
 except ImportError:  # Python < 3.11
@@ -447,20 +450,8 @@ def run(args):
         chipy.ComputeFreeVelocity()
         chipy.SelectProxTactors()
         chipy.RecupRloc(args.rloc_tol)
-        chipy.nlgs_3D_SetCheckType(args.norm, args.tol, args.relax)
-        chipy.nlgs_3D_ExPrep(args.storage.ljust(30))
-        sweeps, iconv = 0, None
-        nint = sum(chipy.inter_handler_3D_tgetNb(i) for i in (chipy.PRPRx_ID, chipy.PRPLx_ID))
-        for ib in range(args.blocks):
-            chipy.nlgs_3D_ExIter(args.check_every)
-            sweeps += args.check_every
-            if nint == 0:
-                break
-            iconv = chipy.nlgs_3D_AfterIterCheck()
-            if iconv in (0, -1):
-                break
-        if nint > 0:
-            chipy.nlgs_3D_ExPost()
+        sweeps, iconv = ex_solver(chipy, args.storage.ljust(30), args.norm, args.tol, args.relax,
+                                  args.check_every, args.blocks)
         chipy.UpdateTactBehav()
         chipy.StockRloc()
         chipy.ComputeDof()
