@@ -14,7 +14,8 @@ use ballast::nscd::contact::ContactLaw;
 use ballast::nscd::d3::rows::{read_cycles, read_series};
 use ballast::nscd::d3::system::{Params3, StepStats3, System3};
 use ballast::nscd::d3::vtk::polygons_of;
-use ballast::nscd::method::{NlgsSettings, OnStall, Policy};
+use ballast::nscd::method::criterion::evaluate;
+use ballast::nscd::method::{NlgsSettings, OnStall, Policy, SweepNorms};
 use ballast::run::{CyclePlan, RunEnd, RunOptions, RunPlan, Runner, Status};
 use ballast::space::bodies::BodyInfo;
 use ballast::Error;
@@ -477,6 +478,30 @@ fn a_stalled_step_stops_the_run_and_keeps_the_last_good_state() {
     assert_eq!((report["end"].as_str(), report["steps"].as_u64()), (Some("finished"), Some(3)), "{outcome:?}");
     assert_eq!(report["unconverged_steps"].as_u64(), Some(3));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `System3::check_by_point`: the check pass point by point. Its norms, summed over the points, are the check
+/// pass that ended the last step: on a step stopped at the cap (3 sweeps), `quad` of the sum is the step's
+/// reported criterion to round-off. Before any step, and after a failed one, there is nothing to report.
+#[test]
+fn the_check_by_point_adds_up_to_the_steps_criterion() {
+    let mut sys = pile(1e-3, true);
+    assert!(sys.check_by_point().is_empty());
+    sys.params.nlgs = NlgsSettings { max_iterations: 3, tolerance: 1e-12, ..sys.params.nlgs };
+    let stats = sys.step().unwrap();
+    assert!(!stats.nlgs.converged);
+    let points = sys.check_by_point();
+    assert_eq!(points.len(), stats.contacts);
+    let keys: Vec<_> = points.iter().map(|(k, _)| *k).collect();
+    assert!(keys.windows(2).all(|w| w[0] < w[1]), "in key order");
+    let sum = points.iter().fold(SweepNorms::default(), |sum, (_, n)| sum.merged(*n));
+    let (quad, _) = evaluate(Policy::Quad, 1e-12, 4.0, &sum, 0.0);
+    let reported = stats.nlgs.criterion;
+    assert!((quad - reported).abs() <= 1e-12 * reported, "{quad} against the step's {reported}");
+    // A failed step keeps nothing to diagnose.
+    sys.params.nlgs.on_stall = OnStall::Stop;
+    assert!(sys.step().is_err());
+    assert!(sys.check_by_point().is_empty());
 }
 
 /// A cube dropped 2 cm onto the floor, followed by cycles of 50 ms (20 Hz, 50 steps of 1 ms), beside the pile.

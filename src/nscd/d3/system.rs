@@ -31,7 +31,9 @@ use crate::geometry::{Pose, Vec3};
 use crate::nscd::contact::ContactLaw;
 use crate::nscd::method::apgd::{solve_apgd_with, ApgdOptions, ApgdWorkspace};
 use crate::nscd::method::split::SplitWorkspace;
-use crate::nscd::method::{apply_impulses, solve_nlgs_split, NlgsReport, NlgsSettings, OnStall, Solver};
+use crate::nscd::method::{
+    apply_impulses, check_by_row, solve_nlgs_split, NlgsReport, NlgsSettings, OnStall, Solver, SweepNorms,
+};
 use crate::space::bodies::{advance, Bodies, Dofs6};
 use crate::space::detection::Detector;
 use crate::space::loads::LoadKind;
@@ -252,6 +254,24 @@ impl System3 {
     /// The contact laws, pair `(i, j)` at `i * materials + j`.
     pub fn laws(&self) -> &[ContactLaw] {
         &self.laws
+    }
+
+    /// The check pass of the last step's solve, point by point (a diagnosis of which contact points hold a solve,
+    /// `examples/nscd3d_residuals.rs`): each contact point's key and its own norms at the step's final impulses
+    /// and velocities (`sum_dvdv` = `|ΔU|²`, `sum_dvdvrr` = `|ΔU|² |P̄|²`, … of [`SweepNorms`]), in key order;
+    /// with the springs' they add up to the check pass's sums. Empty before the first step of this system and
+    /// after a failed step.
+    pub fn check_by_point(&self) -> Vec<((u32, u32, u32), SweepNorms)> {
+        // The rows are those of the kept step when they match its contact list point for point (a failed step
+        // rebuilt and re-solved them without keeping anything).
+        let kept = self.rows.len() == self.contacts.len()
+            && self.rows.iter().zip(&self.contacts).all(|(r, c)| (r.a, r.b) == (c.key.0, c.key.1) && r.p == c.p);
+        if !kept {
+            return Vec::new();
+        }
+        let (mut u, mut rows, mut springs) = (self.bodies.u.clone(), self.rows.clone(), self.spring_rows.clone());
+        let (_, norms) = check_by_row(&mut u, &self.bodies.inv_m, &mut rows, &mut springs);
+        self.contacts.iter().map(|c| c.key).zip(norms).collect()
     }
 
     /// The warm-start memory: the world impulses (N·s) of the last step's contact points, sorted by key.

@@ -177,6 +177,23 @@ impl SweepNorms {
         self.sum_wrwr += wrwr;
     }
 
+    /// The norms of two parts of a pass together: sums added, maxima taken (the split solve's halves, or the
+    /// rows of [`super::check_by_row`]).
+    pub fn merged(self, other: SweepNorms) -> SweepNorms {
+        SweepNorms {
+            active: self.active + other.active,
+            sum_dvdv: self.sum_dvdv + other.sum_dvdv,
+            max_dvdv: self.max_dvdv.max(other.max_dvdv),
+            sum_dvdvrr: self.sum_dvdvrr + other.sum_dvdvrr,
+            max_dvdvrr: self.max_dvdvrr.max(other.max_dvdvrr),
+            sum_dvor: self.sum_dvor + other.sum_dvor,
+            sum_wrr: self.sum_wrr + other.sum_wrr,
+            sum_wrwr: self.sum_wrwr + other.sum_wrwr,
+            sum_wpp: self.sum_wpp + other.sum_wpp,
+            changed: self.changed || other.changed,
+        }
+    }
+
     /// `(QuadDV, MaxmDV, QuadDVR, MaxmDVR, MeanDVoR)`; all zero when no impulse changed
     /// or no row carries an impulse, infinite if the scales vanish while impulses change.
     pub fn norms(&self) -> [f64; 5] {

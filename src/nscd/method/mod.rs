@@ -25,8 +25,8 @@ pub mod split;
 
 pub use criterion::{Measure, Policy, SweepNorms};
 pub use gauss_seidel::{
-    apply_impulses, check, pass, remove_impulses, solve_nlgs, solve_nlgs_split, sweep, sweep_relaxed, NlgsProblem,
-    NlgsReport, Pass,
+    apply_impulses, check, check_by_row, pass, remove_impulses, solve_nlgs, solve_nlgs_split, sweep, sweep_relaxed,
+    NlgsProblem, NlgsReport, Pass,
 };
 pub use settings::{NlgsSettings, OnStall, Solver, DEFAULT_SPLIT_MIN_ROWS, DEFAULT_STALL_MAX_ITERATIONS};
 pub use split::SplitWorkspace;

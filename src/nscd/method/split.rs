@@ -112,22 +112,6 @@ impl<R: Row, S: Row<Dofs = R::Dofs>> Default for SplitWorkspace<R, S> {
     }
 }
 
-/// Sums and maxima of two partial sweeps.
-fn merge(a: SweepNorms, b: SweepNorms) -> SweepNorms {
-    SweepNorms {
-        active: a.active + b.active,
-        sum_dvdv: a.sum_dvdv + b.sum_dvdv,
-        max_dvdv: a.max_dvdv.max(b.max_dvdv),
-        sum_dvdvrr: a.sum_dvdvrr + b.sum_dvdvrr,
-        max_dvdvrr: a.max_dvdvrr.max(b.max_dvdvrr),
-        sum_dvor: a.sum_dvor + b.sum_dvor,
-        sum_wrr: a.sum_wrr + b.sum_wrr,
-        sum_wrwr: a.sum_wrwr + b.sum_wrwr,
-        sum_wpp: a.sum_wpp + b.sum_wpp,
-        changed: a.changed || b.changed,
-    }
-}
-
 /// Which part a row between `a` and `b` belongs to: 0 left, 1 right, 2 interface.
 fn part_of(side: &[u8], a: u32, b: u32) -> usize {
     let side = |i: u32| if i == NONE { FIXED } else { side[i as usize] };
@@ -278,12 +262,12 @@ impl<R: Row, S: Row<Dofs = R::Dofs>> SplitWorkspace<R, S> {
             // A check updates nothing: the interface bodies' velocities are already equal.
             let (l, r) = team.join(|| left.pass(kind), || right.pass(kind));
             if kind == Pass::Check {
-                return merge(merge(l, r), iface.pass(kind));
+                return l.merged(r).merged(iface.pass(kind));
             }
             Self::exchange(left, right, iface, side, slot, true);
             let i = iface.pass(kind);
             Self::exchange(left, right, iface, side, slot, false);
-            merge(merge(l, r), i)
+            l.merged(r).merged(i)
         })
     }
 

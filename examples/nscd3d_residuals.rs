@@ -1,0 +1,67 @@
+//! Which contact points hold a 3D NSCD solve: a 3D scene run for some steps, then its last step's check pass
+//! point by point ([`ballast::nscd::d3::system::System3::check_by_point`]), the diagnosis behind
+//! docs/track3d.md, "Why Gauss–Seidel stops at the cap on the loaded 2 000-grain section".
+//!
+//! `cargo run --release --example nscd3d_residuals -- SCENE.toml [STEPS] [THREADS] [TOP]` (defaults 1, 1, 10).
+//! The scene runs with its own `[nscd]` settings. Printed after the last step:
+//! - the step's sweeps and the `quad` norms from the points' sum (`QuadDV`, `QuadDVR`, `MeanDVoR`, the check pass
+//!   of the final iterate);
+//! - the share of `QuadDV`² and of `QuadDVR`² held by the 1, 10, 100 and 1 000 leading points;
+//! - the TOP points by their share of `QuadDVR`², with their bodies, normal, impulse and the ratio
+//!   `|P_T| / P_N` (the friction coefficient when the point slides).
+
+use ballast::nscd::method::criterion::SweepNorms;
+use ballast::scene::{Scene3, SceneFile};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let path = args.first().ok_or("usage: nscd3d_residuals SCENE.toml [STEPS] [THREADS] [TOP]")?;
+    let steps: u64 = args.get(1).map_or(Ok(1), |s| s.parse())?;
+    let threads: usize = args.get(2).map_or(Ok(1), |s| s.parse())?;
+    let top: usize = args.get(3).map_or(Ok(10), |s| s.parse())?;
+    let mut sys = Scene3::load(path)?.build()?;
+    sys.set_threads(threads);
+    let mut last = None;
+    for _ in 0..steps {
+        last = Some(sys.step()?);
+    }
+    let stats = last.ok_or("STEPS must be at least 1")?;
+    let points = sys.check_by_point();
+    let sum = points.iter().fold(SweepNorms::default(), |s, (_, n)| s.merged(*n));
+    let [quad_dv, _, quad_dvr, _, mean_dvor] = sum.norms();
+    println!(
+        "step {}: {} contact points, {} loaded; {} sweeps, converged {}; QuadDV {quad_dv:.3e}, QuadDVR {quad_dvr:.3e}, \
+         MeanDVoR {mean_dvor:.3e}",
+        sys.steps, stats.contacts, sum.active, stats.nlgs.iterations, stats.nlgs.converged
+    );
+    let share = |value: fn(&SweepNorms) -> f64| {
+        let mut v: Vec<f64> = points.iter().map(|(_, n)| value(n)).collect();
+        v.sort_by(|a, b| b.total_cmp(a));
+        let total: f64 = v.iter().sum();
+        [1, 10, 100, 1000].map(|k| v.iter().take(k).sum::<f64>() / total)
+    };
+    println!("share of QuadDV²  held by the leading 1, 10, 100, 1000 points: {:.3?}", share(|n| n.sum_dvdv));
+    println!("share of QuadDVR² held by the leading 1, 10, 100, 1000 points: {:.3?}", share(|n| n.sum_dvdvrr));
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&i, &j| points[j].1.sum_dvdvrr.total_cmp(&points[i].1.sum_dvdvrr));
+    let total: f64 = points.iter().map(|(_, n)| n.sum_dvdvrr).sum();
+    let name = |i: u32| sys.bodies.info[i as usize].name.clone();
+    for &i in order.iter().take(top) {
+        let ((a, b, k), n) = points[i];
+        let c = &sys.contacts()[i];
+        let pt = c.p[1].hypot(c.p[2]);
+        println!(
+            "  {:5.1} %  {} – {} (point {k}): n [{:+.3}, {:+.3}, {:+.3}], P_N {:.3e} N·s, |P_T|/P_N {:.3}, gap {:.2e} m",
+            100.0 * n.sum_dvdvrr / total,
+            name(a),
+            name(b),
+            c.frame[0].x,
+            c.frame[0].y,
+            c.frame[0].z,
+            c.p[0],
+            if c.p[0] > 0.0 { pt / c.p[0] } else { 0.0 },
+            c.gap
+        );
+    }
+    Ok(())
+}
