@@ -4,9 +4,9 @@
 //!
 //! `cargo run --release --example nscd3d_residuals -- SCENE.toml [STEPS] [THREADS] [TOP]` (defaults 1, 1, 10).
 //! The scene runs with its own `[nscd]` settings. Printed after the last step:
-//! - the step's sweeps and the `quad` norms from the points' sum (`QuadDV`, `QuadDVR`, `MeanDVoR`, the check pass
-//!   of the final iterate);
-//! - the share of `QuadDV`² and of `QuadDVR`² held by the 1, 10, 100 and 1 000 leading points;
+//! - the step's sweeps and the `quad` norms of the check pass of the final iterate (`QuadDV`, `QuadDVR`,
+//!   `MeanDVoR`), summed over the springs and the points;
+//! - the share of `QuadDV`² and of `QuadDVR`² held by the springs and by the 1, 10, 100 and 1 000 leading points;
 //! - the TOP points by their share of `QuadDVR`², with their bodies, normal, impulse and the ratio
 //!   `|P_T| / P_N` (the friction coefficient when the point slides).
 
@@ -26,22 +26,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         last = Some(sys.step()?);
     }
     let stats = last.ok_or("STEPS must be at least 1")?;
-    let points = sys.check_by_point();
-    let sum = points.iter().fold(SweepNorms::default(), |s, (_, n)| s.merged(*n));
+    let (springs, points) = sys.check_by_point();
+    let of_springs = springs.iter().fold(SweepNorms::default(), |s, n| s.merged(*n));
+    let sum = points.iter().fold(of_springs, |s, (_, n)| s.merged(*n));
     let [quad_dv, _, quad_dvr, _, mean_dvor] = sum.norms();
     println!(
         "step {}: {} contact points, {} loaded; {} sweeps, converged {}; QuadDV {quad_dv:.3e}, QuadDVR {quad_dvr:.3e}, \
          MeanDVoR {mean_dvor:.3e}",
         sys.steps, stats.contacts, sum.active, stats.nlgs.iterations, stats.nlgs.converged
     );
+    // Shares of the sum over the springs and the points: the springs' together, then the leading points'.
     let share = |value: fn(&SweepNorms) -> f64| {
         let mut v: Vec<f64> = points.iter().map(|(_, n)| value(n)).collect();
         v.sort_by(|a, b| b.total_cmp(a));
-        let total: f64 = v.iter().sum();
-        [1, 10, 100, 1000].map(|k| v.iter().take(k).sum::<f64>() / total)
+        let total = value(&sum);
+        (value(&of_springs) / total, [1, 10, 100, 1000].map(|k| v.iter().take(k).sum::<f64>() / total))
     };
-    println!("share of QuadDV²  held by the leading 1, 10, 100, 1000 points: {:.3?}", share(|n| n.sum_dvdv));
-    println!("share of QuadDVR² held by the leading 1, 10, 100, 1000 points: {:.3?}", share(|n| n.sum_dvdvrr));
+    let norms: [(&str, fn(&SweepNorms) -> f64); 2] = [("QuadDV² ", |n| n.sum_dvdv), ("QuadDVR²", |n| n.sum_dvdvrr)];
+    for (label, value) in norms {
+        let (by_springs, leading) = share(value);
+        println!(
+            "share of {label}: the {} springs {by_springs:.3}; the leading 1, 10, 100, 1000 points {leading:.3?}",
+            springs.len()
+        );
+    }
     let mut order: Vec<usize> = (0..points.len()).collect();
     order.sort_by(|&i, &j| points[j].1.sum_dvdvrr.total_cmp(&points[i].1.sum_dvdvrr));
     let total: f64 = points.iter().map(|(_, n)| n.sum_dvdvrr).sum();

@@ -257,21 +257,22 @@ impl System3 {
     }
 
     /// The check pass of the last step's solve, point by point (a diagnosis of which contact points hold a solve,
-    /// `examples/nscd3d_residuals.rs`): each contact point's key and its own norms at the step's final impulses
-    /// and velocities (`sum_dvdv` = `|ΔU|²`, `sum_dvdvrr` = `|ΔU|² |P̄|²`, … of [`SweepNorms`]), in key order;
-    /// with the springs' they add up to the check pass's sums. Empty before the first step of this system and
-    /// after a failed step.
-    pub fn check_by_point(&self) -> Vec<((u32, u32, u32), SweepNorms)> {
+    /// `examples/nscd3d_residuals.rs`): the norms of each spring row in the springs' order, and each contact
+    /// point's key with its own norms in key order, at the step's final impulses and velocities (`sum_dvdv` =
+    /// `|ΔU|²`, `sum_dvdvrr` = `|ΔU|² |P̄|²`, … of [`SweepNorms`]). Together they add up to the check pass's sums.
+    /// Both empty before the first step of this system and after a failed step.
+    #[allow(clippy::type_complexity)]
+    pub fn check_by_point(&self) -> (Vec<SweepNorms>, Vec<((u32, u32, u32), SweepNorms)>) {
         // The rows are those of the kept step when they match its contact list point for point (a failed step
         // rebuilt and re-solved them without keeping anything).
         let kept = self.rows.len() == self.contacts.len()
             && self.rows.iter().zip(&self.contacts).all(|(r, c)| (r.a, r.b) == (c.key.0, c.key.1) && r.p == c.p);
-        if !kept {
-            return Vec::new();
+        if !kept || self.steps == 0 {
+            return (Vec::new(), Vec::new());
         }
         let (mut u, mut rows, mut springs) = (self.bodies.u.clone(), self.rows.clone(), self.spring_rows.clone());
-        let (_, norms) = check_by_row(&mut u, &self.bodies.inv_m, &mut rows, &mut springs);
-        self.contacts.iter().map(|c| c.key).zip(norms).collect()
+        let (of_springs, norms) = check_by_row(&mut u, &self.bodies.inv_m, &mut rows, &mut springs);
+        (of_springs, self.contacts.iter().map(|c| c.key).zip(norms).collect())
     }
 
     /// The warm-start memory: the world impulses (N·s) of the last step's contact points, sorted by key.
