@@ -13,6 +13,9 @@
 use ballast::nscd::method::criterion::SweepNorms;
 use ballast::scene::{Scene3, SceneFile};
 
+/// One of the sums of [`SweepNorms`].
+type Part = fn(&SweepNorms) -> f64;
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let path = args.first().ok_or("usage: nscd3d_residuals SCENE.toml [STEPS] [THREADS] [TOP]")?;
@@ -36,13 +39,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         sys.steps, stats.contacts, sum.active, stats.nlgs.iterations, stats.nlgs.converged
     );
     // Shares of the sum over the springs and the points: the springs' together, then the leading points'.
-    let share = |value: fn(&SweepNorms) -> f64| {
+    let share = |value: Part| {
         let mut v: Vec<f64> = points.iter().map(|(_, n)| value(n)).collect();
         v.sort_by(|a, b| b.total_cmp(a));
         let total = value(&sum);
         (value(&of_springs) / total, [1, 10, 100, 1000].map(|k| v.iter().take(k).sum::<f64>() / total))
     };
-    let norms: [(&str, fn(&SweepNorms) -> f64); 2] = [("QuadDV² ", |n| n.sum_dvdv), ("QuadDVR²", |n| n.sum_dvdvrr)];
+    let norms: [(&str, Part); 2] = [("QuadDV² ", |n| n.sum_dvdv), ("QuadDVR²", |n| n.sum_dvdvrr)];
     for (label, value) in norms {
         let (by_springs, leading) = share(value);
         println!(
