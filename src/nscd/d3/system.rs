@@ -263,11 +263,14 @@ impl System3 {
     /// Both empty before the first step of this system and after a failed step.
     #[allow(clippy::type_complexity)]
     pub fn check_by_point(&self) -> (Vec<SweepNorms>, Vec<((u32, u32, u32), SweepNorms)>) {
-        // The rows are those of the kept step when they match its contact list point for point (a failed step
-        // rebuilt and re-solved them without keeping anything).
+        // The rows are those of the kept step when they match its contact list point for point and its springs'
+        // impulses spring for spring (a failed step rebuilt and re-solved them without keeping anything; before
+        // the first step there are no spring rows, or nothing to report).
         let kept = self.rows.len() == self.contacts.len()
-            && self.rows.iter().zip(&self.contacts).all(|(r, c)| (r.a, r.b) == (c.key.0, c.key.1) && r.p == c.p);
-        if !kept || self.steps == 0 {
+            && self.rows.iter().zip(&self.contacts).all(|(r, c)| (r.a, r.b) == (c.key.0, c.key.1) && r.p == c.p)
+            && self.spring_rows.len() == self.springs.len()
+            && self.spring_rows.iter().zip(&self.springs).all(|(r, s)| r.p == s.impulse);
+        if !kept {
             return (Vec::new(), Vec::new());
         }
         let (mut u, mut rows, mut springs) = (self.bodies.u.clone(), self.rows.clone(), self.spring_rows.clone());
