@@ -7,7 +7,7 @@
 //! - the step's sweeps and the `quad` norms of the check pass of the final iterate (`QuadDV`, `QuadDVR`,
 //!   `MeanDVoR`), summed over the springs and the points;
 //! - the share of `QuadDV`² and of `QuadDVR`² held by the springs and by the 1, 10, 100 and 1 000 leading points;
-//! - the TOP points by their share of `QuadDVR`², with their bodies, normal, impulse and the ratio
+//! - the TOP points by their share of `QuadDVR`² (of the springs' and points' sum), with their bodies, normal, impulse and the ratio
 //!   `|P_T| / P_N` (the friction coefficient when the point slides).
 
 use ballast::nscd::method::criterion::SweepNorms;
@@ -42,8 +42,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let share = |value: Part| {
         let mut v: Vec<f64> = points.iter().map(|(_, n)| value(n)).collect();
         v.sort_by(|a, b| b.total_cmp(a));
-        let total = value(&sum);
-        (value(&of_springs) / total, [1, 10, 100, 1000].map(|k| v.iter().take(k).sum::<f64>() / total))
+        let part = |x: f64| fraction(x, value(&sum));
+        (part(value(&of_springs)), [1, 10, 100, 1000].map(|k| part(v.iter().take(k).sum())))
     };
     let norms: [(&str, Part); 2] = [("QuadDV² ", |n| n.sum_dvdv), ("QuadDVR²", |n| n.sum_dvdvrr)];
     for (label, value) in norms {
@@ -55,7 +55,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let mut order: Vec<usize> = (0..points.len()).collect();
     order.sort_by(|&i, &j| points[j].1.sum_dvdvrr.total_cmp(&points[i].1.sum_dvdvrr));
-    let total: f64 = points.iter().map(|(_, n)| n.sum_dvdvrr).sum();
     let name = |i: u32| sys.bodies.info[i as usize].name.clone();
     for &i in order.iter().take(top) {
         let ((a, b, k), n) = points[i];
@@ -63,7 +62,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let pt = c.p[1].hypot(c.p[2]);
         println!(
             "  {:5.1} %  {} – {} (point {k}): n [{:+.3}, {:+.3}, {:+.3}], P_N {:.3e} N·s, |P_T|/P_N {:.3}, gap {:.2e} m",
-            100.0 * n.sum_dvdvrr / total,
+            100.0 * fraction(n.sum_dvdvrr, sum.sum_dvdvrr),
             name(a),
             name(b),
             c.frame[0].x,
@@ -75,4 +74,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     Ok(())
+}
+
+/// `x / total`, 0 when the total is (a converged step whose check pass changes nothing).
+fn fraction(x: f64, total: f64) -> f64 {
+    if total > 0.0 {
+        x / total
+    } else {
+        0.0
+    }
 }
