@@ -11,6 +11,7 @@ use ballast::nscd::contact::ContactLaw;
 use ballast::nscd::d3::system::{Params3, System3};
 use ballast::nscd::method::{NlgsSettings, Policy, Solver};
 use ballast::space::bodies::BodyInfo;
+use ballast::space::detection::FaceGaps;
 use nalgebra::UnitQuaternion;
 
 const G: f64 = 9.81;
@@ -264,4 +265,44 @@ fn a_cube_thrown_fast_at_the_floor_stops_on_it() {
     assert!(lowest > -1e-6, "the cube went {lowest} m into the floor");
     assert!((sys.bodies.pose[1].position.z - half).abs() < 1e-6, "at rest on the floor");
     assert!(sys.bodies.kinetic_energy() < 1e-12, "still moving: {} J", sys.bodies.kinetic_energy());
+}
+
+/// The face–face gap rule in the mechanics. A 0.1 m cube rests on one edge on a fixed polyhedral slab, its
+/// bottom face tilted by 1 mrad, so that the far edge is 0.1 mm up. Under the exact gaps (the default) the far
+/// points are open, and gravity rocks the cube about the low edge until it lies flat: within a few ms, since
+/// its angular acceleration about the edge is about 3 g / (4 half) ≈ 150 rad/s², and it lands plastically. Under
+/// LMGC90's common-plane rule the four corners share the low edge's gap (0), so the faces count as flush and
+/// the cube stays at its tilt: it cannot turn about the edge without closing the far points' gap.
+#[test]
+fn a_tilted_cube_rocks_flat_under_exact_gaps_and_stays_tilted_under_the_common_plane() {
+    let tilt = 1e-3;
+    let half = 0.05;
+    for face_gaps in [FaceGaps::Exact, FaceGaps::CommonPlane] {
+        let mut sys = system(1e-3, Vec3::new(0.0, 0.0, -G), 0.5);
+        sys.params.face_gaps = face_gaps;
+        // The slab's top face at z = 0.
+        sys.bodies.push(
+            BodyInfo::fixed("slab", cuboid([0.2, 0.2, 0.05]), 0),
+            Pose::at(Vec3::new(0.0, 0.0, -0.05)),
+            [0.0; 6],
+        );
+        let cube = BodyInfo::mobile("cube", cuboid([half; 3]), 0, RHO).unwrap();
+        let rotation = UnitQuaternion::from_euler_angles(tilt, 0.0, 0.0);
+        // The low edge (y = −half in the cube's frame) on the slab.
+        let low = rotation * Vec3::new(0.0, -half, -half);
+        let i = sys.bodies.push(cube, Pose { position: Vec3::new(0.0, 0.0, -low.z), rotation }, [0.0; 6]);
+        for _ in 0..200 {
+            sys.step().unwrap();
+        }
+        let left = sys.bodies.pose[i as usize].rotation.angle();
+        match face_gaps {
+            // Flat to 1e-6 rad (0.1 µm over the face); the exact landing leaves nothing measurable.
+            FaceGaps::Exact => assert!(left < 1e-6, "exact gaps: the cube is still tilted by {left} rad"),
+            // The tilt kept to 1e-3 of itself: the solve's tolerance (quad 1e-8) allows no turn.
+            FaceGaps::CommonPlane => {
+                assert!((left - tilt).abs() < 1e-3 * tilt, "common plane: the tilt went from {tilt} to {left} rad")
+            }
+        }
+        assert!(sys.bodies.kinetic_energy() < 1e-12, "{face_gaps:?}: still moving, {} J", sys.bodies.kinetic_energy());
+    }
 }

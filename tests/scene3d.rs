@@ -6,6 +6,7 @@
 use ballast::geometry::{Polyhedron, Solid, Vec3};
 use ballast::nscd::d3::system::System3;
 use ballast::scene::{d3::Scene3, Scene, SceneFile, SceneKind};
+use ballast::space::detection::FaceGaps;
 use ballast::Error;
 use nalgebra::{Quaternion, UnitQuaternion};
 
@@ -467,6 +468,16 @@ fn simulation_and_nscd_sections() {
     let sys = Scene3::from_toml_str(&stopping).unwrap().build().unwrap();
     assert_eq!(sys.params.nlgs.on_stall, ballast::nscd::method::OnStall::Stop, "on_stall = stop is taken in 3D");
     expect(&edit("alert_distance = 1.0e-3", "alert_distance = -1.0"), &["nscd.alert_distance: must be non-negative"]);
+    // The face–face gap rule: exact by default, LMGC90's common plane on request, kept through a round trip.
+    assert_eq!(example().build().unwrap().params.face_gaps, FaceGaps::Exact);
+    let common = Scene3::from_toml_str(&edit("[nscd]", "[nscd]\nface_gaps = \"common_plane\"")).unwrap();
+    assert_eq!(common.build().unwrap().params.face_gaps, FaceGaps::CommonPlane);
+    let again = Scene3::from_toml_str(&common.to_toml_string().unwrap()).unwrap();
+    assert_eq!(again.build().unwrap().params.face_gaps, FaceGaps::CommonPlane);
+    expect(
+        &edit("[nscd]", "[nscd]\nface_gaps = \"flat\""),
+        &["nscd.face_gaps: unknown rule 'flat', expected 'exact' or 'common_plane'"],
+    );
     // The settings that apply are taken as given.
     let tuned = edit(
         "[nscd]",

@@ -325,6 +325,10 @@ fn nscd_settings() {
     expect(&edit("max_factor = 16.0", "max_factor = 0.5"), &["nscd.max_factor"]);
     expect(&edit("criterion = \"quad\"", "criterion = \"fast\""), &["nscd.criterion: unknown criterion 'fast'"]);
     expect(&edit("max_factor = 16.0", "max_factor = 16.0\nalert_distance = -1.0"), &["nscd.alert_distance"]);
+    expect(
+        &edit("max_factor = 16.0", "max_factor = 16.0\nface_gaps = \"exact\""),
+        &["nscd.face_gaps: the gap rule of two polyhedra's face–face contacts is a 3D setting"],
+    );
     expect(&edit("every = 2", "every = 0"), &["output.every"]);
 }
 

@@ -14,6 +14,7 @@ use ballast::nscd::d3::rows::read_cycles;
 use ballast::nscd::d3::system::System3;
 use ballast::scenarios::track3d::{self, LoadingSpec, SampleReport, SampleSpec, GRAIN_PREFIX, PAD_PREFIX, SLEEPER};
 use ballast::scene::{Scene3, SceneFile};
+use ballast::space::detection::FaceGaps;
 use ballast::studies::track3d::{self as study, SettleOptions};
 use ballast::studies::{Accelerate, Quiet};
 use track3d_common::{ballast, named, refused, sample, GRAINS, LOAD_DT};
@@ -186,6 +187,11 @@ fn the_loaded_scene_puts_the_sleeper_on_the_grains() {
     assert_eq!((load.frequency, load.phase, load.direction), (20.0, -std::f64::consts::PI, [0.0, 0.0, 1.0]));
     let imposed = body.imposed.unwrap();
     assert!(imposed.vx.is_some() && imposed.vy.is_some() && imposed.vz.is_none() && imposed.spin.is_some());
+    // The face–face gap rule: exact unless asked, LMGC90's common plane when asked.
+    assert_eq!(sys.params.face_gaps, FaceGaps::Exact);
+    let common = LoadingSpec { face_gaps: "common_plane".into(), ..spec };
+    study::load(&s.path, &common, &out).unwrap();
+    assert_eq!(Scene3::load(&out).unwrap().build().unwrap().params.face_gaps, FaceGaps::CommonPlane);
 }
 
 /// Two cycles: two rows of cycles.csv, the sleeper went down (it landed and pressed the layer and the sublayer),
@@ -285,6 +291,7 @@ fn bad_specs_name_their_field() {
     bad_loading(LoadingSpec { sleeper_length: Some(-1.0), ..d.clone() }, "sleeper_length");
     bad_loading(LoadingSpec { criterion: "fast".into(), ..d.clone() }, "criterion");
     bad_loading(LoadingSpec { tolerance: 2.0, ..d.clone() }, "tolerance");
+    bad_loading(LoadingSpec { face_gaps: "flat".into(), ..d.clone() }, "face_gaps");
     bad_loading(LoadingSpec { mean_pressure: f64::INFINITY, ..d.clone() }, "mean_pressure");
     bad_loading(LoadingSpec { dt: 0.0, ..d }, "dt");
 }
@@ -297,13 +304,14 @@ fn bad_flags_are_named_on_one_line() {
     let sample = s.path.to_str().unwrap();
     let out = dir.join("x.toml");
     let out = out.to_str().unwrap();
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 7] = [
         (&["track3d", "sample", "--grains", "0", "--out", out], "--grains:"),
         (&["track3d", "sample", "--grains", "10", "--tolerance", "2", "--out", out], "--tolerance:"),
         (&["track3d", "sample", "--grains", "10", "--dt=-1", "--out", out], "--dt:"),
         (&["track3d", "load", "--sample", sample, "--out", out, "--cycles", "0"], "--cycles:"),
         (&["track3d", "load", "--sample", sample, "--out", out, "--sleeper-width", "3"], "--sleeper-width:"),
         (&["track3d", "load", "--sample", sample, "--out", out, "--mean-pressure", "inf"], "--mean-pressure:"),
+        (&["track3d", "load", "--sample", sample, "--out", out, "--face-gaps", "flat"], "--face-gaps:"),
     ];
     for (args, flag) in cases {
         refused(args, flag);

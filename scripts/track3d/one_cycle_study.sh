@@ -11,6 +11,9 @@
 #   q3  quad 1e-3, 12 replicas;  e5 energy 1.66e-5, 6;  q4 quad 1e-4 (at most 2 000 sweeps), 6;
 #   q4x quad 1e-4 reached on every step (on_stall = "extend", up to 20 000 sweeps), 2 — the reference.
 # Then: python3 summarize_cycle.py OUT_DIR q4x q3 e5 q4
+# SETTINGS="q3 quad 1e-3 6;q4 quad 1e-4 6" runs those instead (name criterion tolerance replicas, `;` between),
+# and REFERENCE names the summary's reference (default: the last setting).
+# The scene's own [nscd] keys other than these (e.g. face_gaps) are kept.
 set -euo pipefail
 SCENE=$1
 OUT=$2
@@ -26,6 +29,18 @@ go() { # name criterion tolerance replica [extra]
       -e "s/^max_iterations = \(.*\)/max_iterations = \1${5:-}/" "$OUT/start$4.toml" > "$n.toml"
   "$BALLAST" run "$n.toml" --out "$n" --steps "$STEPS" --threads 1 --quiet > "$n.log" 2>&1
 }
+if [ -n "${SETTINGS:-}" ]; then
+  names=()
+  IFS=';' read -ra rows <<< "$SETTINGS"
+  for row in "${rows[@]}"; do
+    read -r name crit tol reps <<< "$row"
+    names+=("$name")
+    for ((r = 0; r < reps; r++)); do go "$name" "$crit" "$tol" "$r"; done
+  done
+  ref=${REFERENCE:-${names[-1]}}
+  python3 "$HERE/summarize_cycle.py" "$OUT" "$ref" $(printf '%s\n' "${names[@]}" | grep -vx "$ref")
+  exit 0
+fi
 for r in 0 1 2 3 4 5 6 7 8 9 10 11; do go q3 quad 1e-3 $r; done
 for r in 0 1 2 3 4 5; do go e5 energy 1.66e-5 $r; done
 for r in 0 1 2 3 4 5; do go q4 quad 1e-4 $r; done

@@ -150,6 +150,10 @@ pub struct LoadingArgs {
     pub min_iterations: usize,
     #[arg(long, default_value_t = LoadingSpec::default().max_iterations)]
     pub max_iterations: usize,
+    /// Gaps of the grains' face–face contacts: exact (each point its own) or common_plane (LMGC90's: the
+    /// smallest, the faces counted flush).
+    #[arg(long, default_value_t = LoadingSpec::default().face_gaps)]
+    pub face_gaps: String,
     /// Width of the sleeper along the track (m); default: half the box's length (0.3 m on the full section).
     #[arg(long)]
     pub sleeper_width: Option<f64>,
@@ -180,6 +184,7 @@ impl LoadingArgs {
             tolerance: self.tolerance,
             min_iterations: self.min_iterations,
             max_iterations: self.max_iterations,
+            face_gaps: self.face_gaps.clone(),
             sleeper_width: self.sleeper_width,
             sleeper_length: self.sleeper_length,
             mean_pressure: self.mean_pressure,
@@ -193,7 +198,7 @@ impl LoadingArgs {
 
 /// The spec fields of this command's library calls and their flags (the shared ones, `dt`, `cycles`, …, are
 /// mapped by `flags.rs` too).
-const FLAGS: [(&str, &str); 21] = [
+const FLAGS: [(&str, &str); 22] = [
     ("grains", "--grains"),
     ("dt", "--dt"),
     ("max_duration", "--max-duration"),
@@ -202,6 +207,7 @@ const FLAGS: [(&str, &str); 21] = [
     ("tolerance", "--tolerance"),
     ("min_iterations", "--min-iterations"),
     ("max_iterations", "--max-iterations"),
+    ("face_gaps", "--face-gaps"),
     ("sleeper_width", "--sleeper-width"),
     ("sleeper_length", "--sleeper-length"),
     ("mean_pressure", "--mean-pressure"),

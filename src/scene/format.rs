@@ -98,6 +98,11 @@ pub struct NscdSection {
     /// smallest inner radius of the non-fixed bodies (of all bodies if none moves).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub alert_distance: Option<f64>,
+    /// 3D scenes only: how the points of a face–face contact of two polyhedra get their gaps, `"exact"`
+    /// (default: each its own) or `"common_plane"` (LMGC90's rule: the smallest, the faces counted flush;
+    /// [`crate::space::detection::FaceGaps`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub face_gaps: Option<String>,
 }
 
 /// `[[material]]`.

@@ -213,7 +213,7 @@ pub(crate) fn steps_of(dt: f64, duration: f64) -> u64 {
 /// The value of an optional named key of `[nscd]`: `default` when absent, else
 /// the value `from_name` finds, or the error "`key`: unknown `what` '…', expected
 /// `expected`".
-fn named<T>(
+pub(crate) fn named<T>(
     key: &str,
     what: &str,
     given: Option<&str>,
@@ -350,6 +350,11 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
     let relaxation = ns.relaxation.unwrap_or(defaults.nlgs.relaxation);
     if !(relaxation > 0.0 && relaxation < 2.0) {
         return err(format!("nscd.relaxation: must be in (0, 2), got {}", num(relaxation)));
+    }
+    if ns.face_gaps.is_some() {
+        return err("nscd.face_gaps: the gap rule of two polyhedra's face–face contacts is a 3D setting; a 2D \
+                    scene's polygons have their own detection: remove the key"
+            .to_string());
     }
     if let Some(a) = ns.alert_distance {
         non_negative("nscd.alert_distance", a)?;

@@ -35,7 +35,7 @@ use crate::nscd::method::{
     apply_impulses, check_by_row, solve_nlgs_split, NlgsReport, NlgsSettings, OnStall, Solver, SweepNorms,
 };
 use crate::space::bodies::{advance, Bodies, Dofs6};
-use crate::space::detection::Detector;
+use crate::space::detection::{Detector, FaceGaps};
 use crate::space::loads::LoadKind;
 use crate::space::springs::Spring3;
 use crate::{Error, Result};
@@ -54,6 +54,10 @@ pub struct Params3 {
     /// the largest speed of a point of a non-fixed body at the start of the step, when the fastest body needs it
     /// (as in 2D). Default 1e-3.
     pub alert_distance: f64,
+    /// How the points of a face–face contact of two polyhedra get their gaps: each its own
+    /// ([`FaceGaps::Exact`], the default) or, as in LMGC90, the smallest ([`FaceGaps::CommonPlane`]).
+    #[serde(default)]
+    pub face_gaps: FaceGaps,
     /// The Gauss–Seidel's policy, tolerance and caps ([`NlgsSettings::default`]).
     pub nlgs: NlgsSettings,
 }
@@ -65,6 +69,7 @@ impl Default for Params3 {
             theta: 0.5,
             gravity: Vec3::new(0.0, 0.0, -9.81),
             alert_distance: 1e-3,
+            face_gaps: FaceGaps::Exact,
             nlgs: NlgsSettings::default(),
         }
     }
@@ -377,6 +382,7 @@ impl System3 {
         self.mobile.clear();
         self.mobile.extend((0..n).map(|i| self.bodies.is_free(i)));
         let alert = self.params.alert_distance.max(2.0 * h * self.fastest_point_speed());
+        self.detector.set_face_gaps(self.params.face_gaps);
         self.detector.run(&self.bodies.info, &self.poses_m, &self.mobile, alert);
         let detect_seconds = clock.elapsed().as_secs_f64();
         // 3. Rows, warm start, solve.

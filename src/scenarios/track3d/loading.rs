@@ -68,6 +68,9 @@ pub struct LoadingSpec {
     pub min_iterations: usize,
     /// Most sweeps per step (≥ `min_iterations`).
     pub max_iterations: usize,
+    /// The face–face gap rule of the grains' contacts (`nscd.face_gaps`): `exact` (default) or `common_plane`
+    /// (LMGC90's; [`crate::space::detection::FaceGaps`]).
+    pub face_gaps: String,
     /// Steps between rows of `series.csv`.
     pub output_every: u64,
 }
@@ -91,6 +94,7 @@ impl LoadingSpec {
             tolerance: 1e-4,
             min_iterations: 1,
             max_iterations: 2000,
+            face_gaps: "exact".into(),
             output_every: 10,
         }
     }
@@ -125,6 +129,9 @@ impl LoadingSpec {
         }
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
             return refuse(format!("tolerance: must be in (0, 1), got {}", self.tolerance));
+        }
+        if crate::space::detection::FaceGaps::from_name(&self.face_gaps).is_none() {
+            return refuse(format!("face_gaps: '{}' is not one of 'exact', 'common_plane'", self.face_gaps));
         }
         if self.min_iterations == 0 || self.max_iterations < self.min_iterations {
             return refuse(format!(
@@ -219,6 +226,7 @@ pub fn loaded_scene(sample: &Scene3, spec: &LoadingSpec) -> Result<Scene3> {
     nscd.tolerance = Some(spec.tolerance);
     nscd.min_iterations = Some(spec.min_iterations);
     nscd.max_iterations = Some(spec.max_iterations);
+    nscd.face_gaps = Some(spec.face_gaps.clone());
     out.output = Some(OutputSection {
         every: Some(spec.output_every),
         cycles: Some(CyclesSpec { frequency: spec.frequency, body: Some(SLEEPER.into()), positions: Some(true) }),

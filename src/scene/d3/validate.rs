@@ -19,6 +19,7 @@ use crate::nscd::nlgs::{NlgsSettings, Solver};
 use crate::scene::common::{check_output, check_simulation};
 use crate::scene::validate::{err, label, num};
 use crate::scene::{Material, Scene, SceneFile};
+use crate::space::detection::FaceGaps;
 use crate::space::loads::{Imposed3, Load3};
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::collections::HashMap;
@@ -66,6 +67,14 @@ pub(crate) fn check(scene: &Scene3) -> Result<Checked3> {
     }
     check_simulation(sim, "nscd", 3)?;
     let (theta, nlgs) = check_shared(scene)?;
+    let face_gaps = crate::scene::validate::named(
+        "nscd.face_gaps",
+        "rule",
+        scene.nscd.as_ref().and_then(|n| n.face_gaps.as_deref()),
+        FaceGaps::default(),
+        FaceGaps::from_name,
+        "'exact' or 'common_plane'",
+    )?;
     let materials: HashMap<&str, usize> =
         scene.materials.iter().enumerate().map(|(i, m)| (m.name.as_str(), i)).collect();
     let (bodies, names) = check_bodies(scene, &materials)?;
@@ -80,6 +89,7 @@ pub(crate) fn check(scene: &Scene3) -> Result<Checked3> {
         theta,
         gravity: Vec3::from(gravity),
         alert_distance: alert_distance(scene, &bodies),
+        face_gaps,
         nlgs,
     };
     Ok(Checked3 { params, bodies, springs })
@@ -95,7 +105,8 @@ fn check_shared(scene: &Scene3) -> Result<(f64, NlgsSettings)> {
     while scene.materials.iter().any(|m| m.name == own) {
         own.push('_');
     }
-    probe.nscd = scene.nscd.clone();
+    // The 3D-only key is read by `check`.
+    probe.nscd = scene.nscd.clone().map(|n| crate::scene::format::NscdSection { face_gaps: None, ..n });
     probe.contacts = scene.contacts.clone();
     probe.materials = scene.materials.clone();
     probe.materials.push(Material { name: own.clone(), density: 1.0 });

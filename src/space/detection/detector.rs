@@ -26,6 +26,7 @@ mod share;
 use super::broad::{Aabb3, Broad3};
 use super::narrow::Scratch;
 use super::placed::{Plane, Topologies};
+use super::FaceGaps;
 use crate::geometry::{Pose, Solid, Vec3};
 use crate::team::{Team, TeamStats};
 use place::{PlaceBlock, PLACE_BLOCKS, PLACE_MIN};
@@ -116,6 +117,8 @@ pub struct Detector {
     around: Vec<u32>,
     memory: Memory,
     next_memory: Memory,
+    /// The face–face gap rule of polyhedron pairs.
+    face_gaps: FaceGaps,
     /// The caller's polygon buffers.
     scratch: Scratch,
     /// The helper's share (in its own allocation, see [`Ctx`]).
@@ -143,6 +146,16 @@ impl Detector {
         if (threads >= 2) != (self.team.threads() >= 2) {
             self.team = Team::new(threads.min(2));
         }
+    }
+
+    /// Sets the face–face gap rule of polyhedron pairs ([`FaceGaps::Exact`] by default).
+    pub fn set_face_gaps(&mut self, face_gaps: FaceGaps) {
+        self.face_gaps = face_gaps;
+    }
+
+    /// The face–face gap rule of polyhedron pairs.
+    pub fn face_gaps(&self) -> FaceGaps {
+        self.face_gaps
     }
 
     /// Threads of the narrow phase (1 or 2).
@@ -330,7 +343,7 @@ impl Detector {
     /// caller takes blocks of pairs from the front and the helper (with two threads) from the back, and the
     /// helper's blocks are then appended in order.
     fn narrow_all<S: Borrow<Solid> + Sync>(&mut self, solids: &[S], alert: f64) {
-        let Detector { world, shapes, pairs, memory, next_memory, scratch, back, team, found, .. } = self;
+        let Detector { world, shapes, pairs, memory, next_memory, face_gaps, scratch, back, team, found, .. } = self;
         let ctx = Ctx {
             placed: &world.placed,
             vertices: &world.vertices,
@@ -342,6 +355,7 @@ impl Detector {
             pairs,
             memory,
             alert,
+            face_gaps: *face_gaps,
         };
         // The caller's outputs on its own stack while the helper runs (see `Ctx`).
         let (mut found_here, mut memory_here) = (std::mem::take(found), std::mem::take(next_memory));

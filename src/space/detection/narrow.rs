@@ -14,7 +14,7 @@
 use super::axis::{common_plane_in, is_exact, refine, AxisKind, CommonPlane, Dots, Search};
 use super::placed::{Plane, PolyhedronView};
 use super::polygon::{self, contact_points_in, reduce_points, Frame, Label, Labelled, CAP};
-use super::Manifold;
+use super::{FaceGaps, Manifold, COMMON_PLANE_BAND};
 use crate::geometry::{Vec2, Vec3};
 
 /// Length tolerance of the polygon work, relative to the smaller radius of the pair.
@@ -35,18 +35,30 @@ pub fn polyhedron_polyhedron(
     alert: f64,
     hint: Option<&Vec3>,
 ) -> Option<Manifold> {
+    polyhedron_polyhedron_with(a, b, alert, hint, FaceGaps::Exact)
+}
+
+/// [`polyhedron_polyhedron`] with the face–face gap rule `face_gaps`.
+pub fn polyhedron_polyhedron_with(
+    a: &PolyhedronView,
+    b: &PolyhedronView,
+    alert: f64,
+    hint: Option<&Vec3>,
+    face_gaps: FaceGaps,
+) -> Option<Manifold> {
     let mut m = Manifold::new(Vec3::z());
-    polyhedron_polyhedron_into(a, b, alert, hint, &mut Scratch::default(), &mut m).0.then_some(m)
+    polyhedron_polyhedron_into(a, b, alert, hint, face_gaps, &mut Scratch::default(), &mut m).0.then_some(m)
 }
 
 /// [`polyhedron_polyhedron`] into `m` (meaningful when the first value returned is true: a contact), with
 /// the axis to remember for the next step: the normal when in contact, else the axis found to separate the
-/// two; `scratch` holds the polygon work's buffers.
+/// two; `face_gaps` is the face–face gap rule; `scratch` holds the polygon work's buffers.
 pub(crate) fn polyhedron_polyhedron_into(
     a: &PolyhedronView,
     b: &PolyhedronView,
     alert: f64,
     hint: Option<&Vec3>,
+    face_gaps: FaceGaps,
     scratch: &mut Scratch,
     m: &mut Manifold,
 ) -> (bool, Vec3) {
@@ -61,13 +73,13 @@ pub(crate) fn polyhedron_polyhedron_into(
             Search::Plane(p) => plane = p,
         }
     }
-    let met = on_plane(a, b, alert, &plane, &mut scratch.polygon, m);
+    let met = on_plane(a, b, alert, &plane, face_gaps, &mut scratch.polygon, m);
     if !met && plane.separation > 0.0 && plane.kind != AxisKind::Closest {
         // The projections missed each other although the axis looked exact: ask GJK.
         match refine(a, b, alert, plane) {
             Search::Apart(axis) => return (false, axis),
             Search::Plane(p) if p.kind == AxisKind::Closest => {
-                on_plane(a, b, alert, &p, &mut scratch.polygon, m);
+                on_plane(a, b, alert, &p, face_gaps, &mut scratch.polygon, m);
                 return (m.len > 0, p.normal);
             }
             Search::Plane(_) => {}
@@ -76,13 +88,14 @@ pub(crate) fn polyhedron_polyhedron_into(
     (m.len > 0, plane.normal)
 }
 
-/// The contact points of `a` and `b` on the common plane `plane`, into `m`, and whether the features'
-/// projections met.
+/// The contact points of `a` and `b` on the common plane `plane`, into `m`, under the face–face gap rule
+/// `face_gaps`, and whether the features' projections met.
 fn on_plane(
     a: &PolyhedronView,
     b: &PolyhedronView,
     alert: f64,
     plane: &CommonPlane,
+    face_gaps: FaceGaps,
     scratch: &mut polygon::Scratch,
     m: &mut Manifold,
 ) -> bool {
@@ -90,9 +103,33 @@ fn on_plane(
     *m = Manifold::new(n);
     let eps = EPS * a.radius.min(b.radius);
     let frame = Frame { o: 0.5 * (a.centre + b.centre), t1: m.t1, t2: m.t2, n, eps };
+    if face_gaps == FaceGaps::CommonPlane {
+        if let Some(band) = face_face_band(a, b, &n, plane.separation, eps) {
+            let met =
+                contact_points_in(scratch, a, b, &frame, band, f64::INFINITY, plane.witness, |x, gap| m.push(x, gap));
+            let g = m.points().iter().map(|p| p.gap).fold(f64::INFINITY, f64::min);
+            for p in &mut m.points[..m.len] {
+                p.gap = g;
+            }
+            return met;
+        }
+    }
     // Every vertex that could have a gap within the alert distance against a flat opposite surface.
     let band = (alert - plane.separation).max(0.0) + eps;
     contact_points_in(scratch, a, b, &frame, band, alert, plane.witness, |x, gap| m.push(x, gap))
+}
+
+/// [`FaceGaps::CommonPlane`]'s test: the band (m) when both `a` (on the `+n` side) and `b` have at least three
+/// vertices within it of their vertex nearest the plane, else `None`; `separation` is the plane's (m).
+fn face_face_band(a: &PolyhedronView, b: &PolyhedronView, n: &Vec3, separation: f64, eps: f64) -> Option<f64> {
+    let (lo_a, _) = a.extent(n, &a.centre);
+    let (_, hi_b) = b.extent(n, &b.centre);
+    let reference = (-lo_a).min(hi_b).max(0.0);
+    let band = COMMON_PLANE_BAND * reference + 0.5 * (-separation).max(0.0) + eps;
+    let near = |v: &PolyhedronView, extreme: f64, sign: f64| {
+        v.vertices.iter().filter(|x| sign * (n.dot(&(*x - v.centre)) - extreme) <= band).take(3).count() == 3
+    };
+    (near(a, lo_a, 1.0) && near(b, hi_b, -1.0)).then_some(band)
 }
 
 /// A vertex near a wall.

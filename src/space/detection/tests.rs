@@ -2,7 +2,9 @@
 //! face, shifted, edge to face, vertex to face and edge across edge: unit cubes (half size 0.5), gaps of
 //! ±1e-3 within an alert distance of 1e-2, and every case again under random rigid motions of the pair.
 
-use super::narrow::{polyhedron_polyhedron, sphere_half_space, sphere_polyhedron, sphere_sphere};
+use super::narrow::{
+    polyhedron_polyhedron, polyhedron_polyhedron_with, sphere_half_space, sphere_polyhedron, sphere_sphere,
+};
 use super::*;
 use crate::geometry::{Face, Polyhedron, Pose, Vec3};
 use nalgebra::{Unit, UnitQuaternion};
@@ -208,6 +210,41 @@ fn tilted_face_has_a_gap_per_point() {
     let mid: Vec<Vec3> = expected.iter().map(|v| Vec3::new(v.x, v.y, 0.5 * (v.z + 0.5))).collect();
     check(&m, Vec3::z(), &mid, &gaps);
     assert!((gaps[0] - gaps[2]).abs() > 1.5e-3, "the two sides differ: {gaps:?}");
+}
+
+/// LMGC90's face–face rule ([`FaceGaps::CommonPlane`]) on a 0.4 cube on a unit cube, tilted about x by `tilt`
+/// (rad): the band is 10 % of the smaller centroid-to-plane distance, 0.1 × 0.4 = 0.04, and the tilted bottom face
+/// spans 0.8 sin(tilt) along the normal. Below 0.05 rad its four corners are within the band: the four points of
+/// the exact rule, each with the exact rule's smallest gap. Above, only the low edge is: the exact rule's points
+/// and gaps, as LMGC90's edge–face case.
+#[test]
+fn common_plane_gaps_flatten_only_face_face_contacts() {
+    let top = Polyhedron::cuboid([0.4; 3]).unwrap();
+    for (tilt, face_face) in [(2e-3, true), (0.03, true), (0.08, false), (0.2, false)] {
+        for g in GAPS {
+            let r = about(Vec3::x(), tilt);
+            // The lowest corner at gap g above the unit cube's top face (z = 0.5).
+            let low = (0..8).map(|k| (r * top.vertices[k]).z).fold(f64::INFINITY, f64::min);
+            let pa = pose(Vec3::new(0.0, 0.0, 0.5 + g - low), r);
+            let (va, vb) = (PlacedPolyhedron::new(&top, &pa), PlacedPolyhedron::new(&cube(), &Pose::at(Vec3::zeros())));
+            let exact = polyhedron_polyhedron_with(&va.view(), &vb.view(), ALERT, None, FaceGaps::Exact).unwrap();
+            let common =
+                polyhedron_polyhedron_with(&va.view(), &vb.view(), ALERT, None, FaceGaps::CommonPlane).unwrap();
+            assert!((exact.points().iter().map(|p| p.gap).fold(f64::INFINITY, f64::min) - g).abs() < TOL);
+            if face_face {
+                // The four corners, as the exact rule gives them with an alert distance that reaches the far
+                // side (0.05 m: beyond the 0.024 m spread, short of the top face 0.8 m up).
+                let all = polyhedron_polyhedron_with(&va.view(), &vb.view(), 0.05, None, FaceGaps::Exact).unwrap();
+                let pts: Vec<Vec3> = all.points().iter().map(|p| p.position).collect();
+                check(&common, exact.normal, &pts, &[g; 4]);
+                let spread = all.points().iter().map(|p| p.gap).fold(f64::NEG_INFINITY, f64::max) - g;
+                assert!((spread - 0.8 * tilt.sin()).abs() < 1e-9, "tilt {tilt}: exact gaps spread {spread}");
+            } else {
+                assert_eq!(common, exact, "tilt {tilt}: an edge on a face keeps its exact gaps");
+                assert_eq!(exact.len, 2, "tilt {tilt}: the low edge");
+            }
+        }
+    }
 }
 
 #[test]

@@ -9,7 +9,7 @@ use super::super::narrow::{
     sphere_sphere, Scratch,
 };
 use super::super::placed::{Edge3, PolyhedronView};
-use super::super::Manifold;
+use super::super::{FaceGaps, Manifold};
 use super::{Found, Memory, Placed};
 use crate::geometry::{Solid, Vec3};
 use std::borrow::Borrow;
@@ -97,6 +97,7 @@ pub(super) struct Ctx<'a, S> {
     pub(super) pairs: &'a [(u32, u32)],
     pub(super) memory: &'a [((u32, u32), Vec3)],
     pub(super) alert: f64,
+    pub(super) face_gaps: FaceGaps,
 }
 
 impl<S: Borrow<Solid>> Ctx<'_, S> {
@@ -194,7 +195,7 @@ impl<S: Borrow<Solid>> Ctx<'_, S> {
         let m = match (self.placed[i as usize], self.placed[j as usize]) {
             (Placed::Polyhedron { .. }, Placed::Polyhedron { .. }) => {
                 let (Some(a), Some(b)) = (self.view(i), self.view(j)) else { return false };
-                let (met, axis) = polyhedron_polyhedron_into(&a, &b, alert, hint, scratch, out);
+                let (met, axis) = polyhedron_polyhedron_into(&a, &b, alert, hint, self.face_gaps, scratch, out);
                 memory.push(((i, j), axis));
                 return met;
             }
