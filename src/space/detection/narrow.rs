@@ -107,7 +107,11 @@ fn on_plane(
         if let Some(band) = face_face_band(a, b, &n, plane.separation, eps) {
             let met =
                 contact_points_in(scratch, a, b, &frame, band, f64::INFINITY, plane.witness, |x, gap| m.push(x, gap));
+            // The points are kept whatever their gap; the contact is, as the exact rule's, only within the alert.
             let g = m.points().iter().map(|p| p.gap).fold(f64::INFINITY, f64::min);
+            if g > alert {
+                m.len = 0;
+            }
             for p in &mut m.points[..m.len] {
                 p.gap = g;
             }
