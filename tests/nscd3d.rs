@@ -269,8 +269,9 @@ fn a_cube_thrown_fast_at_the_floor_stops_on_it() {
 
 /// The face–face gap rule in the mechanics. A 0.1 m cube rests on one edge on a fixed polyhedral slab, its
 /// bottom face tilted by 1 mrad, so that the far edge is 0.1 mm up. Under the exact gaps (the default) the far
-/// points are open, and gravity rocks the cube about the low edge until it lies flat: within a few ms, since
-/// its angular acceleration about the edge is about 3 g / (4 half) ≈ 150 rad/s², and it lands plastically. Under
+/// points are open, and gravity rocks the cube about the low edge until it lies flat: in about 5 ms, since its
+/// angular acceleration about the edge is 3 g / (4 a) ≈ 74 rad/s² (side a = 0.1 m, moment of inertia about the
+/// edge 2 m a² / 3), and it lands plastically. Under
 /// LMGC90's common-plane rule the four corners share the low edge's gap (0), so the faces count as flush and
 /// the cube stays at its tilt: it cannot turn about the edge without closing the far points' gap.
 #[test]
