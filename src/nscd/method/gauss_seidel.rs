@@ -144,19 +144,18 @@ pub fn check_by_row<R: Row, S: Row<Dofs = R::Dofs>>(
     rows: &mut [R],
     springs: &mut [S],
 ) -> (Vec<SweepNorms>, Vec<SweepNorms>) {
-    let mut of_springs = Vec::with_capacity(springs.len());
-    for s in springs {
-        let mut norms = SweepNorms::default();
-        s.visit::<false>(u, inv_m, 1.0, &mut norms);
-        of_springs.push(norms);
-    }
-    let mut of_rows = Vec::with_capacity(rows.len());
-    for r in rows {
-        let mut norms = SweepNorms::default();
-        r.visit::<false>(u, inv_m, 1.0, &mut norms);
-        of_rows.push(norms);
-    }
-    (of_springs, of_rows)
+    (each_checked(u, inv_m, springs), each_checked(u, inv_m, rows))
+}
+
+/// Each row of `rows` visited by the check pass on its own: its norms, in order.
+fn each_checked<R: Row>(u: &mut [R::Dofs], inv_m: &[R::Dofs], rows: &mut [R]) -> Vec<SweepNorms> {
+    rows.iter_mut()
+        .map(|r| {
+            let mut norms = SweepNorms::default();
+            r.visit::<false>(u, inv_m, 1.0, &mut norms);
+            norms
+        })
+        .collect()
 }
 
 /// One pass of the given kind.

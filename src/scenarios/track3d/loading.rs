@@ -94,7 +94,7 @@ impl LoadingSpec {
             tolerance: 1e-4,
             min_iterations: 1,
             max_iterations: 2000,
-            face_gaps: "exact".into(),
+            face_gaps: crate::space::detection::FaceGaps::Exact.name().into(),
             output_every: 10,
         }
     }

@@ -153,11 +153,6 @@ impl Detector {
         self.face_gaps = face_gaps;
     }
 
-    /// The face–face gap rule of polyhedron pairs.
-    pub fn face_gaps(&self) -> FaceGaps {
-        self.face_gaps
-    }
-
     /// Threads of the narrow phase (1 or 2).
     pub fn threads(&self) -> usize {
         self.team.threads()

@@ -2,9 +2,7 @@
 //! face, shifted, edge to face, vertex to face and edge across edge: unit cubes (half size 0.5), gaps of
 //! ±1e-3 within an alert distance of 1e-2, and every case again under random rigid motions of the pair.
 
-use super::narrow::{
-    polyhedron_polyhedron, polyhedron_polyhedron_with, sphere_half_space, sphere_polyhedron, sphere_sphere,
-};
+use super::narrow::{polyhedron_polyhedron_with, sphere_half_space, sphere_polyhedron, sphere_sphere};
 use super::*;
 use crate::geometry::{Face, Polyhedron, Pose, Vec3};
 use nalgebra::{Unit, UnitQuaternion};
@@ -60,8 +58,13 @@ fn tetrahedron(r: f64) -> Polyhedron {
 
 /// The contact of candidate `a` at `pa` with antagonist `b` at `pb`.
 fn contact(a: &Polyhedron, pa: &Pose, b: &Polyhedron, pb: &Pose, alert: f64) -> Option<Manifold> {
+    contact_with(a, pa, b, pb, alert, FaceGaps::Exact)
+}
+
+/// [`contact`] under the face–face gap rule `rule`.
+fn contact_with(a: &Polyhedron, pa: &Pose, b: &Polyhedron, pb: &Pose, alert: f64, rule: FaceGaps) -> Option<Manifold> {
     let (va, vb) = (PlacedPolyhedron::new(a, pa), PlacedPolyhedron::new(b, pb));
-    polyhedron_polyhedron(&va.view(), &vb.view(), alert, None)
+    polyhedron_polyhedron_with(&va.view(), &vb.view(), alert, None, rule)
 }
 
 fn close(a: &Vec3, b: &Vec3) -> bool {
@@ -226,15 +229,14 @@ fn common_plane_gaps_flatten_only_face_face_contacts() {
             // The lowest corner at gap g above the unit cube's top face (z = 0.5).
             let low = (0..8).map(|k| (r * top.vertices[k]).z).fold(f64::INFINITY, f64::min);
             let pa = pose(Vec3::new(0.0, 0.0, 0.5 + g - low), r);
-            let (va, vb) = (PlacedPolyhedron::new(&top, &pa), PlacedPolyhedron::new(&cube(), &Pose::at(Vec3::zeros())));
-            let exact = polyhedron_polyhedron_with(&va.view(), &vb.view(), ALERT, None, FaceGaps::Exact).unwrap();
-            let common =
-                polyhedron_polyhedron_with(&va.view(), &vb.view(), ALERT, None, FaceGaps::CommonPlane).unwrap();
+            let (bottom, pb) = (cube(), Pose::at(Vec3::zeros()));
+            let exact = contact_with(&top, &pa, &bottom, &pb, ALERT, FaceGaps::Exact).unwrap();
+            let common = contact_with(&top, &pa, &bottom, &pb, ALERT, FaceGaps::CommonPlane).unwrap();
             assert!((exact.points().iter().map(|p| p.gap).fold(f64::INFINITY, f64::min) - g).abs() < TOL);
             if face_face {
                 // The four corners, as the exact rule gives them with an alert distance that reaches the far
                 // side (0.05 m: beyond the 0.024 m spread, short of the top face 0.8 m up).
-                let all = polyhedron_polyhedron_with(&va.view(), &vb.view(), 0.05, None, FaceGaps::Exact).unwrap();
+                let all = contact_with(&top, &pa, &bottom, &pb, 0.05, FaceGaps::Exact).unwrap();
                 let pts: Vec<Vec3> = all.points().iter().map(|p| p.position).collect();
                 check(&common, exact.normal, &pts, &[g; 4]);
                 let spread = all.points().iter().map(|p| p.gap).fold(f64::NEG_INFINITY, f64::max) - g;
@@ -312,16 +314,12 @@ fn moved(p: &Pose, (r, t): &(UnitQuaternion<f64>, Vec3)) -> Pose {
 #[test]
 fn invariant_under_a_rigid_motion_of_the_pair() {
     let mut rng = ChaCha8Rng::seed_from_u64(36);
-    let with = |a: &Polyhedron, pa: &Pose, b: &Polyhedron, pb: &Pose, rule: FaceGaps| {
-        let (va, vb) = (PlacedPolyhedron::new(a, pa), PlacedPolyhedron::new(b, pb));
-        polyhedron_polyhedron_with(&va.view(), &vb.view(), ALERT, None, rule).unwrap()
-    };
     for (g, rule) in GAPS.into_iter().flat_map(|g| [(g, FaceGaps::Exact), (g, FaceGaps::CommonPlane)]) {
         for (name, a, pa, b, pb) in cases(g) {
-            let m0 = with(&a, &pa, &b, &pb, rule);
+            let m0 = contact_with(&a, &pa, &b, &pb, ALERT, rule).unwrap();
             for _ in 0..20 {
                 let mv = motion(&mut rng);
-                let m = with(&a, &moved(&pa, &mv), &b, &moved(&pb, &mv), rule);
+                let m = contact_with(&a, &moved(&pa, &mv), &b, &moved(&pb, &mv), ALERT, rule).unwrap();
                 assert!((mv.0 * m0.normal - m.normal).norm() < TOL, "{name}: normal");
                 assert_eq!(m.len, m0.len, "{name}: count");
                 for (p0, p) in m0.points().iter().zip(m.points()) {
