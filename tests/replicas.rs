@@ -123,6 +123,58 @@ fn md_perturbation_moves_every_sphere_within_the_ball() {
     assert!(mean.iter().all(|m| m.abs() < 1.6e-2), "E d / R = {mean:?}");
 }
 
+/// `ballast run --replica R --perturb D`: the run starts from the same scene the library's perturbation gives
+/// (2D polygons, 3D spheres, 3D polyhedra), records it in `scene.toml` and `replica.json`; replica 0 is the
+/// file byte for byte; a bad distance is refused naming the flag.
+#[test]
+fn run_replica_starts_from_the_librarys_perturbed_scene() {
+    use ballast::scene::Scene3;
+    use ballast::studies::replicas::{perturb_scene3, ReplicaRecord, REPLICA_FILE};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = scratch::dir("run-replica");
+    let p = Perturbation { distance_m: 1e-6, seed: 5 };
+    let go = |scene: &str, r: u64, out: &str| {
+        let (scene, out) = (root.join(scene), dir.join(out));
+        let (r, d, s) = (r.to_string(), p.distance_m.to_string(), p.seed.to_string());
+        let (scene_s, out_s) = (scene.to_str().unwrap(), out.to_str().unwrap());
+        run(&["run", scene_s, "--out", out_s, "--steps", "2", "--replica", &r, "--perturb", &d, "--perturb-seed", &s]);
+        let record: ReplicaRecord =
+            serde_json::from_str(&std::fs::read_to_string(out.join(REPLICA_FILE)).unwrap()).unwrap();
+        (out.join("scene.toml"), record)
+    };
+    // The recorded `scene.toml` has the run's length (`--steps`): the bodies are compared.
+    let (file, record) = go("examples/pentagon_deposit.toml", 3, "2d");
+    let mut want = Scene::load(root.join("examples/pentagon_deposit.toml")).unwrap();
+    let want_record = perturb_scene(&mut want, &p, 3).unwrap();
+    assert_eq!(record, want_record);
+    assert_eq!(Scene::load(&file).unwrap().bodies, want.bodies);
+    assert!(record.bodies_moved > 0 && record.largest_displacement_m <= 1e-6);
+
+    let (file, record) = go("examples/md_two_spheres.toml", 2, "md");
+    let mut want = MdScene::load(root.join("examples/md_two_spheres.toml")).unwrap();
+    assert_eq!(record, perturb_md_scene(&mut want, &p, 2).unwrap());
+    assert_eq!(MdScene::load(&file).unwrap().bodies, want.bodies);
+
+    let (file, record) = go("examples/cubes3d.toml", 1, "3d");
+    let mut want = Scene3::load(root.join("examples/cubes3d.toml")).unwrap();
+    assert_eq!(record, perturb_scene3(&mut want, &p, 1).unwrap());
+    assert_eq!(Scene3::load(&file).unwrap().bodies, want.bodies);
+
+    // Replica 0: the scene as it is, nothing moved.
+    let (file, record) = go("examples/cubes3d.toml", 0, "3d-0");
+    assert_eq!((record.replica, record.bodies_moved, record.largest_displacement_m), (0, 0, 0.0));
+    assert_eq!(Scene3::load(&file).unwrap().bodies, Scene3::load(root.join("examples/cubes3d.toml")).unwrap().bodies);
+
+    let r = Command::new(env!("CARGO_BIN_EXE_ballast"))
+        .args(["run", root.join("examples/cubes3d.toml").to_str().unwrap(), "--out"])
+        .arg(dir.join("bad"))
+        .args(["--replica", "1", "--perturb=-1e-9", "--quiet"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(!r.status.success() && err.contains("--perturb"), "{err}");
+}
+
 /// A 50-grain sample (as the ensemble study's test deposits it).
 fn sample(dir: &Path) -> String {
     let out = dir.join("sample");

@@ -6,6 +6,9 @@
 use super::{Bars, Failure};
 use ballast::run::{default_threads, RunLength, RunOptions};
 use ballast::settlement::AccelerationProgress;
+use ballast::studies::replicas::{
+    perturbed_text, Perturbation, Start, DEFAULT_PERTURBATION_M, DEFAULT_PERTURB_SEED, REPLICA_FILE,
+};
 use ballast::studies::run_loaded;
 use std::path::PathBuf;
 
@@ -58,6 +61,18 @@ pub struct RunArgs {
     /// in DIR records it. A 3D MD scene runs on `md` only.
     #[arg(long, value_name = "ENGINE", value_parser = ["nscd", "md2d", "md"])]
     engine: Option<String>,
+    /// Run replica R of the scene instead of the scene itself: R = 0 is the scene as it is, R ≥ 1 the scene
+    /// with every mobile body moved by at most --perturb, drawn from stream R of --perturb-seed (the starts
+    /// the studies' replicas have: `track3d settle --replicas`, `saussine convergence --replicas`). The scene
+    /// copy in DIR records the moved start, `DIR/replica.json` what was done.
+    #[arg(long, value_name = "R")]
+    replica: Option<u64>,
+    /// Largest displacement of a body at the replica's start (m), uniform in the disc (2D) or the ball (3D).
+    #[arg(long, value_name = "DIST", requires = "replica", default_value_t = DEFAULT_PERTURBATION_M, allow_negative_numbers = true)]
+    perturb: f64,
+    /// Seed of the perturbation (replica R draws from stream R of it).
+    #[arg(long, value_name = "SEED", requires = "replica", default_value_t = DEFAULT_PERTURB_SEED)]
+    perturb_seed: u64,
 }
 
 /// `ballast run`.
@@ -79,7 +94,19 @@ pub fn main(a: RunArgs) -> Result<(), Failure> {
     // A scene with `[settlement]` runs the settlement-acceleration procedure.
     let bar = super::cycle_bar(a.quiet);
     let mut show = |p: &AccelerationProgress| super::show_cycles(&bar, p);
-    let loaded = ballast::open::open(&a.scene, &opts)?;
+    let loaded = match a.replica {
+        None => ballast::open::open(&a.scene, &opts)?,
+        Some(replica) => {
+            let start = Start { replica, perturbation: Perturbation { distance_m: a.perturb, seed: a.perturb_seed } };
+            let text = ballast::scene::read_text(&a.scene)?;
+            let name = a.scene.display().to_string();
+            let (text, record) = perturbed_text(text, &name, opts.engine.as_deref(), &start)?;
+            let loaded = ballast::open::open_text(text, &a.scene, &opts)?;
+            ballast::io::create_output_dir(&a.out)?;
+            ballast::io::write_json(&a.out.join(REPLICA_FILE), &record)?;
+            loaded
+        }
+    };
     if loaded.settles() {
         let summary = loaded.settle(&a.out, &opts, &mut show)?;
         bar.finish_and_clear();

@@ -51,9 +51,11 @@
 
 mod ensemble;
 mod stats;
+mod text;
 
 pub use ensemble::*;
 pub use stats::*;
+pub use text::perturbed_text;
 
 use crate::error::{Error, Result};
 use crate::nscd::d3::rows::CycleRow3;
