@@ -279,8 +279,23 @@ fn bad_specs_name_their_field() {
     bad_sample(SampleSpec { pad_gap: 0.03, ..SampleSpec::track(1).scaled(10) }, "pad_gap");
     bad_sample(SampleSpec { friction: f64::NAN, ..SampleSpec::track(1).scaled(10) }, "friction");
     bad_sample(SampleSpec { tolerance: 0.0, ..SampleSpec::track(1).scaled(10) }, "tolerance");
+    bad_sample(SampleSpec { theta: 0.4, ..SampleSpec::track(1).scaled(10) }, "theta");
+    bad_sample(SampleSpec { theta: f64::NAN, ..SampleSpec::track(1).scaled(10) }, "theta");
+    // The deposit's θ is the scene's (default 1); the loaded scene has the loading's (default the paper's ½),
+    // not the sample's.
+    for theta in [0.5, 1.0] {
+        let scene = track3d::sample_scene(&SampleSpec { theta, ..SampleSpec::track(1).scaled(10) }).unwrap();
+        assert_eq!(scene.nscd.as_ref().and_then(|n| n.theta), Some(theta));
+    }
+    assert_eq!(SampleSpec::track(1).theta, 1.0);
     let (_, s) = sample();
     let sample_scene = Scene3::load(&s.path).unwrap();
+    assert_eq!(sample_scene.nscd.as_ref().and_then(|n| n.theta), Some(1.0));
+    for theta in [0.5, 0.75] {
+        let loaded = track3d::loaded_scene(&sample_scene, &LoadingSpec { theta, ..LoadingSpec::default() }).unwrap();
+        assert_eq!(loaded.nscd.as_ref().and_then(|n| n.theta), Some(theta));
+    }
+    assert_eq!(LoadingSpec::default().theta, 0.5);
     let bad_loading = |spec: LoadingSpec, field: &str| {
         let e = track3d::loaded_scene(&sample_scene, &spec).unwrap_err().to_string();
         assert!(e.starts_with(&format!("{field}:")), "{e}");
@@ -291,6 +306,7 @@ fn bad_specs_name_their_field() {
     bad_loading(LoadingSpec { sleeper_length: Some(-1.0), ..d.clone() }, "sleeper_length");
     bad_loading(LoadingSpec { criterion: "fast".into(), ..d.clone() }, "criterion");
     bad_loading(LoadingSpec { tolerance: 2.0, ..d.clone() }, "tolerance");
+    bad_loading(LoadingSpec { theta: 1.5, ..d.clone() }, "theta");
     bad_loading(LoadingSpec { face_gaps: "flat".into(), ..d.clone() }, "face_gaps");
     bad_loading(LoadingSpec { mean_pressure: f64::INFINITY, ..d.clone() }, "mean_pressure");
     bad_loading(LoadingSpec { dt: 0.0, ..d }, "dt");

@@ -37,6 +37,10 @@ pub enum Track3dCommand {
         /// Longest deposit (s); it ends earlier at equilibrium.
         #[arg(long, default_value_t = SampleSpec::default().max_duration)]
         max_duration: f64,
+        /// θ of the deposit's time scheme, in [0.5, 1]: 1 damps the grains' rocking and reaches rest
+        /// (docs/track3d.md, "The deposit's θ"); the loaded runs keep θ = 1/2.
+        #[arg(long, default_value_t = SampleSpec::default().theta)]
+        theta: f64,
         /// Tolerance of the deposit's solver (`quad` policy).
         #[arg(long, default_value_t = SampleSpec::default().tolerance)]
         tolerance: f64,
@@ -140,6 +144,9 @@ pub struct LoadingArgs {
     /// Time step (s).
     #[arg(long, default_value_t = LoadingSpec::default().dt)]
     pub dt: f64,
+    /// θ of the time scheme, in [0.5, 1] (the paper's 0.5, whatever the sample was deposited with).
+    #[arg(long, default_value_t = LoadingSpec::default().theta)]
+    pub theta: f64,
     /// Convergence policy: strict, quad, quad_max, energy, velocity.
     #[arg(long, default_value_t = LoadingSpec::default().criterion)]
     pub criterion: String,
@@ -180,6 +187,7 @@ impl LoadingArgs {
         LoadingSpec {
             cycles: self.cycles,
             dt: self.dt,
+            theta: self.theta,
             criterion: self.criterion.clone(),
             tolerance: self.tolerance,
             min_iterations: self.min_iterations,
@@ -198,10 +206,11 @@ impl LoadingArgs {
 
 /// The spec fields of this command's library calls and their flags (the shared ones, `dt`, `cycles`, …, are
 /// mapped by `flags.rs` too).
-const FLAGS: [(&str, &str); 22] = [
+const FLAGS: [(&str, &str); 23] = [
     ("grains", "--grains"),
     ("dt", "--dt"),
     ("max_duration", "--max-duration"),
+    ("theta", "--theta"),
     ("cycles", "--cycles"),
     ("criterion", "--criterion"),
     ("tolerance", "--tolerance"),
@@ -262,12 +271,29 @@ fn print_sample(s: &Sample) {
 
 pub fn main(cmd: Track3dCommand) -> Result<(), Failure> {
     match cmd {
-        Track3dCommand::Sample { seed, grains, dt, max_duration, tolerance, max_iterations, out, resume, quiet } => {
+        Track3dCommand::Sample {
+            seed,
+            grains,
+            dt,
+            max_duration,
+            theta,
+            tolerance,
+            max_iterations,
+            out,
+            resume,
+            quiet,
+        } => {
             if grains == 0 {
                 return Err(input("--grains: must be at least 1, got 0".into()));
             }
-            let spec =
-                SampleSpec { dt, max_duration, tolerance, max_iterations, ..SampleSpec::track(seed).scaled(grains) };
+            let spec = SampleSpec {
+                dt,
+                max_duration,
+                theta,
+                tolerance,
+                max_iterations,
+                ..SampleSpec::track(seed).scaled(grains)
+            };
             let sample = track3d::sample(&spec, &out, resume, &Bars::single(quiet)).map_err(as_flag)?;
             print_sample(&sample);
         }

@@ -60,6 +60,9 @@ pub struct LoadingSpec {
     pub cycles: u64,
     /// Time step (s).
     pub dt: f64,
+    /// θ of the Moreau–Jean scheme, in [1/2, 1]: the paper's 1/2 (default), whatever θ the sample was deposited
+    /// with ([`super::SampleSpec::theta`]).
+    pub theta: f64,
     /// NLGS policy: `strict`, `quad`, `quad_max`, `energy` or `velocity`.
     pub criterion: String,
     /// Tolerance of the policy, in (0, 1).
@@ -90,6 +93,7 @@ impl LoadingSpec {
             stiffness_factor: 1.0,
             cycles,
             dt: 2e-4,
+            theta: 0.5,
             criterion: "quad".into(),
             tolerance: 1e-4,
             min_iterations: 1,
@@ -121,6 +125,9 @@ impl LoadingSpec {
             return refuse("cycles: must be at least 1, got 0".into());
         }
         positive("dt: the time step (s)", self.dt)?;
+        if !(0.5..=1.0).contains(&self.theta) {
+            return refuse(format!("theta: must be in [0.5, 1], got {}", self.theta));
+        }
         if Policy::from_name(&self.criterion).is_none() {
             return refuse(format!(
                 "criterion: '{}' is not one of 'strict', 'quad', 'quad_max', 'energy', 'velocity'",
@@ -222,6 +229,7 @@ pub fn loaded_scene(sample: &Scene3, spec: &LoadingSpec) -> Result<Scene3> {
     out.simulation.dt = spec.dt;
     out.simulation.duration = spec.cycles as f64 / spec.frequency;
     let nscd = out.nscd.get_or_insert_with(Default::default);
+    nscd.theta = Some(spec.theta);
     nscd.criterion = Some(spec.criterion.clone());
     nscd.tolerance = Some(spec.tolerance);
     nscd.min_iterations = Some(spec.min_iterations);
