@@ -125,7 +125,7 @@ fn md_perturbation_moves_every_sphere_within_the_ball() {
 
 /// `ballast run --replica R --perturb D`: the run starts from the same scene the library's perturbation gives
 /// (2D polygons, 3D spheres, 3D polyhedra), records it in `scene.toml` and `replica.json`; replica 0 is the
-/// file byte for byte; a bad distance is refused naming the flag.
+/// scene as it is; a bad distance is refused naming the flag.
 #[test]
 fn run_replica_starts_from_the_librarys_perturbed_scene() {
     use ballast::scene::Scene3;

@@ -37,8 +37,8 @@ pub enum Track3dCommand {
         /// Longest deposit (s); it ends earlier at equilibrium.
         #[arg(long, default_value_t = SampleSpec::default().max_duration)]
         max_duration: f64,
-        /// θ of the deposit's time scheme, in [0.5, 1]: 1 damps the grains' rocking and reaches rest
-        /// (docs/track3d.md, "The deposit's θ"); the loaded runs keep θ = 1/2.
+        /// θ of the deposit's time scheme, in [0.5, 1]: 1 is dissipative and reached rest on every seed tried,
+        /// with smaller overlaps (docs/track3d.md, "The deposit's θ"); the loaded runs keep θ = 1/2.
         #[arg(long, default_value_t = SampleSpec::default().theta)]
         theta: f64,
         /// Tolerance of the deposit's solver (`quad` policy).

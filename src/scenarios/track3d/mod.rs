@@ -45,12 +45,13 @@
 //! - **Deposit**: dt = 2e-4 s (the 2D sample's), **θ = 1** ([`SampleSpec::theta`]), `quad` **1e-3** with at
 //!   most 2 000 sweeps ([`SampleSpec::tolerance`], [`SampleSpec::max_iterations`]), alert distance 1 mm. On the
 //!   200-grain section `quad` 1e-4 made 256 sweeps per step with 194 steps at the cap for the same layer as 1e-3
-//!   (50 sweeps, none at the cap). θ = 1 is numerically dissipative and θ = 1/2 is not: on seeds 1–3 of the 200-grain section θ = 1 reached rest in 1.26–1.49 s every time, where θ = 1/2
-//!   hovered above the threshold until the 3 s cap once, and it left the largest overlap 1.4–2× smaller
-//!   (0.24–0.64 against 0.48–1.06 mm), for the same layer (solid fraction within 0.012). The loaded runs keep
-//!   the paper's θ = 1/2 (docs/track3d.md, "The deposit's θ"). The
-//!   deposit's end state is what counts, and the equilibrium stop guarantees it is at rest: it ends when the
-//!   kinetic energy of the mobile bodies has stayed below [`SampleSpec::rest_energy`] = 1e-10 J per grain (an
+//!   (50 sweeps, none at the cap). θ = 1 is numerically dissipative and θ = 1/2 is not: on seeds 1–3 of the
+//!   200-grain section θ = 1 reached rest in 1.26–1.49 s every time, where θ = 1/2 hovered above the threshold
+//!   until the 3 s cap once, and it left the largest overlap 1.4–2× smaller (0.24–0.64 against 0.48–1.06 mm),
+//!   for the same layer (solid fraction within 0.012). The loaded runs keep the paper's θ = 1/2
+//!   ([`LoadingSpec::theta`]; docs/track3d.md, "The deposit's θ"). The deposit's end state is what counts,
+//!   and the equilibrium stop guarantees it is at rest: it ends when the kinetic energy of the mobile bodies
+//!   has stayed below [`SampleSpec::rest_energy`] = 1e-10 J per grain (an
 //!   rms speed of 8e-5 m/s for the mean grain, 32 g) for [`SampleSpec::rest_steps`] = 500 steps (0.1 s), or
 //!   after [`SampleSpec::max_duration`] = 3 s.
 
