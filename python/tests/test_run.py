@@ -3,16 +3,13 @@ stopped (by `stop_after`, by `progress` returning False, by Ctrl-C) leaves a che
 continues to the bytes of an uninterrupted run, and the simulation keeps the state the run reached."""
 
 import json
-import os
-import signal
 import subprocess
-import threading
 
 import numpy as np
 import pytest
 
 import ballast
-from test_simulation import ROOT, cli
+from test_simulation import ROOT, cli, ctrl_c_after
 
 BLOCK = ROOT / "examples" / "block_on_floor.toml"
 SPHERES = ROOT / "examples" / "md_two_spheres.toml"
@@ -66,13 +63,8 @@ def test_a_stopped_run_resumes_to_the_bytes_of_an_uninterrupted_one(tmp_path, ho
 
 def test_ctrl_c_stops_a_run_with_keyboard_interrupt_and_a_checkpoint(tmp_path):
     sim = ballast.load(SPHERES)
-    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            sim.run(tmp_path / "run", steps=10**9)
-    finally:
-        timer.cancel()
+    with ctrl_c_after(0.5), pytest.raises(KeyboardInterrupt):
+        sim.run(tmp_path / "run", steps=10**9)
     done = sim.steps_done
     assert 0 < done < 10**9
     assert (tmp_path / "run" / "checkpoint.json").is_file()

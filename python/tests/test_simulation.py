@@ -2,10 +2,13 @@
 state comes out as numpy arrays of the documented shapes, positions after N steps equal the command line's
 `final.json` bit for bit, the write-back round-trips, and errors are the documented Python exceptions."""
 
+import contextlib
 import json
 import os
 import pathlib
+import signal
 import subprocess
+import threading
 
 import numpy as np
 import pytest
@@ -25,6 +28,21 @@ def cli():
         if path.exists():
             return str(path)
     pytest.fail("no ballast command: build it (cargo build) or set BALLAST_BIN")
+
+
+@contextlib.contextmanager
+def ctrl_c_after(seconds):
+    """SIGINT to this process after `seconds`, with Python's own Ctrl-C handler installed meanwhile: a process
+    started in the background by a non-interactive shell inherits SIGINT ignored, and Python then installs no
+    handler, so the signal would never reach the run."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, previous)
 
 
 @pytest.mark.parametrize("scene", EXAMPLES, ids=lambda p: p.stem)
@@ -117,19 +135,12 @@ def test_a_run_that_blows_up_raises_diverged_error_with_step_and_body():
 def test_ctrl_c_ends_stepping_between_two_steps_with_keyboard_interrupt():
     """SIGINT while `step` runs a long way: KeyboardInterrupt within the signal check's period, the state that
     of the last step made (finite, its clock consistent with its step count)."""
-    import signal
-    import threading
     import time
 
     sim = ballast.load(ROOT / "examples" / "md_two_spheres.toml")
-    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
     start = time.monotonic()
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            sim.step(10**12)
-    finally:
-        timer.cancel()
+    with ctrl_c_after(0.3), pytest.raises(KeyboardInterrupt):
+        sim.step(10**12)
     elapsed = time.monotonic() - start
     # 0.3 s until the signal, then at most one 20 ms chunk plus a step: 1 s leaves room for a loaded machine.
     assert elapsed < 1.3, elapsed
