@@ -49,6 +49,15 @@ pub(crate) fn non_negative(what: &str, v: f64) -> Result<f64> {
     }
 }
 
+/// `v` if it is a θ of the Moreau–Jean scheme, in [1/2, 1], else an error `{what} must be in [0.5, 1], got {v}`.
+pub(crate) fn theta(what: &str, v: f64) -> Result<f64> {
+    if (0.5..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        refuse(format!("{what} must be in [0.5, 1], got {v}"))
+    }
+}
+
 /// `v` if it is finite, else an error naming `what`.
 pub(crate) fn finite(what: &str, v: f64) -> Result<f64> {
     if v.is_finite() {

@@ -125,9 +125,7 @@ impl LoadingSpec {
             return refuse("cycles: must be at least 1, got 0".into());
         }
         positive("dt: the time step (s)", self.dt)?;
-        if !(0.5..=1.0).contains(&self.theta) {
-            return refuse(format!("theta: must be in [0.5, 1], got {}", self.theta));
-        }
+        theta("theta:", self.theta)?;
         if Policy::from_name(&self.criterion).is_none() {
             return refuse(format!(
                 "criterion: '{}' is not one of 'strict', 'quad', 'quad_max', 'energy', 'velocity'",

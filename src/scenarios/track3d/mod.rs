@@ -62,7 +62,7 @@ pub use loading::{loaded_scene, LoadingSpec, SLEEPER_GAP};
 pub use measure::{measure_sample, SampleReport};
 
 use super::grains3d::{grains, GrainSpec};
-use super::{non_negative, positive, refuse};
+use super::{non_negative, positive, refuse, theta};
 use crate::error::Result;
 use crate::geometry::Vec3;
 use crate::nscd::Policy;
@@ -226,9 +226,7 @@ impl SampleSpec {
         non_negative("friction: the grains' friction coefficient", self.friction)?;
         positive("dt: the deposit's time step (s)", self.dt)?;
         positive("max_duration: the longest deposit (s)", self.max_duration)?;
-        if !(0.5..=1.0).contains(&self.theta) {
-            return refuse(format!("theta: the deposit's θ must be in [0.5, 1], got {}", self.theta));
-        }
+        theta("theta: the deposit's θ", self.theta)?;
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
             return refuse(format!("tolerance: must be in (0, 1), got {}", self.tolerance));
         }

@@ -32,20 +32,19 @@ pub fn perturbed_text(
     // The kind is that of the scene as run, so that an engine the scene cannot run on is refused here as
     // the run would refuse it; the scene itself is perturbed in its own file's form.
     match SceneKind::of(&text, name, engine)? {
-        SceneKind::Md => {
-            let mut scene = MdScene::from_toml_str_named(&text, name)?;
-            let record = perturb_md_scene(&mut scene, p, r)?;
-            Ok((scene.to_toml_string()?, record))
-        }
-        SceneKind::Nscd3 => {
-            let mut scene = Scene3::from_toml_str_named(&text, name)?;
-            let record = perturb_scene3(&mut scene, p, r)?;
-            Ok((scene.to_toml_string()?, record))
-        }
-        SceneKind::Nscd | SceneKind::PlanarMd => {
-            let mut scene = Scene::from_toml_str_named(&text, name)?;
-            let record = perturb_scene(&mut scene, p, r)?;
-            Ok((scene.to_toml_string()?, record))
-        }
+        SceneKind::Md => moved(&text, name, |s: &mut MdScene| perturb_md_scene(s, p, r)),
+        SceneKind::Nscd3 => moved(&text, name, |s: &mut Scene3| perturb_scene3(s, p, r)),
+        SceneKind::Nscd | SceneKind::PlanarMd => moved(&text, name, |s: &mut Scene| perturb_scene(s, p, r)),
     }
+}
+
+/// The scene `text` read as an `S`, moved by `perturb`, written back; with the record of the move.
+fn moved<S: SceneFile>(
+    text: &str,
+    name: &str,
+    perturb: impl FnOnce(&mut S) -> Result<ReplicaRecord>,
+) -> Result<(String, ReplicaRecord)> {
+    let mut scene = S::from_toml_str_named(text, name)?;
+    let record = perturb(&mut scene)?;
+    Ok((scene.to_toml_string()?, record))
 }
