@@ -1,8 +1,8 @@
 //! The `ballast run` command: output files on a valid scene, exit code 2 and a
 //! one-line error on an invalid one.
 
-mod fixtures;
-mod scratch;
+use crate::fixtures;
+use crate::scratch;
 
 use std::process::Command;
 

@@ -5,7 +5,7 @@
 //! stiffen, the MD ensemble settlement approaches the NSCD ensemble settlement,
 //! judged with the replicas' 95 % confidence intervals.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::io::read_csv;
 use ballast::scenarios::saussine::LoadingSpec;

@@ -1,6 +1,6 @@
 //! Per-cycle settlement statistics (`cycles.csv`) against a quasi-static spring.
 
-mod common;
+use crate::common;
 use ballast::nscd::{Harmonic, Load, Spring};
 use ballast::run::{CyclePlan, RunOptions, RunPlan, Runner};
 use common::*;

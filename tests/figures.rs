@@ -1,7 +1,7 @@
 //! `ballast::io::figures`: each figure is written as a PNG of the right size and an
 //! SVG with the expected elements; bad values are skipped, never a panic.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::io::figures::{displacement_field, force_chains, line_chart, Arrow, Axes, ForceLine, Series};
 use ballast::report::plane::{force_lines_of, polygons_of};

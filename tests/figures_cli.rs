@@ -6,7 +6,7 @@
 //! `ballast::report::draw_run_figures`, by `ballast run --figures`'s
 //! path (`RunOptions::figures`) and by the `ballast figures DIR` command.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::engine::contacts::{self, ContactKind};
 use ballast::engine::FinalState;

@@ -34,7 +34,7 @@
 //! `--nocapture`). Failures in code another session is changing are listed in
 //! [`KNOWN`] (with a TODO) and reported, not failed.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::open::run_file;
 use ballast::run::checkpoint::crc32;

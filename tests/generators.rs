@@ -3,7 +3,7 @@
 //! replaced, and refuse impossible parameters with a one-line error naming the
 //! parameter (no panic, endless loop or invalid scene).
 
-mod scratch;
+use crate::scratch;
 
 use ballast::md::V3;
 use ballast::scenarios::karrech::{self, KarrechSpec, Loading};

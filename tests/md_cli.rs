@@ -2,7 +2,7 @@
 //! stop and resume with the same bytes, the equilibrium stop, VTK snapshots,
 //! servo-wall columns, and exit code 2 with one line on an invalid scene.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::scene::SceneFile;
 use std::path::Path;

@@ -8,7 +8,7 @@
 //! ~2 ms and overlaps stay a few % of the radius; every impact is resolved with
 //! 1000 or more steps, which costs well under a millisecond for two spheres.
 
-mod md_common;
+use crate::md_common;
 
 use ballast::md::law::{e_star, hertz_alpha_for_restitution, linear_alpha_for_restitution};
 use ballast::md::{Damping, GearSet, Ghosts, Integrator, MdSystem, PairLaw, Particles, SymmetryPlane, V3};

@@ -15,8 +15,7 @@
 //! doubled or misplaced contact (or a point off by the smallest overlap) shows
 //! at 1e-4 or more.
 
-#[path = "md_common/mod.rs"]
-mod md_common;
+use crate::md_common;
 
 use ballast::md::law::hertz_alpha_for_restitution;
 use ballast::md::{

@@ -7,7 +7,7 @@
 //! materials (E = 10 MPa; k = 5000 N/m, k_t = 1000 N/m as in David et al. §3),
 //! time steps of 1/50 to 1/200 of a contact time.
 
-mod md_common;
+use crate::md_common;
 
 use ballast::md::law::hertz_alpha_for_restitution;
 use ballast::md::{

@@ -3,7 +3,7 @@
 //! resting on a floor (linear and Hertz-like), stick and slip on an incline at
 //! `tan α = μ`, and a pad on a sublayer spring at the frequency it has under NSCD.
 
-mod common;
+use crate::common;
 use ballast::md::planar::{PlanarParams, PlanarSystem, SoftLaw, SoftModel};
 use ballast::plane::{BodyInfo, Harmonic, Spring};
 use std::f64::consts::{PI, TAU};

@@ -5,7 +5,7 @@
 //! the same bytes, the settlement driver runs on it, and bad `[soft]` tables or
 //! time steps are one-line errors naming the key and the numbers.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::open::run_file;
 use ballast::run::RunOptions;

@@ -4,7 +4,7 @@
 //! servo walls hold their prescribed stress, and the cyclic stress reaches
 //! `p₀ + Δσ` at mid-cycle.
 
-mod scratch;
+use crate::scratch;
 
 use std::path::Path;
 use std::process::Command;

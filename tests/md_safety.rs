@@ -7,7 +7,7 @@
 //! The contact times and stability limits are checked against closed forms and
 //! against the engine itself.
 
-mod md_common;
+use crate::md_common;
 
 use ballast::md::law::{e_star, hertz_contact_time, hertz_max_overlap, linear_contact_time, HERTZ_DURATION};
 use ballast::md::neighbours::{grid, Neighbours};

@@ -6,7 +6,7 @@
 //! and the body and leaves its last good state; the cycle rows of a cube dropped on the floor report its fall
 //! (free fall in closed form, then at rest on the floor); the configuration written back and the model checks.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::engine::{contacts, ContactKind, Engine, FinalState, RelaxSettings};
 use ballast::geometry::{Polyhedron, Pose, Solid, Vec3};

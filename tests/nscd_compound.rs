@@ -2,7 +2,7 @@
 //! a sleeper with two bars resting on its bars, the lateral resistance a bar in a
 //! groove gives, contact keys, the scene syntax `parts = [...]` and VTK output.
 
-mod common;
+use crate::common;
 
 use ballast::geometry::{rotate, Compound, GeometryError, Shape, Vec2};
 use ballast::nscd::{BodyInfo, Harmonic, Imposed, Load, System};

@@ -6,7 +6,7 @@
 //! The single-step tests take the problem of a step just made (`System::nlgs_problem`)
 //! and solve it cold with the interior point alone (no NLGS before or after it).
 
-mod common;
+use crate::common;
 
 use ballast::nscd::interior::{solve_interior, InteriorOptions, InteriorWorkspace};
 use ballast::nscd::nlgs::{solve_nlgs, NlgsProblem, NlgsReport, NlgsSettings, Solver};

@@ -1,7 +1,7 @@
 //! Rigid-body mechanics of the NSCD engine against closed-form answers:
 //! free fall, friction on an incline and on a floor, impacts, a resting column.
 
-mod common;
+use crate::common;
 use common::*;
 
 /// θ = 1/2 integrates a constant acceleration exactly:

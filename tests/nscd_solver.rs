@@ -1,7 +1,7 @@
 //! NLGS behaviour: convergence policies, warm start, reproducibility and the
 //! handling of a blow-up.
 
-mod common;
+use crate::common;
 use ballast::nscd::{Policy, System};
 use ballast::scene::SceneFile;
 use ballast::Error;

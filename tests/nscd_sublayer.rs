@@ -1,6 +1,6 @@
 //! Viscoelastic sublayer springs (law 17) against the damped linear oscillator.
 
-mod common;
+use crate::common;
 use ballast::nscd::{Harmonic, Spring, System};
 use common::*;
 

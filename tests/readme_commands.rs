@@ -10,7 +10,7 @@
 //! commands: the examples and benches are built by `cargo clippy
 //! --all-targets` in CI, the tests by this very run.
 
-mod scratch;
+use crate::scratch;
 
 use std::path::Path;
 use std::process::Command;

@@ -3,7 +3,7 @@
 //! a 50-grain sample (flat sleeper, 2 cycles at dt = 1 ms), whose ensemble
 //! tables must be the statistics of the replicas' own `cycles.csv`.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::scene::SceneFile;
 use ballast::scene::{MdScene, Scene};

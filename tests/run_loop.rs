@@ -5,8 +5,8 @@
 //! leaves the last good state and its row; every CSV it writes reads back
 //! through the library's row types.
 
-mod fixtures;
-mod scratch;
+use crate::fixtures;
+use crate::scratch;
 
 use ballast::engine::Engine;
 use ballast::engine::FinalState;

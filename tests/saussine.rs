@@ -5,7 +5,7 @@
 //! measured by `ballast saussine sample` (data/saussine2006/README.md); the
 //! reduced one keeps the tests within seconds.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::run::{RunOptions, Runner, Status};
 use ballast::scenarios::saussine::{loaded_scene, measure_sample, sample_scene, LoadingSpec, SampleSpec};

@@ -3,7 +3,7 @@
 //! dt = 1 ms): what each study must show, and that its summary agrees with the
 //! runs it summarises.
 
-mod scratch;
+use crate::scratch;
 
 use std::path::Path;
 use std::process::Command;

@@ -4,7 +4,7 @@
 //! with 1.8× fewer computed cycles, within the spread of full runs whose start
 //! differs by 1e-9 m; its outputs, its checkpoint and its resume.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::run::positions::CyclePositions;
 use ballast::run::{RunOptions, Runner, Status};

@@ -7,7 +7,7 @@
 //! The load is a tenth of the paper's amplitude (at the full one the soft
 //! contacts are pressed by 5 % of a radius and the sample flows).
 
-mod scratch;
+use crate::scratch;
 
 use ballast::engine::Engine;
 use ballast::run::{RunOptions, Runner};

@@ -6,8 +6,7 @@
 //! iterations than the paper's gradient method, and the relaxed state then
 //! steps at rest.
 
-#[path = "md_common/mod.rs"]
-mod md_common;
+use crate::md_common;
 
 use ballast::engine::Engine;
 use ballast::engine::{Functional, Method, RelaxReport, RelaxSettings};

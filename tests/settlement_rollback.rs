@@ -5,7 +5,7 @@
 //! for bit; a landing rolled back after its window (`rollback_rate`) from a
 //! checkpoint taken on probation resumes to the uninterrupted run's numbers.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::open::settle_file;
 use ballast::run::RunOptions;

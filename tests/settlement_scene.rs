@@ -2,7 +2,7 @@
 //! runs the procedure; a stopped run resumes to the same numbers; bad tables are
 //! one-line errors naming the key.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::open::settle_file;
 use ballast::run::RunOptions;

@@ -2,7 +2,7 @@
 //! binary), at small sizes: what each writes, what it returns, what its
 //! [`RunDisplay`] is told, and which errors are input errors.
 
-mod scratch;
+use crate::scratch;
 
 use ballast::io::table::write_all;
 use ballast::run::{Progress, RunOptions, RunOutcome};

@@ -6,8 +6,8 @@
 //! through the settlement driver; bad input is refused naming the field (the library) or the flag (the command
 //! line).
 
-mod scratch;
-mod track3d_common;
+use crate::scratch;
+use crate::track3d_common;
 
 use ballast::geometry::{Solid, Vec3};
 use ballast::nscd::d3::rows::read_cycles;

@@ -7,8 +7,8 @@
 //! per run with the difference from the reference setting, and a second invocation with `resume` runs nothing;
 //! bad input is refused naming the field (library) or the flag (command line).
 
-mod scratch;
-mod track3d_common;
+use crate::scratch;
+use crate::track3d_common;
 
 use ballast::nscd::d3::rows::{read_cycles, CycleRow3};
 use ballast::scenarios::track3d::LoadingSpec;

@@ -1,7 +1,7 @@
 //! VTK snapshots: the files are parsed back by the small readers below (legacy
 //! ASCII and XML PolyData) and checked against the system they were written from.
 
-mod fixtures;
+use crate::fixtures;
 
 use ballast::io::vtk::PvdCollection;
 use ballast::nscd::System;
