@@ -18,7 +18,7 @@
 //!   `amplitude_pressure` set it. The sleeper's own weight (4.7 kPa for 0.2 m of concrete) adds to it.
 //! - **Solver of the loaded run**: dt = 2e-4 s (250 steps per cycle at 20 Hz, the 2D study's step), `quad`
 //!   1e-4, 1 to 20 000 sweeps (`docs/track3d.md` has the 3D studies of the stopping rule: over 20 cycles of the
-//!   200-grain section the sleeper creeps by about 2 µm per cycle at 1e-4, 0.6 at 3e-5 and 0.3 at 1e-5, the
+//!   200-grain section the sleeper creeps by about 2 µm per cycle at 1e-4, 0.6 at 3e-5 and 0.4 at 1e-5, the
 //!   solver's and not the ballast's), a `series.csv` row every 10 steps, `cycles.csv` with the grains' positions at every
 //!   cycle end (what a settlement driver fits).
 
