@@ -1,7 +1,8 @@
 //! The 24-grain sample of the 3D track section's tests (`tests/track3d.rs`, `tests/track3d_replicas.rs`),
-//! deposited once per test binary into its scratch folder, helpers on its scenes, and the command line.
+//! deposited once per test process (the two files share `tests/main.rs`'s binary) into its scratch folder,
+//! helpers on its scenes, and the command line.
 
-// Each test binary uses some of these.
+// Each test file uses some of these.
 #![allow(dead_code)]
 
 use crate::scratch;
