@@ -17,10 +17,10 @@
 //!   later. A real axle load puts about a hundred times this under a sleeper; `mean_pressure` and
 //!   `amplitude_pressure` set it. The sleeper's own weight (4.7 kPa for 0.2 m of concrete) adds to it.
 //! - **Solver of the loaded run**: dt = 2e-4 s (250 steps per cycle at 20 Hz, the 2D study's step), `quad`
-//!   1e-4, 1 to 20 000 sweeps (`docs/track3d.md` has the 3D studies of the stopping rule: over 20 cycles of the
-//!   200-grain section the sleeper creeps by about 2 µm per cycle at 1e-4, 0.6 at 3e-5 and 0.4 at 1e-5, the
-//!   solver's and not the ballast's), a `series.csv` row every 10 steps, `cycles.csv` with the grains' positions at every
-//!   cycle end (what a settlement driver fits).
+//!   1e-4, 1 to 20 000 sweeps (`docs/track3d.md` has the 3D studies of the stopping rule: over cycles 11–20 of
+//!   the 200-grain section the seated sleeper settles about 2 µm per cycle at 1e-4, 0.6 at 3e-5 and 0.4 at
+//!   1e-5, so most of 1e-4's is the solver's creep), a `series.csv` row every 10 steps, `cycles.csv` with the
+//!   grains' positions at every cycle end (what a settlement driver fits).
 
 use super::*;
 use crate::error::Error;
@@ -71,8 +71,8 @@ pub struct LoadingSpec {
     /// Fewest sweeps per step (≥ 1).
     pub min_iterations: usize,
     /// Most sweeps per step (≥ `min_iterations`); default 20 000. At 2 000, the default before, steps ended at
-    /// the cap with the sleeper under-supported, and it slipped by 0.1–0.4 mm in single cycles over 20 cycles of
-    /// the 200-grain section; at 20 000 no replica slipped, for fewer sweeps on average (`docs/track3d.md`,
+    /// the cap and the sleeper slipped by 0.1–0.4 mm in single cycles over 20 cycles of the 200-grain section;
+    /// at 20 000 no replica slipped, for fewer sweeps on average (`docs/track3d.md`,
     /// "The sweep cap and the creep over 20 cycles").
     pub max_iterations: usize,
     /// The face–face gap rule of the grains' contacts (`nscd.face_gaps`): `exact` (default) or `common_plane`
