@@ -36,6 +36,7 @@ mod md_scene;
 mod nlgs_measure;
 mod nscd3d;
 mod nscd3d_drives;
+mod nscd3d_overlaps;
 mod nscd3d_relax;
 mod nscd3d_run;
 mod nscd_compound;

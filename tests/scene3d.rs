@@ -4,6 +4,7 @@
 //! naming the key.
 
 use ballast::geometry::{Polyhedron, Solid, Vec3};
+use ballast::nscd::d3::overlaps::Overlaps;
 use ballast::nscd::d3::system::System3;
 use ballast::scene::{d3::Scene3, Scene, SceneFile, SceneKind};
 use ballast::space::detection::FaceGaps;
@@ -477,6 +478,16 @@ fn simulation_and_nscd_sections() {
     expect(
         &edit("[nscd]", "[nscd]\nface_gaps = \"flat\""),
         &["nscd.face_gaps: unknown rule 'flat', expected 'exact' or 'common_plane'"],
+    );
+    // The overlap law: kept by default, held on request, kept through a round trip.
+    assert_eq!(example().build().unwrap().params.overlaps, Overlaps::Kept);
+    let held = Scene3::from_toml_str(&edit("[nscd]", "[nscd]\noverlaps = \"held\"")).unwrap();
+    assert_eq!(held.build().unwrap().params.overlaps, Overlaps::Held);
+    let again = Scene3::from_toml_str(&held.to_toml_string().unwrap()).unwrap();
+    assert_eq!(again.build().unwrap().params.overlaps, Overlaps::Held);
+    expect(
+        &edit("[nscd]", "[nscd]\noverlaps = \"gap\""),
+        &["nscd.overlaps: unknown rule 'gap', expected 'kept' or 'held'"],
     );
     // The settings that apply are taken as given.
     let tuned = edit(

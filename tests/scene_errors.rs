@@ -329,6 +329,10 @@ fn nscd_settings() {
         &edit("max_factor = 16.0", "max_factor = 16.0\nface_gaps = \"exact\""),
         &["nscd.face_gaps: the gap rule of two polyhedra's face–face contacts is a 3D setting"],
     );
+    expect(
+        &edit("max_factor = 16.0", "max_factor = 16.0\noverlaps = \"held\""),
+        &["nscd.overlaps: the held-overlap law is a 3D setting"],
+    );
     expect(&edit("every = 2", "every = 0"), &["output.every"]);
 }
 

@@ -10,6 +10,7 @@ use crate::scratch;
 use crate::track3d_common;
 
 use ballast::geometry::{Solid, Vec3};
+use ballast::nscd::d3::overlaps::Overlaps;
 use ballast::nscd::d3::rows::read_cycles;
 use ballast::nscd::d3::system::System3;
 use ballast::scenarios::track3d::{self, LoadingSpec, SampleReport, SampleSpec, GRAIN_PREFIX, PAD_PREFIX, SLEEPER};
@@ -192,6 +193,11 @@ fn the_loaded_scene_puts_the_sleeper_on_the_grains() {
     let common = LoadingSpec { face_gaps: "common_plane".into(), ..spec };
     study::load(&s.path, &common, &out).unwrap();
     assert_eq!(Scene3::load(&out).unwrap().build().unwrap().params.face_gaps, FaceGaps::CommonPlane);
+    // The overlap law: the velocity-level law unless asked, held when asked.
+    assert_eq!(sys.params.overlaps, Overlaps::Kept);
+    let held = LoadingSpec { overlaps: "held".into(), ..common };
+    study::load(&s.path, &held, &out).unwrap();
+    assert_eq!(Scene3::load(&out).unwrap().build().unwrap().params.overlaps, Overlaps::Held);
 }
 
 /// Two cycles: two rows of cycles.csv, the sleeper went down (it landed and pressed the layer and the sublayer),
@@ -308,6 +314,7 @@ fn bad_specs_name_their_field() {
     bad_loading(LoadingSpec { tolerance: 2.0, ..d.clone() }, "tolerance");
     bad_loading(LoadingSpec { theta: 1.5, ..d.clone() }, "theta");
     bad_loading(LoadingSpec { face_gaps: "flat".into(), ..d.clone() }, "face_gaps");
+    bad_loading(LoadingSpec { overlaps: "gap".into(), ..d.clone() }, "overlaps");
     bad_loading(LoadingSpec { mean_pressure: f64::INFINITY, ..d.clone() }, "mean_pressure");
     bad_loading(LoadingSpec { dt: 0.0, ..d }, "dt");
 }
@@ -320,7 +327,7 @@ fn bad_flags_are_named_on_one_line() {
     let sample = s.path.to_str().unwrap();
     let out = dir.join("x.toml");
     let out = out.to_str().unwrap();
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 8] = [
         (&["track3d", "sample", "--grains", "0", "--out", out], "--grains:"),
         (&["track3d", "sample", "--grains", "10", "--tolerance", "2", "--out", out], "--tolerance:"),
         (&["track3d", "sample", "--grains", "10", "--dt=-1", "--out", out], "--dt:"),
@@ -328,6 +335,7 @@ fn bad_flags_are_named_on_one_line() {
         (&["track3d", "load", "--sample", sample, "--out", out, "--sleeper-width", "3"], "--sleeper-width:"),
         (&["track3d", "load", "--sample", sample, "--out", out, "--mean-pressure", "inf"], "--mean-pressure:"),
         (&["track3d", "load", "--sample", sample, "--out", out, "--face-gaps", "flat"], "--face-gaps:"),
+        (&["track3d", "load", "--sample", sample, "--out", out, "--overlaps", "gap"], "--overlaps:"),
     ];
     for (args, flag) in cases {
         refused(args, flag);

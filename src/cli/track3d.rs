@@ -161,6 +161,10 @@ pub struct LoadingArgs {
     /// smallest, the faces counted flush).
     #[arg(long, default_value_t = LoadingSpec::default().face_gaps)]
     pub face_gaps: String,
+    /// What a closed contact does with an overlap: kept (Moreau–Jean's velocity-level law) or held (an
+    /// overlap may not grow past the shallowest the point has had).
+    #[arg(long, default_value_t = LoadingSpec::default().overlaps)]
+    pub overlaps: String,
     /// Width of the sleeper along the track (m); default: half the box's length (0.3 m on the full section).
     #[arg(long)]
     pub sleeper_width: Option<f64>,
@@ -193,6 +197,7 @@ impl LoadingArgs {
             min_iterations: self.min_iterations,
             max_iterations: self.max_iterations,
             face_gaps: self.face_gaps.clone(),
+            overlaps: self.overlaps.clone(),
             sleeper_width: self.sleeper_width,
             sleeper_length: self.sleeper_length,
             mean_pressure: self.mean_pressure,
@@ -206,7 +211,7 @@ impl LoadingArgs {
 
 /// The spec fields of this command's library calls and their flags (the shared ones, `dt`, `cycles`, …, are
 /// mapped by `flags.rs` too).
-const FLAGS: [(&str, &str); 23] = [
+const FLAGS: [(&str, &str); 24] = [
     ("grains", "--grains"),
     ("dt", "--dt"),
     ("max_duration", "--max-duration"),
@@ -217,6 +222,7 @@ const FLAGS: [(&str, &str); 23] = [
     ("min_iterations", "--min-iterations"),
     ("max_iterations", "--max-iterations"),
     ("face_gaps", "--face-gaps"),
+    ("overlaps", "--overlaps"),
     ("sleeper_width", "--sleeper-width"),
     ("sleeper_length", "--sleeper-length"),
     ("mean_pressure", "--mean-pressure"),

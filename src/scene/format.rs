@@ -103,6 +103,11 @@ pub struct NscdSection {
     /// [`crate::space::detection::FaceGaps`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub face_gaps: Option<String>,
+    /// 3D scenes only: what a closed contact does with an overlap, `"kept"` (default: Moreau–Jean's
+    /// velocity-level law) or `"held"` (an overlap may not grow past the shallowest the point has had;
+    /// [`crate::nscd::d3::overlaps::Overlaps`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overlaps: Option<String>,
 }
 
 /// `[[material]]`.

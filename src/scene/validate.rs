@@ -356,6 +356,11 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
                     scene's polygons have their own detection: remove the key"
             .to_string());
     }
+    if ns.overlaps.is_some() {
+        return err("nscd.overlaps: the held-overlap law is a 3D setting; a 2D scene's contacts keep the \
+                    velocity-level law: remove the key"
+            .to_string());
+    }
     if let Some(a) = ns.alert_distance {
         non_negative("nscd.alert_distance", a)?;
         if a > MAX_LENGTH {

@@ -28,7 +28,8 @@ pub struct ContactRow3 {
     pub a: u32,
     /// Antagonist body.
     pub b: u32,
-    /// The contact stays open when `U_0N ≥ s_open` (m/s): `−g_m / h` for a gap `g_m > 0` at `q_m`, else 0.
+    /// The contact stays open when `U_0N ≥ s_open` (m/s): `−g_m / h` for a gap `g_m > 0` at `q_m`, else 0; under
+    /// [`super::overlaps::Overlaps::Held`], `−(g_m − g_ref) / h` ([`super::overlaps::opening_threshold`]).
     pub s_open: f64,
     /// The normal velocity enforced once closed (m/s): `max(s_open, −e_n U_N⁻)`.
     pub c_closed: f64,
@@ -64,7 +65,8 @@ fn dot3(x: &[f64; 3], y: &[f64]) -> f64 {
 impl ContactRow3 {
     /// The row of a contact at point `point` (world) with the frame `frame = [n, t₁, t₂]` between candidate
     /// `a` at `pose_a` and antagonist `b` at `pose_b` (the intermediate configuration), their inverse masses and
-    /// start-of-step velocities (for `U⁻`), the gap `gap` (m) at `q_m` and the time step `h` (s).
+    /// start-of-step velocities (for `U⁻`), the gap `gap` (m) at `q_m`, the time step `h` (s) and, under
+    /// [`super::overlaps::Overlaps::Held`], the point's reference gap `held` (m; `None`: the velocity-level law).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         (a, b): (u32, u32),
@@ -75,6 +77,7 @@ impl ContactRow3 {
         (ua, ub): (&Dofs6, &Dofs6),
         gap: f64,
         h: f64,
+        held: Option<f64>,
         law: &ContactLaw,
     ) -> Self {
         let rho_a = pose_a.rotation.inverse_transform_vector(&(point - pose_a.position));
@@ -86,7 +89,11 @@ impl ContactRow3 {
         let wm: [[f64; 3]; 3] =
             std::array::from_fn(|i| std::array::from_fn(|j| wdot(&h_a, im_a, i, j) + wdot(&h_b, im_b, i, j)));
         let minus: [f64; 3] = std::array::from_fn(|k| dot6(&h_a[k], ua) - dot6(&h_b[k], ub));
-        let s_open = if gap > 0.0 { -gap / h } else { 0.0 };
+        let s_open = match held {
+            Some(g_ref) => super::overlaps::opening_threshold(gap, g_ref, h),
+            None if gap > 0.0 => -gap / h,
+            None => 0.0,
+        };
         let c_closed =
             if law.restitution_n > 0.0 && minus[0] < 0.0 { s_open.max(-law.restitution_n * minus[0]) } else { s_open };
         let lin = |k: usize| [frame[k].x, frame[k].y, frame[k].z];

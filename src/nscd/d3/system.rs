@@ -21,11 +21,13 @@
 //! (its bodies, clock, warm start and contact list).
 //!
 //! The system is plain serde data (a checkpoint of the run loop is its serde form): the parameters, bodies, laws,
-//! clock and the last step's contacts with their impulses (the warm start of the next step); the solver's
+//! clock and the last step's contacts with their impulses (the warm start of the next step) and, under
+//! [`Overlaps::Held`], their reference gaps; the solver's
 //! buffers and the detector are not kept (the detector's per-pair memory of the normal only lets it stop early:
 //! its result does not depend on it), so a state read back steps on with the same numbers.
 
 use super::contact::ContactRow3;
+use super::overlaps::{reference_gap, Overlaps};
 use super::spring::SpringRow3;
 use crate::geometry::{Pose, Vec3};
 use crate::nscd::contact::ContactLaw;
@@ -58,6 +60,10 @@ pub struct Params3 {
     /// ([`FaceGaps::Exact`], the default) or, as in LMGC90, the smallest ([`FaceGaps::CommonPlane`]).
     #[serde(default)]
     pub face_gaps: FaceGaps,
+    /// What a closed contact does with an overlap: keep it ([`Overlaps::Kept`], Moreau–Jean's velocity-level
+    /// law, the default) or hold it from growing ([`Overlaps::Held`]).
+    #[serde(default)]
+    pub overlaps: Overlaps,
     /// The Gauss–Seidel's policy, tolerance and caps ([`NlgsSettings::default`]).
     pub nlgs: NlgsSettings,
 }
@@ -70,6 +76,7 @@ impl Default for Params3 {
             gravity: Vec3::new(0.0, 0.0, -9.81),
             alert_distance: 1e-3,
             face_gaps: FaceGaps::Exact,
+            overlaps: Overlaps::Kept,
             nlgs: NlgsSettings::default(),
         }
     }
@@ -163,6 +170,10 @@ pub struct System3 {
     memory: Vec<(Key, Vec3)>,
     /// The last step's contact points with their impulses, sorted by key.
     contacts: Vec<Contact3>,
+    /// Under [`Overlaps::Held`], the reference gap (m) of each of [`Self::contacts`] (same order); empty under
+    /// [`Overlaps::Kept`].
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    held: Vec<f64>,
     #[serde(skip)]
     detector: Detector,
     #[serde(skip)]
@@ -172,6 +183,9 @@ pub struct System3 {
     /// Per row: its key, point, frame `[n, t₁, t₂]` and gap.
     #[serde(skip)]
     geometry: Vec<(Key, Vec3, [Vec3; 3], f64)>,
+    /// Per row under [`Overlaps::Held`]: its reference gap (m).
+    #[serde(skip)]
+    held_rows: Vec<f64>,
     #[serde(skip)]
     u_begin: Vec<Dofs6>,
     #[serde(skip)]
@@ -205,10 +219,12 @@ impl System3 {
             materials,
             laws: vec![ContactLaw::default(); materials * materials],
             contacts: Vec::new(),
+            held: Vec::new(),
             detector: Detector::default(),
             poses_m: Vec::new(),
             rows: Vec::new(),
             geometry: Vec::new(),
+            held_rows: Vec::new(),
             memory: Vec::new(),
             u_begin: Vec::new(),
             u: Vec::new(),
@@ -389,9 +405,18 @@ impl System3 {
         let clock = std::time::Instant::now();
         self.rows.clear();
         self.geometry.clear();
+        self.held_rows.clear();
+        let held = self.params.overlaps == Overlaps::Held;
         for f in &self.detector.found {
             let (a, b) = (f.key.0 as usize, f.key.1 as usize);
             let frame = [f.normal, f.t1, f.t2];
+            let last = self.memory.binary_search_by(|(key, _)| key.cmp(&f.key)).ok();
+            let g_ref = held.then(|| {
+                // The same rank of the pair may be another feature: a point farther than the alert distance from
+                // the last one is a new point (`overlaps` module doc).
+                let same = last.filter(|&k| (self.contacts[k].point - f.position).norm() <= alert);
+                reference_gap(f.gap, same.and_then(|k| self.held.get(k).copied()))
+            });
             let mut row = ContactRow3::new(
                 (f.key.0, f.key.1),
                 f.position,
@@ -401,9 +426,13 @@ impl System3 {
                 (&self.u_begin[a], &self.u_begin[b]),
                 f.gap,
                 h,
+                g_ref,
                 self.law(a, b),
             );
-            if let Ok(k) = self.memory.binary_search_by(|(key, _)| key.cmp(&f.key)) {
+            if let Some(g_ref) = g_ref {
+                self.held_rows.push(g_ref);
+            }
+            if let Some(k) = last {
                 let pw = self.memory[k].1;
                 row.p = crate::nscd::d3::cone::project_cone([pw.dot(&f.normal), pw.dot(&f.t1), pw.dot(&f.t2)], row.mu);
             }
@@ -474,6 +503,7 @@ impl System3 {
         std::mem::swap(&mut self.bodies.u, &mut self.u);
         self.memory.clear();
         self.contacts.clear();
+        std::mem::swap(&mut self.held, &mut self.held_rows);
         for (row, &(key, point, frame, gap)) in self.rows.iter().zip(&self.geometry) {
             let pw = frame[0] * row.p[0] + frame[1] * row.p[1] + frame[2] * row.p[2];
             self.memory.push((key, pw));
@@ -609,6 +639,15 @@ impl System3 {
         if !self.contacts.iter().all(|c| in_range(&c.key)) || self.contacts.windows(2).any(|w| w[0].key >= w[1].key) {
             return bad("last contacts: bodies out of range or keys not sorted".into());
         }
+        if self.memory.len() != self.contacts.len() || self.memory.iter().zip(&self.contacts).any(|(m, c)| m.0 != c.key)
+        {
+            return bad("warm start and last contacts: not the same keys".into());
+        }
+        if !(self.held.is_empty() || self.held.len() == self.contacts.len())
+            || !self.held.iter().all(|g| *g <= 0.0 && g.is_finite())
+        {
+            return bad("held: not one reference gap (≤ 0, finite) per last contact".into());
+        }
         for (k, s) in self.springs.iter().enumerate() {
             if s.a >= n || s.b.is_some_and(|b| b >= n) {
                 return bad(format!("spring {k}: body out of range ({n} bodies)"));
@@ -706,6 +745,7 @@ impl System3 {
         }
         self.memory.clear();
         self.contacts.clear();
+        self.held.clear();
         self.detector = Detector::with_threads(self.threads);
         Ok(())
     }

@@ -78,6 +78,9 @@ pub struct LoadingSpec {
     /// The face–face gap rule of the grains' contacts (`nscd.face_gaps`): `exact` (default) or `common_plane`
     /// (LMGC90's; [`crate::space::detection::FaceGaps`]).
     pub face_gaps: String,
+    /// What a closed contact does with an overlap (`nscd.overlaps`): `kept` (default, Moreau–Jean's
+    /// velocity-level law) or `held` (an overlap may not grow; [`crate::nscd::d3::overlaps::Overlaps`]).
+    pub overlaps: String,
     /// Steps between rows of `series.csv`.
     pub output_every: u64,
 }
@@ -103,6 +106,7 @@ impl LoadingSpec {
             min_iterations: 1,
             max_iterations: 20_000,
             face_gaps: crate::space::detection::FaceGaps::Exact.name().into(),
+            overlaps: crate::nscd::d3::overlaps::Overlaps::Kept.name().into(),
             output_every: 10,
         }
     }
@@ -141,6 +145,9 @@ impl LoadingSpec {
         }
         if crate::space::detection::FaceGaps::from_name(&self.face_gaps).is_none() {
             return refuse(format!("face_gaps: '{}' is not one of 'exact', 'common_plane'", self.face_gaps));
+        }
+        if crate::nscd::d3::overlaps::Overlaps::from_name(&self.overlaps).is_none() {
+            return refuse(format!("overlaps: '{}' is not one of 'kept', 'held'", self.overlaps));
         }
         if self.min_iterations == 0 || self.max_iterations < self.min_iterations {
             return refuse(format!(
@@ -237,6 +244,7 @@ pub fn loaded_scene(sample: &Scene3, spec: &LoadingSpec) -> Result<Scene3> {
     nscd.min_iterations = Some(spec.min_iterations);
     nscd.max_iterations = Some(spec.max_iterations);
     nscd.face_gaps = Some(spec.face_gaps.clone());
+    nscd.overlaps = Some(spec.overlaps.clone());
     out.output = Some(OutputSection {
         every: Some(spec.output_every),
         cycles: Some(CyclesSpec { frequency: spec.frequency, body: Some(SLEEPER.into()), positions: Some(true) }),

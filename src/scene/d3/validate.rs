@@ -14,6 +14,7 @@ use super::drives::{check_drives, check_springs, CheckedSpring3};
 use super::format::{BodySpec3, Scene3};
 use crate::error::{clip, Error, Result};
 use crate::geometry::{Polyhedron, Pose, Solid, SolidError, Vec3, MAX_LENGTH, MIN_SIZE};
+use crate::nscd::d3::overlaps::Overlaps;
 use crate::nscd::d3::system::Params3;
 use crate::nscd::nlgs::{NlgsSettings, Solver};
 use crate::scene::common::{check_output, check_simulation};
@@ -75,6 +76,14 @@ pub(crate) fn check(scene: &Scene3) -> Result<Checked3> {
         FaceGaps::from_name,
         "'exact' or 'common_plane'",
     )?;
+    let overlaps = crate::scene::validate::named(
+        "nscd.overlaps",
+        "rule",
+        scene.nscd.as_ref().and_then(|n| n.overlaps.as_deref()),
+        Overlaps::default(),
+        Overlaps::from_name,
+        "'kept' or 'held'",
+    )?;
     let materials: HashMap<&str, usize> =
         scene.materials.iter().enumerate().map(|(i, m)| (m.name.as_str(), i)).collect();
     let (bodies, names) = check_bodies(scene, &materials)?;
@@ -90,6 +99,7 @@ pub(crate) fn check(scene: &Scene3) -> Result<Checked3> {
         gravity: Vec3::from(gravity),
         alert_distance: alert_distance(scene, &bodies),
         face_gaps,
+        overlaps,
         nlgs,
     };
     Ok(Checked3 { params, bodies, springs })
@@ -105,8 +115,8 @@ fn check_shared(scene: &Scene3) -> Result<(f64, NlgsSettings)> {
     while scene.materials.iter().any(|m| m.name == own) {
         own.push('_');
     }
-    // The 3D-only key is read by `check`.
-    probe.nscd = scene.nscd.clone().map(|n| crate::scene::format::NscdSection { face_gaps: None, ..n });
+    // The 3D-only keys are read by `check`.
+    probe.nscd = scene.nscd.clone().map(|n| crate::scene::format::NscdSection { face_gaps: None, overlaps: None, ..n });
     probe.contacts = scene.contacts.clone();
     probe.materials = scene.materials.clone();
     probe.materials.push(Material { name: own.clone(), density: 1.0 });

@@ -73,6 +73,7 @@ pub(crate) fn to_toml(scene: &Scene3) -> String {
         opt(&mut out, "stall_max_iterations", n.stall_max_iterations, |i| i.to_string());
         opt(&mut out, "alert_distance", n.alert_distance, float);
         opt(&mut out, "face_gaps", n.face_gaps.as_deref(), string);
+        opt(&mut out, "overlaps", n.overlaps.as_deref(), string);
     }
     write_output(&mut out, scene.output.as_ref());
     write_settlement(&mut out, scene.settlement.as_ref());
