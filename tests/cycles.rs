@@ -1,6 +1,7 @@
 //! Per-cycle settlement statistics (`cycles.csv`) against a quasi-static spring.
 
 use crate::common;
+use crate::scratch;
 use ballast::nscd::{Harmonic, Load, Spring};
 use ballast::run::{CyclePlan, RunOptions, RunPlan, Runner};
 use common::*;
@@ -41,7 +42,7 @@ fn cycle_settlement_of_a_sprung_pad_is_the_quasi_static_deflection() {
     });
     let k = k_n / l0;
     // The library's run loop writes cycles.csv (with the positions of the pad).
-    let dir = std::env::temp_dir().join(format!("ballast-cycles-{}", std::process::id()));
+    let dir = scratch::path("cycles");
     let plan = RunPlan {
         cycles: Some(CyclePlan { frequency: f, body: Some(p), positions: true }),
         ..RunPlan::new(1500, 1500)

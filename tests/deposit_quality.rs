@@ -19,6 +19,7 @@
 //! Gauss–Seidel) stays within these bounds; a solver that converged worse
 //! would not.
 
+use crate::scratch;
 use ballast::run::RunEnd;
 use ballast::run::{RunOptions, Runner};
 use ballast::scenarios::{pentagon_deposit, DepositSpec};
@@ -32,7 +33,7 @@ fn a_scaled_deposit_comes_to_rest_with_small_overlaps() {
     sys.params.nlgs.split_min_rows = 1; // the 724-grain deposit's problems are all split
     let mut plan = scene.plan().unwrap();
     plan.output_every = 1000;
-    let dir = std::env::temp_dir().join(format!("ballast-deposit-quality-{}", std::process::id()));
+    let dir = scratch::path("deposit-quality");
     let opts = RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() };
     let run = Runner::from_system(sys, plan).unwrap().run(&dir, &opts, &mut |_| {}).unwrap();
     let r = &run.report;

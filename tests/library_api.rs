@@ -4,6 +4,7 @@
 //! contact law refused by `MdSystem::new`, `GeometryError` converted by `?`, and
 //! the engines' contact counts and body sizes (the settlement driver's bounds).
 
+use crate::scratch;
 use ballast::geometry::{ConvexPolygon, GeometryError, Shape};
 use ballast::md::{
     self, Ghosts, LawTable, Material, MdSettings, MdSystem, Motion, PairLaw, Particles, SymmetryPlane, Wall, V3,
@@ -494,7 +495,7 @@ fn engines_count_the_force_carrying_contacts_and_size_the_bodies() {
 fn error_kinds_tell_a_file_an_argument_and_a_checkpoint_apart() {
     use ballast::run::RunOptions;
     let missing = std::path::Path::new("examples/no_such_scene.toml");
-    let out = std::env::temp_dir().join(format!("ballast-library-api-{}-kinds", std::process::id()));
+    let out = scratch::path("kinds");
     match ballast::open::run_file(missing, &out, &RunOptions::default(), &mut |_| {}) {
         Err(e @ Error::File { .. }) => {
             assert!(e.is_input());

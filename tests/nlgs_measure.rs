@@ -5,6 +5,7 @@
 //! restarted cold (`P = 0`, `u = u_free`): 1173 contacts, every sweep does real
 //! corrections.
 
+use crate::scratch;
 use ballast::nscd::criterion::{evaluate, Measure, Policy};
 use ballast::nscd::nlgs::{check, solve_nlgs, sweep, NlgsProblem, NlgsSettings, OnStall};
 use ballast::run::RunOptions;
@@ -105,9 +106,7 @@ fn a_stalled_step_is_accepted_extended_or_stops_the_run() {
     assert!(extended.criterion < 1e-4);
 
     // Stop: the run ends with Error::Stalled, keeping the last good step.
-    let dir = std::env::temp_dir().join(format!("ballast-stall-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch::dir("stall");
     let text = std::fs::read_to_string(PILE)
         .unwrap()
         .replace("max_iterations = 2000", "max_iterations = 3\ntolerance = 1e-7\non_stall = \"stop\"");

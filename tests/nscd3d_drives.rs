@@ -6,6 +6,7 @@
 //! oscillation is a rotation by `2 atan(Ω h / 2)` per step, exactly, and the energy is conserved), and a slab
 //! guided along z on four compression-only springs (the static compression `m g L0 / (4 k_N)`).
 
+use crate::scratch;
 use ballast::geometry::{Polyhedron, Pose, Solid, Vec3};
 use ballast::nscd::contact::ContactLaw;
 use ballast::nscd::d3::system::{Params3, System3};
@@ -282,9 +283,7 @@ fn the_sleeper_example_balances_vertical_momentum() {
 fn the_sleeper_example_runs_stops_and_resumes_to_the_same_bytes() {
     use ballast::open::open;
     use ballast::run::RunOptions;
-    let dir = std::env::temp_dir().join(format!("ballast-nscd3d-drives-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch::dir("sleeper");
     let path = dir.join("sleeper3d.toml");
     std::fs::write(&path, SLEEPER).unwrap();
     let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };

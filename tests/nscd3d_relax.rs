@@ -3,6 +3,7 @@
 //! through SO(3)'s right Jacobian), the mass-metric projection of a single overlap against its closed form,
 //! a sunk cube lifted straight up, held and imposed bodies left in place, and the engine's write-back.
 
+use crate::scratch;
 use ballast::engine::relax::Functional;
 use ballast::engine::{Engine, RelaxSettings};
 use ballast::geometry::{Polyhedron, Pose, Solid, Vec3};
@@ -147,9 +148,7 @@ fn the_settlement_driver_runs_on_the_3d_engine() {
     use ballast::run::RunOptions;
     let text = include_str!("../examples/sleeper3d.toml").replace("duration = 0.1 ", "duration = 0.5 ")
         + "\n[settlement]\ninitial_cycles = 2\ncomputed_cycles = 3\nextrapolated_cycles = 3\n";
-    let dir = std::env::temp_dir().join(format!("ballast-nscd3d-relax-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch::dir("accelerated");
     let path = dir.join("accelerated.toml");
     std::fs::write(&path, text).unwrap();
     let opts = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };

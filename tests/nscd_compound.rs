@@ -3,6 +3,7 @@
 //! groove gives, contact keys, the scene syntax `parts = [...]` and VTK output.
 
 use crate::common;
+use crate::scratch;
 
 use ballast::geometry::{rotate, Compound, GeometryError, Shape, Vec2};
 use ballast::nscd::{BodyInfo, Harmonic, Imposed, Load, System};
@@ -368,8 +369,7 @@ fn bad_parts_give_one_line_errors() {
 #[test]
 fn vtk_writes_one_cell_per_part() {
     let sys = Scene::from_toml_str(SCENE).unwrap().build().unwrap();
-    let dir = std::env::temp_dir().join(format!("ballast_compound_vtk_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch::dir("vtk");
     let path = dir.join("bodies.vtk");
     ballast::plane::vtk::write_bodies(&path, &sys).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();

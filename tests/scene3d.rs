@@ -3,6 +3,7 @@
 //! back to the same scene and system, its cubes come to rest on the floor; and every class of error is one line
 //! naming the key.
 
+use crate::scratch;
 use ballast::geometry::{Polyhedron, Solid, Vec3};
 use ballast::nscd::d3::overlaps::Overlaps;
 use ballast::nscd::d3::system::System3;
@@ -579,9 +580,7 @@ fn the_scene_file_opens_and_runs_on_the_3d_engine() {
     use ballast::engine::final_state::FinalState;
     use ballast::open::{open, Loaded};
     use ballast::run::RunOptions;
-    let dir = std::env::temp_dir().join(format!("ballast-scene3d-open-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch::dir("open");
     let path = dir.join("cubes3d.toml");
     std::fs::write(&path, EXAMPLE).unwrap();
     assert_eq!(SceneKind::of(EXAMPLE, "cubes3d.toml", None).unwrap(), SceneKind::Nscd3);
