@@ -59,7 +59,7 @@ fn loaded_column(overlaps: Overlaps, steps: usize) -> (System3, Vec<f64>) {
 /// `quad` 1e-3, the velocity-level law leaves the closed contacts approaching by a little every step and the
 /// column sinks cycle after cycle (measured 29 µm after 2 cycles, 155 µm after 10: a creep of 16 µm per cycle).
 /// Under the held law each step's growth is pushed back out by the next one, so the column stays within one
-/// step's growth of its height (measured ≤ 0.6 µm over the 10 cycles; bound 2 µm, 80× under the kept law's
+/// step's growth of its height (measured ≤ 0.6 µm over the 10 cycles; bound 2 µm, 1/60 of the kept law's
 /// creep over cycles 2–10).
 #[test]
 fn a_loaded_column_creeps_under_kept_overlaps_and_keeps_its_height_under_held_ones() {
