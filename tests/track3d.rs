@@ -94,10 +94,12 @@ fn sample_json_agrees_with_an_independent_computation() {
     // vertex, has as much void at the walls and the surface as inside, so well below a bulk's 0.55–0.6, but a
     // layer below 0.2 would be grains standing on their tips.
     assert!((0.2..0.64).contains(&phi), "solid fraction {phi}");
-    // The layer's mean surface is below the highest vertex and at most one longest grain (75 mm) under it.
+    // The layer's mean surface is below the highest vertex and at most one longest grain (75 mm) under it. The
+    // report measures it after its steps of measurement and the test takes the vertex at the sample's state:
+    // 1e-5 m of slack for the motion in between, as above (a deposit of this file's seed measured 3.7e-7 m).
     let top = grains.iter().flat_map(|&i| vertices(&sys, i)).map(|v| v.z).fold(f64::NEG_INFINITY, f64::max);
     let surface_gap = top - r.surface_m;
-    assert!((0.0..=0.075).contains(&surface_gap), "surface {} m, top vertex {top} m", r.surface_m);
+    assert!((-1e-5..=0.075).contains(&surface_gap), "surface {} m, top vertex {top} m", r.surface_m);
 
     // Weights: ρ V g of the grains, and of the pads (boxes of the scene's half sizes).
     let grain_weight = density(&scene, "ballast") * volume * G;

@@ -55,6 +55,10 @@ pub struct ContactRow3 {
     pub mu: f64,
 }
 
+// Six cache lines: the block's reciprocal pivots (`Delassus3`) filled the padding after `mu`; a field more
+// would add a seventh line to every active visit.
+const _: () = assert!(std::mem::size_of::<ContactRow3>() == 384);
+
 pub use crate::space::bodies::{dot6, gen_dir};
 
 #[inline(always)]

@@ -24,8 +24,9 @@
 //!
 //! **Measured against each other** on the same 100 000 random coupled contacts (`tests::random_case`: 29 % open,
 //! 62 % sliding, 9 % sticking; `cargo test --release --lib nscd::d3::cone::tests::measure -- --ignored
-//! --nocapture`, one AMD EPYC core), the exact [`solve`] takes 110 ns per call with a largest [`residual`] of
-//! 6e-15, and Alart–Curnier 305 ns cold (3.9 Newton steps per closed contact; 10 runs, 0.01 %, not converged
+//! --nocapture`, one core of this machine), the exact [`solve`] takes 90 ns per call with a largest [`residual`]
+//! of 6e-15 (108 ns before its block kept the reciprocal pivots of its sticking system and the Newton's last
+//! turns lost their square root, side by side), and Alart–Curnier 305 ns cold (3.9 Newton steps per closed contact; 10 runs, 0.01 %, not converged
 //! within 50 steps: sticking contacts with μ ≈ 0.9–1 and strong coupling, stalled near `P_N = 0`) and 180 ns
 //! warm-started from the exact impulse perturbed by 1 % (2.1 steps, no failure, largest residual 1.6e-12).
 //! The exact solver, faster than Alart–Curnier even warm and exact to round-off, is the one recommended for
@@ -39,16 +40,42 @@ pub use newton::{solve_alart_curnier, AC_MAX_ITERATIONS, AC_TOLERANCE};
 
 /// The local Delassus block `W = H* M⁻¹ H` of one contact in its frame `(n, t1, t2)` (1/kg, i.e. m/s of
 /// local velocity per N·s of impulse), symmetric positive semidefinite.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Delassus3 {
     /// `m[i][j]`: velocity component `i` per unit impulse component `j` (0: normal, 1 and 2: tangents) (1/kg).
     pub m: [[f64; 3]; 3],
+    /// The reciprocals of the pivots `d_k` of `W = L D Lᵀ` (kg), computed once by [`Delassus3::new`] so that the
+    /// sweeps' visits solve the sticking system without a division: `1/d_0 = 1/W_NN`, 0 when `W` has a term
+    /// that is not finite or `W_NN ≤ 0` (no impulse then moves the contact); `1/d_1` and `1/d_2` are 0 when
+    /// their pivot is below [`PIVOT`] of `W`'s largest diagonal term (`W` singular for the sticking system).
+    inv_pivots: [f64; 3],
+}
+
+impl Default for Delassus3 {
+    /// The zero block (no impulse moves the contact).
+    fn default() -> Self {
+        Self::new([[0.0; 3]; 3])
+    }
 }
 
 impl Delassus3 {
     /// The block of `m`, symmetrised (`(m + mᵀ)/2`) to remove the round-off of its assembly.
     pub fn new(m: [[f64; 3]; 3]) -> Self {
-        Self { m: std::array::from_fn(|i| std::array::from_fn(|j| 0.5 * (m[i][j] + m[j][i]))) }
+        let m: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| 0.5 * (m[i][j] + m[j][i])));
+        let mut inv_pivots = [0.0; 3];
+        if m.iter().flatten().all(|x| x.is_finite()) && m[0][0] > 0.0 {
+            let tiny = PIVOT * m[0][0].max(m[1][1]).max(m[2][2]);
+            let (l10, l20) = (m[1][0] / m[0][0], m[2][0] / m[0][0]);
+            let d1 = m[1][1] - l10 * m[1][0];
+            let l21 = (m[2][1] - l20 * m[1][0]) / d1;
+            let d2 = m[2][2] - l20 * m[2][0] - l21 * l21 * d1;
+            inv_pivots[0] = 1.0 / m[0][0];
+            if d1 > tiny && d2 > tiny {
+                inv_pivots[1] = 1.0 / d1;
+                inv_pivots[2] = 1.0 / d2;
+            }
+        }
+        Self { m, inv_pivots }
     }
 
     /// `W P` (m/s).
@@ -88,6 +115,7 @@ pub fn solve(w: &Delassus3, u_free: [f64; 3], s_open: f64, c_closed: f64, mu: f6
 /// Gauss–Seidel sweeps the row's impulse of the last visit, whose direction changes little from sweep to
 /// sweep: Newton then needs fewer steps. The solution is the law's, as [`solve`]'s; where the law has several
 /// sliding solutions (a strongly coupled block), the one nearest that direction.
+#[inline(always)]
 pub fn solve_near(
     w: &Delassus3,
     u_free: [f64; 3],
@@ -101,12 +129,11 @@ pub fn solve_near(
     if u_free[0] >= s_open || r <= 0.0 {
         return [0.0; 3];
     }
-    // After the open exit (it returns the same zero): a NaN `U_N` or `c` fails both of its tests.
-    if !(u_free.iter().chain(m.iter().flatten()).all(|x| x.is_finite()) && c_closed.is_finite()) {
-        return [0.0; 3];
-    }
-    if m[0][0] <= 0.0 {
-        // No impulse moves U_N (W ⪰ 0 and W_NN = 0 make W's first row 0): the law cannot be met.
+    // After the open exit (it returns the same zero): a NaN `U_N` or `c` fails both of its tests. One sum is
+    // finite only if its terms are (finite terms overflowing it, beyond 1e308 m/s, count as non-finite too).
+    // `1/W_NN = 0`: a term of `W` is not finite, or no impulse moves U_N (W ⪰ 0 and W_NN = 0 make W's first
+    // row 0) and the law cannot be met.
+    if w.inv_pivots[0] == 0.0 || !(u_free[0] + u_free[1] + u_free[2] + c_closed).is_finite() {
         return [0.0; 3];
     }
     let mu = if mu > 0.0 { mu } else { 0.0 };
@@ -115,12 +142,13 @@ pub fn solve_near(
     }
     let a = [u_free[1], u_free[2]];
     // Sticking: U = (c, 0, 0), i.e. W P = (r, −U_free_T).
-    let stick = ldl_solve(m, [r, -a[0], -a[1]]);
-    if let Some(p) = stick {
-        if p[0] >= 0.0 && p[1] * p[1] + p[2] * p[2] <= mu * mu * p[0] * p[0] {
-            return p;
-        }
+    // (The candidate tested in registers before it becomes an `Option`: built as one, it went through the
+    // stack piecewise and was read back whole, a store-forwarding stall on every visit.)
+    let (p, solvable) = ldl_solve(w, [r, -a[0], -a[1]]);
+    if solvable && p[0] >= 0.0 && p[1] * p[1] + p[2] * p[2] <= mu * mu * p[0] * p[0] {
+        return p;
     }
+    let stick = solvable.then_some(p);
     let s = Slide::new(m, a, r, mu);
     // Slip direction guess: the last slip, else opposite to the sticking friction, else along the frictionless
     // slip velocity.
@@ -179,28 +207,38 @@ fn best_projection(
 #[inline(always)]
 fn normalize(v: [f64; 2]) -> Option<[f64; 2]> {
     let n = len2(v[0], v[1]);
-    (n > 0.0 && n.is_finite()).then(|| [v[0] / n, v[1] / n])
+    (n > 0.0 && n.is_finite()).then(|| {
+        let inv = 1.0 / n;
+        [v[0] * inv, v[1] * inv]
+    })
 }
 
-/// `x` with `W x = b` by `W = L D Lᵀ` (backward stable for `W ⪰ 0`: `W x − b` is round-off of `|W||x|`);
-/// `None` if a pivot is below [`PIVOT`] (`W_NN > 0` is known).
+/// The unit vector `d` turned by `atan δ`: `(d + δ d⊥) / √(1 + δ²)`. Below `|δ| = 1e-3` (Newton's last steps)
+/// the factor is its series `1 − δ²/2 + 3δ⁴/8`, whose error `5δ⁶/16 < 4e-19` is below round-off: no square root
+/// nor division on the sweeps' critical path; larger turns renormalise exactly.
 #[inline(always)]
-fn ldl_solve(m: &[[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
-    let tiny = PIVOT * m[0][0].max(m[1][1]).max(m[2][2]);
-    let (l10, l20) = (m[1][0] / m[0][0], m[2][0] / m[0][0]);
-    let d1 = m[1][1] - l10 * m[1][0];
-    if d1.is_nan() || d1 <= tiny {
-        return None;
+fn turn(d: [f64; 2], delta: f64) -> Option<[f64; 2]> {
+    let v = [d[0] - delta * d[1], d[1] + delta * d[0]];
+    if delta.abs() < 1e-3 {
+        let e = delta * delta;
+        let k = 1.0 - e * (0.5 - 0.375 * e);
+        return Some([v[0] * k, v[1] * k]);
     }
-    let l21 = (m[2][1] - l20 * m[1][0]) / d1;
-    let d2 = m[2][2] - l20 * m[2][0] - l21 * l21 * d1;
-    if d2.is_nan() || d2 <= tiny {
-        return None;
-    }
+    normalize(v)
+}
+
+/// `x` with `W x = b` by `W = L D Lᵀ` (backward stable for `W ⪰ 0`: `W x − b` is round-off of `|W||x|`), with the
+/// reciprocal pivots of [`Delassus3::new`], and whether the block is regular for it (`W_NN > 0` is known; a
+/// singular block gives a meaningless `x`).
+#[inline(always)]
+fn ldl_solve(w: &Delassus3, b: [f64; 3]) -> ([f64; 3], bool) {
+    let (m, [i0, i1, i2]) = (&w.m, w.inv_pivots);
+    let (l10, l20) = (m[1][0] * i0, m[2][0] * i0);
+    let l21 = (m[2][1] - l20 * m[1][0]) * i1;
     let y1 = b[1] - l10 * b[0];
-    let x2 = (b[2] - l20 * b[0] - l21 * y1) / d2;
-    let x1 = y1 / d1 - l21 * x2;
-    Some([b[0] / m[0][0] - l10 * x1 - l20 * x2, x1, x2])
+    let x2 = (b[2] - l20 * b[0] - l21 * y1) * i2;
+    let x1 = y1 * i1 - l21 * x2;
+    ([b[0] * i0 - l10 * x1 - l20 * x2, x1, x2], i1 != 0.0)
 }
 
 /// The sliding problem of one contact: for a slip direction `d`, `D(d) = W_NN − μ W_NT·d` and
@@ -244,6 +282,7 @@ impl Slide {
 
     /// Newton on `g` in `θ` from `d`: the step `δ` turns `d` by `atan δ` (`d ← (d + δ d⊥)/|…|`), which keeps the
     /// quadratic convergence and bounds a step by 90°. `None` when it does not reach a root.
+    #[inline(always)]
     fn newton(&self, mut d: [f64; 2]) -> Option<[f64; 2]> {
         let tol = ROOT_TOL * self.scale;
         for _ in 0..40 {
@@ -255,7 +294,7 @@ impl Slide {
                 break;
             }
             let delta = (-g / dg).clamp(-1e6, 1e6);
-            d = normalize([d[0] - delta * d[1], d[1] + delta * d[0]])?;
+            d = turn(d, delta)?;
             if delta.abs() <= 1e-15 {
                 break;
             }
