@@ -25,10 +25,11 @@
 //! **Measured against each other** on the same 100 000 random coupled contacts (`tests::random_case`: 29 % open,
 //! 62 % sliding, 9 % sticking; `cargo test --release --lib nscd::d3::cone::tests::measure -- --ignored
 //! --nocapture`, one core of this machine), the exact [`solve`] takes 90 ns per call with a largest [`residual`]
-//! of 6e-15 (108 ns before its block kept the reciprocal pivots of its sticking system and the Newton's last
-//! turns lost their square root, side by side), and Alart–Curnier 305 ns cold (3.9 Newton steps per closed contact; 10 runs, 0.01 %, not converged
-//! within 50 steps: sticking contacts with μ ≈ 0.9–1 and strong coupling, stalled near `P_N = 0`) and 180 ns
-//! warm-started from the exact impulse perturbed by 1 % (2.1 steps, no failure, largest residual 1.6e-12).
+//! of 6e-15 (108 ns, side by side, before its block kept the reciprocal pivots of its sticking system and
+//! Newton's last turns lost their square root), and Alart–Curnier 305 ns cold (3.9 Newton steps per closed
+//! contact; 10 runs, 0.01 %, not converged within 50 steps: sticking contacts with μ ≈ 0.9–1 and strong
+//! coupling, stalled near `P_N = 0`) and 180 ns warm-started from the exact impulse perturbed by 1 % (2.1
+//! steps, no failure, largest residual 1.6e-12).
 //! The exact solver, faster than Alart–Curnier even warm and exact to round-off, is the one recommended for
 //! the engine's row; Alart–Curnier stays as a cross-check.
 
@@ -59,7 +60,8 @@ impl Default for Delassus3 {
 }
 
 impl Delassus3 {
-    /// The block of `m`, symmetrised (`(m + mᵀ)/2`) to remove the round-off of its assembly.
+    /// The block of `m`, symmetrised (`(m + mᵀ)/2`) to remove the round-off of its assembly, with the
+    /// reciprocal pivots of its sticking system.
     pub fn new(m: [[f64; 3]; 3]) -> Self {
         let m: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| 0.5 * (m[i][j] + m[j][i])));
         let mut inv_pivots = [0.0; 3];
