@@ -17,8 +17,8 @@
 //! growths whose push-out throws bodies apart. So the velocity-level law is the default.
 //!
 //! The reference `g_ref` of a point is, with `g` its gap at the intermediate configuration `q_m`:
-//! - `min(0, g)` for a new point (no point of the same key last step, or one farther than the alert distance
-//!   from it, which is another feature of the pair under the same rank);
+//! - `min(0, g)` for a new point (no point of the same pair last step within the alert distance that an earlier
+//!   point of the pair has not continued: the system finds a point's last step by place, not by rank);
 //! - `min(0, max(g_ref_last, g))` for a point that carries on.
 //!
 //! and the row's opening threshold is `s_open = −(g − g_ref)/h`, which is the velocity-level law's `−g/h` for an

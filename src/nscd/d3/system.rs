@@ -11,8 +11,10 @@
 //!    turned by the exact rotation `exp((1 − θ) h R_n ω_n)` (LMGC90 turns its frame by the same spin, with a
 //!    linearised or Cayley map); the contacts are detected there ([`crate::space::detection`]), within the alert
 //!    distance raised to twice what the fastest point covers in a step (as in 2D).
-//! 3. **Contact problem**: the rows at `q_m`, warm-started from the impulses of the previous step's contact with
-//!    the same key (kept as world vectors and projected on the new frame), solved by the method's policies.
+//! 3. **Contact problem**: the rows at `q_m`, warm-started from the impulse of the point of the previous step that
+//!    each point continues — of the same pair, the nearest within the alert distance, each taken once (kept as
+//!    world vectors and projected on the new frame; as LMGC90's `recup_rloc` finds a point by place when it cannot
+//!    by feature) — and solved by the method's policies.
 //! 4. **Update**: `u_{n+1}` from the solve; `q_{n+1} = q_m + θ h u_{n+1}` (centroid and frame as in 2).
 //!
 //! A step that starts from or produces a non-finite velocity or position, or leaves an overlap deeper than half
@@ -166,7 +168,8 @@ pub struct System3 {
     pub origin: crate::clock::Origin,
     materials: usize,
     laws: Vec<ContactLaw>,
-    /// The impulses (world, N·s) of the last step's contacts, sorted by key: the next step's warm start.
+    /// The impulses (world, N·s) of the last step's contacts, sorted by key (the order of [`Self::contacts`]): the
+    /// next step's warm start.
     memory: Vec<(Key, Vec3)>,
     /// The last step's contact points with their impulses, sorted by key.
     contacts: Vec<Contact3>,
@@ -407,16 +410,16 @@ impl System3 {
         self.geometry.clear();
         self.held_rows.clear();
         let held = self.params.overlaps == Overlaps::Held;
+        // The last points of the pair being read that an earlier point of it has continued (`previous_point`).
+        let (mut pair, mut taken) = ((u32::MAX, u32::MAX), 0u8);
         for f in &self.detector.found {
             let (a, b) = (f.key.0 as usize, f.key.1 as usize);
             let frame = [f.normal, f.t1, f.t2];
-            let last = self.memory.binary_search_by(|(key, _)| key.cmp(&f.key)).ok();
-            let g_ref = held.then(|| {
-                // The same rank of the pair may be another feature: a point farther than the alert distance from
-                // the last one is a new point (`overlaps` module doc).
-                let same = last.filter(|&k| (self.contacts[k].point - f.position).norm() <= alert);
-                reference_gap(f.gap, same.and_then(|k| self.held.get(k).copied()))
-            });
+            if (f.key.0, f.key.1) != pair {
+                (pair, taken) = ((f.key.0, f.key.1), 0);
+            }
+            let last = previous_point(&self.contacts, f.key, &f.position, alert, &mut taken);
+            let g_ref = held.then(|| reference_gap(f.gap, last.and_then(|k| self.held.get(k).copied())));
             let mut row = ContactRow3::new(
                 (f.key.0, f.key.1),
                 f.position,
@@ -432,8 +435,8 @@ impl System3 {
             if let Some(g_ref) = g_ref {
                 self.held_rows.push(g_ref);
             }
-            if let Some(k) = last {
-                let pw = self.memory[k].1;
+            // `memory` runs alongside `contacts` (`check_state`); an emptied one is a cold start.
+            if let Some(&(_, pw)) = last.and_then(|k| self.memory.get(k).filter(|m| m.0 == self.contacts[k].key)) {
                 row.p = crate::nscd::d3::cone::project_cone([pw.dot(&f.normal), pw.dot(&f.t1), pw.dot(&f.t2)], row.mu);
             }
             self.rows.push(row);
@@ -749,6 +752,30 @@ impl System3 {
         self.detector = Detector::with_threads(self.threads);
         Ok(())
     }
+}
+
+/// The last step's point that a new point of the pair `key` at `position` continues: among the last step's points of
+/// the same pair (`contacts`, sorted by key) not yet `taken` by an earlier point of the pair this step (bit `j` for
+/// the pair's `j`-th last point; at most 8 are told apart, a pair has at most 4), the nearest to `position` if
+/// within `within` (m), ties to the lower rank; marks it taken. By place, not by rank: a rank follows the features
+/// that make the point ([`crate::space::detection`]), and where two faces are flush their corners come from either
+/// body as the bodies shift by round-off, so the same corner changes rank from step to step.
+fn previous_point(contacts: &[Contact3], key: Key, position: &Vec3, within: f64, taken: &mut u8) -> Option<usize> {
+    let start = contacts.partition_point(|c| (c.key.0, c.key.1) < (key.0, key.1));
+    let mut best: Option<(usize, f64)> = None;
+    for (j, c) in contacts[start..].iter().enumerate().take(8) {
+        if (c.key.0, c.key.1) != (key.0, key.1) {
+            break;
+        }
+        let d = (c.point - position).norm();
+        if *taken & (1 << j) == 0 && d <= within && best.is_none_or(|(_, b)| d < b) {
+            best = Some((j, d));
+        }
+    }
+    best.map(|(j, _)| {
+        *taken |= 1 << j;
+        start + j
+    })
 }
 
 /// Whether two values serialise to the same JSON (floats bit for bit through serde_json's shortest round trip).
