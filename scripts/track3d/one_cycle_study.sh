@@ -6,7 +6,7 @@
 #
 # SCENE is a loaded state (e.g. the final_scene.toml of a `track3d settle` run after its seating);
 # every run is 250 steps (one 20 Hz cycle at dt = 2e-4 s) on one thread. Replica r starts from the
-# scene with every non-fixed body moved by at most 1e-9 m (perturb_scene.py, seed r; r = 0: as it is).
+# scene with every mobile body moved by at most 1e-9 m (`ballast run --replica r`; r = 0: as it is).
 # Settings (name criterion tolerance replicas [extra [nscd] lines]):
 #   q3  quad 1e-3, 12 replicas;  e5 energy 1.66e-5, 6;  q4 quad 1e-4 (at most 2 000 sweeps), 6;
 #   q4x quad 1e-4 reached on every step (on_stall = "extend", up to 20 000 sweeps), 2 — the reference.
@@ -24,10 +24,10 @@ mkdir -p "$OUT"
 go() { # name criterion tolerance replica [extra]
   local n="$OUT/$1-r$4"
   [ -f "$n/summary.json" ] && return 0
-  [ -f "$OUT/start$4.toml" ] || python3 "$HERE/perturb_scene.py" "$SCENE" "$OUT/start$4.toml" "$4" 1e-9 > /dev/null
   sed -e "s/^criterion = .*/criterion = \"$2\"/" -e "s/^tolerance = .*/tolerance = $3/" \
-      -e "s/^max_iterations = \(.*\)/max_iterations = \1${5:-}/" "$OUT/start$4.toml" > "$n.toml"
-  "$BALLAST" run "$n.toml" --out "$n" --steps "$STEPS" --threads 1 --quiet > "$n.log" 2>&1
+      -e "s/^max_iterations = \(.*\)/max_iterations = \1${5:-}/" "$SCENE" > "$n.toml"
+  "$BALLAST" run "$n.toml" --out "$n" --steps "$STEPS" --threads 1 --quiet --replica "$4" --perturb 1e-9 \
+      > "$n.log" 2>&1
 }
 if [ -n "${SETTINGS:-}" ]; then
   names=()
