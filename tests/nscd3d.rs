@@ -313,9 +313,9 @@ fn a_tilted_cube_rocks_flat_under_exact_gaps_and_stays_tilted_under_the_common_p
 /// by `O(h)`, and its warm start (the last step's impulses, at the same points) leaves little to iterate. The
 /// bricks' faces are flush, so the corners of each contact polygon come from either brick as the bricks shift by
 /// round-off, and a point's rank in its pair changes from step to step: a warm start by rank put the impulses on
-/// the wrong corners. Measured over steps 2–40 (the first, cold step 1 088 sweeps): 11 sweeps per step with the
-/// warm start at the points' places, 263 with it by rank. The bound, a tenth of the cold step, lies between them
-/// with a factor of 2.4 and 10 on either side. (From step ~42 all twenty points carry load and every step needs
+/// the wrong corners. Measured over steps 2–40 (the first, cold step 1 088 sweeps): 12.2 sweeps per step with the
+/// warm start at the points' places, 274 with it by rank. The bound, a tenth of the cold step, lies between them
+/// with a factor of 8.9 below it and 2.5 above. (From step ~42 all twenty points carry load and every step needs
 /// ~200 sweeps however it starts: Gauss–Seidel down a five-brick stack.)
 #[test]
 fn a_shaken_column_of_flush_bricks_is_warm_started_at_its_points() {
