@@ -410,15 +410,19 @@ impl System3 {
         self.geometry.clear();
         self.held_rows.clear();
         let held = self.params.overlaps == Overlaps::Held;
-        // The last points of the pair being read that an earlier point of it has continued (`previous_point`).
-        let (mut pair, mut taken) = ((u32::MAX, u32::MAX), 0u8);
+        // The pair being read, where its last points start in `contacts` (both lists are sorted by key, so the
+        // start only moves forward) and which of them an earlier point of the pair has continued.
+        let (mut pair, mut start, mut taken) = ((u32::MAX, u32::MAX), 0, 0u8);
         for f in &self.detector.found {
             let (a, b) = (f.key.0 as usize, f.key.1 as usize);
             let frame = [f.normal, f.t1, f.t2];
             if (f.key.0, f.key.1) != pair {
-                (pair, taken) = ((f.key.0, f.key.1), 0);
+                pair = (f.key.0, f.key.1);
+                start += self.contacts[start..].partition_point(|c| (c.key.0, c.key.1) < pair);
+                taken = 0;
             }
-            let last = previous_point(&self.contacts, f.key, &f.position, alert, &mut taken);
+            let same_pair = self.contacts[start..].iter().take_while(|c| (c.key.0, c.key.1) == pair);
+            let last = previous_point(same_pair, &f.position, alert, &mut taken).map(|j| start + j);
             let g_ref = held.then(|| reference_gap(f.gap, last.and_then(|k| self.held.get(k).copied())));
             let mut row = ContactRow3::new(
                 (f.key.0, f.key.1),
@@ -754,19 +758,20 @@ impl System3 {
     }
 }
 
-/// The last step's point that a new point of the pair `key` at `position` continues: among the last step's points of
-/// the same pair (`contacts`, sorted by key) not yet `taken` by an earlier point of the pair this step (bit `j` for
-/// the pair's `j`-th last point; at most 8 are told apart, a pair has at most 4), the nearest to `position` if
-/// within `within` (m), ties to the lower rank; marks it taken. By place, not by rank: a rank follows the features
-/// that make the point ([`crate::space::detection`]), and where two faces are flush their corners come from either
-/// body as the bodies shift by round-off, so the same corner changes rank from step to step.
-fn previous_point(contacts: &[Contact3], key: Key, position: &Vec3, within: f64, taken: &mut u8) -> Option<usize> {
-    let start = contacts.partition_point(|c| (c.key.0, c.key.1) < (key.0, key.1));
+/// Which of a pair's last points (`last`, the last step's points of the pair in rank order) a new point of the
+/// pair at `position` continues: of those not yet `taken` by an earlier point of the pair this step (bit `j` for
+/// the `j`-th; at most 8 are told apart, a pair has at most 4), the nearest to `position` if within `within` (m),
+/// ties to the lower rank; marks it taken. By place, not by rank: a rank follows the features that make the point
+/// ([`crate::space::detection`]), and where two faces are flush their corners come from either body as the bodies
+/// shift by round-off, so the same corner changes rank from step to step.
+fn previous_point<'c>(
+    last: impl Iterator<Item = &'c Contact3>,
+    position: &Vec3,
+    within: f64,
+    taken: &mut u8,
+) -> Option<usize> {
     let mut best: Option<(usize, f64)> = None;
-    for (j, c) in contacts[start..].iter().enumerate().take(8) {
-        if (c.key.0, c.key.1) != (key.0, key.1) {
-            break;
-        }
+    for (j, c) in last.enumerate().take(8) {
         let d = (c.point - position).norm();
         if *taken & (1 << j) == 0 && d <= within && best.is_none_or(|(_, b)| d < b) {
             best = Some((j, d));
@@ -774,7 +779,7 @@ fn previous_point(contacts: &[Contact3], key: Key, position: &Vec3, within: f64,
     }
     best.map(|(j, _)| {
         *taken |= 1 << j;
-        start + j
+        j
     })
 }
 
