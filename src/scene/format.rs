@@ -77,6 +77,10 @@ pub struct NscdSection {
     /// Over-relaxation factor `ω` of the NLGS sweeps, in (0, 2); default 1 (none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub relaxation: Option<f64>,
+    /// Depth `m` of the Anderson mixing of the NLGS sweeps, 0 to 8; default 0 (plain sweeps;
+    /// `crate::nscd::method::anderson`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anderson: Option<usize>,
     /// Where the convergence norms are measured: `"sweep"` (during the updating
     /// sweep) or `"check"` (a separate pass after it that updates nothing, as LMGC90).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -351,6 +351,16 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
     if !(relaxation > 0.0 && relaxation < 2.0) {
         return err(format!("nscd.relaxation: must be in (0, 2), got {}", num(relaxation)));
     }
+    let anderson = ns.anderson.unwrap_or(defaults.nlgs.anderson);
+    if anderson > crate::nscd::method::anderson::MAX_DEPTH {
+        return err(format!(
+            "nscd.anderson: the depth of the mixing must be 0 to {}, got {anderson}",
+            crate::nscd::method::anderson::MAX_DEPTH
+        ));
+    }
+    if anderson > 0 && solver != Solver::Nlgs {
+        return err(format!("nscd.anderson: mixes the NLGS sweeps, not solver = '{}': remove one key", solver.name()));
+    }
     if ns.face_gaps.is_some() {
         return err("nscd.face_gaps: the gap rule of two polyhedra's face–face contacts is a 3D setting; a 2D \
                     scene's polygons have their own detection: remove the key"
@@ -380,6 +390,7 @@ fn check_nscd(ns: &NscdSection) -> Result<(f64, NlgsSettings)> {
         solver,
         on_stall,
         stall_max_iterations,
+        anderson,
     };
 
     Ok((theta, nlgs))

@@ -124,6 +124,7 @@ pub(crate) fn to_toml(scene: &Scene) -> String {
         opt(&mut out, "max_factor", n.max_factor, float);
         opt(&mut out, "symmetric", n.symmetric, |b| b.to_string());
         opt(&mut out, "relaxation", n.relaxation, float);
+        opt(&mut out, "anderson", n.anderson, |i| i.to_string());
         opt(&mut out, "measure", n.measure.as_deref(), string);
         opt(&mut out, "solver", n.solver.as_deref(), string);
         opt(&mut out, "on_stall", n.on_stall.as_deref(), string);

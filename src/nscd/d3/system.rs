@@ -33,6 +33,7 @@ use super::overlaps::{reference_gap, Overlaps};
 use super::spring::SpringRow3;
 use crate::geometry::{Pose, Vec3};
 use crate::nscd::contact::ContactLaw;
+use crate::nscd::method::anderson::{solve_nlgs_anderson_split, AndersonWorkspace};
 use crate::nscd::method::apgd::{solve_apgd_with, ApgdOptions, ApgdWorkspace};
 use crate::nscd::method::split::SplitWorkspace;
 use crate::nscd::method::{
@@ -203,6 +204,9 @@ pub struct System3 {
     /// Buffers of the accelerated solver (`solver = "apgd"`).
     #[serde(skip)]
     apgd: ApgdWorkspace<ContactRow3>,
+    /// Buffers of the Anderson mixing of the sweeps (`nscd.anderson`) when the problem is not split.
+    #[serde(skip)]
+    anderson: AndersonWorkspace,
     /// Threads of the step (0 or 1: one); not part of the state (the numbers do not depend on it).
     #[serde(skip)]
     threads: usize,
@@ -235,6 +239,7 @@ impl System3 {
             spring_rows: Vec::new(),
             split: SplitWorkspace::default(),
             apgd: ApgdWorkspace::default(),
+            anderson: Default::default(),
             threads: 1,
         }
     }
@@ -460,6 +465,17 @@ impl System3 {
                 &NlgsSettings { max_iterations: settings.sweep_cap(), ..*settings },
                 &ApgdOptions::default(),
                 &mut self.apgd,
+                &mut self.u,
+                &self.bodies.inv_m,
+                &mut self.rows,
+                &mut self.spring_rows,
+            ),
+            _ if settings.anderson > 0 => solve_nlgs_anderson_split(
+                settings,
+                &mut self.anderson,
+                &mut self.split,
+                self.threads,
+                |i| poses_m[i].position.x,
                 &mut self.u,
                 &self.bodies.inv_m,
                 &mut self.rows,

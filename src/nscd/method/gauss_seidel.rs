@@ -239,7 +239,7 @@ pub fn solve_nlgs_split<R: Row, S: Row<Dofs = R::Dofs>>(
 /// lower so that the first check comes a little early rather than late.
 const FIRST_CHECK_RATIO: f64 = 0.5;
 
-fn iterate(settings: &NlgsSettings, mut pass: impl FnMut(Pass) -> SweepNorms) -> NlgsReport {
+pub(super) fn iterate(settings: &NlgsSettings, mut pass: impl FnMut(Pass) -> SweepNorms) -> NlgsReport {
     let s = settings;
     let checked = s.measure == Measure::Check && !s.policy.over_sweeps();
     let mut tail = (s.policy == Policy::Velocity).then(VelocityTail::default);

@@ -17,6 +17,7 @@
 //! it solves the step as a linear complementarity problem, which only a polyhedral cone (2D) allows; a 3D cone
 //! needs a second-order-cone form.
 
+pub mod anderson;
 pub mod apgd;
 pub mod criterion;
 pub mod gauss_seidel;

@@ -49,6 +49,10 @@ pub struct NlgsSettings {
     /// default 10 × the default `max_iterations`.
     #[serde(default = "default_stall_max_iterations")]
     pub stall_max_iterations: usize,
+    /// Depth `m` of the Anderson mixing of the sweeps ([`super::anderson`]), at most
+    /// [`super::anderson::MAX_DEPTH`]; 0: plain sweeps, the default.
+    #[serde(default)]
+    pub anderson: usize,
 }
 
 /// The solver of each step's problem.
@@ -187,6 +191,7 @@ impl Default for NlgsSettings {
             solver: Solver::default(),
             on_stall: OnStall::default(),
             stall_max_iterations: DEFAULT_STALL_MAX_ITERATIONS,
+            anderson: 0,
         }
     }
 }

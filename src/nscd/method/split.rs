@@ -26,6 +26,8 @@
 //!
 //! Nothing is allocated once the buffers have grown to the problem's size.
 
+use super::anderson::{Lane, Mixer};
+use super::apgd::{AffineRow, ConeRow};
 use super::criterion::SweepNorms;
 use super::gauss_seidel::{pass, Pass};
 use super::Row;
@@ -48,6 +50,8 @@ struct Part<R: Row, S: Row<Dofs = R::Dofs>> {
     spring_of: Vec<u32>,
     /// Original index of each mobile body (the fixed copies follow them).
     body_of: Vec<u32>,
+    /// The part's history of the Anderson mixing ([`super::anderson`]).
+    lane: Lane,
 }
 
 impl<R: Row, S: Row<Dofs = R::Dofs>> Default for Part<R, S> {
@@ -60,6 +64,7 @@ impl<R: Row, S: Row<Dofs = R::Dofs>> Default for Part<R, S> {
             row_of: Vec::new(),
             spring_of: Vec::new(),
             body_of: Vec::new(),
+            lane: Lane::default(),
         }
     }
 }
@@ -67,6 +72,22 @@ impl<R: Row, S: Row<Dofs = R::Dofs>> Default for Part<R, S> {
 impl<R: Row, S: Row<Dofs = R::Dofs>> Part<R, S> {
     fn pass(&mut self, kind: Pass) -> SweepNorms {
         pass(kind, &mut self.u, &self.inv_m, &mut self.rows, &mut self.springs)
+    }
+
+    fn absorb(&mut self, slots: &super::anderson::Slots) -> super::anderson::Dots
+    where
+        R: ConeRow,
+        S: AffineRow<Dofs = R::Dofs>,
+    {
+        self.lane.absorb(slots, &self.u, &self.rows, &self.springs)
+    }
+
+    fn mix(&mut self, gamma: &[f64; super::anderson::MAX_DEPTH])
+    where
+        R: ConeRow,
+        S: AffineRow<Dofs = R::Dofs>,
+    {
+        self.lane.mix(gamma, &mut self.u, &self.inv_m, &mut self.rows, &mut self.springs);
     }
 
     fn clear(&mut self) {
@@ -267,6 +288,51 @@ impl<R: Row, S: Row<Dofs = R::Dofs>> SplitWorkspace<R, S> {
             Self::exchange(left, right, iface, side, slot, true);
             let i = iface.pass(kind);
             Self::exchange(left, right, iface, side, slot, false);
+            l.merged(r).merged(i)
+        })
+    }
+
+    /// [`Self::run`] with the Anderson mixing of `mixer` after its sweeps ([`super::anderson`]): each part
+    /// keeps its own history, the halves' passes over it run side by side (in turn on one thread) and the
+    /// interface's after them, the halves' velocities mixed from their histories and the interface's copied from
+    /// them; the dot products are added left, right, interface, whatever the threads.
+    pub(crate) fn run_mixed<T>(
+        &mut self,
+        threads: usize,
+        mixer: &mut Mixer,
+        sweeps: impl FnOnce(&mut dyn FnMut(Pass) -> SweepNorms) -> T,
+    ) -> T
+    where
+        R: ConeRow,
+        S: AffineRow<Dofs = R::Dofs>,
+    {
+        if (threads >= 2) != (self.team.threads() >= 2) {
+            self.team = Team::new(threads);
+        }
+        let depth = mixer.depth();
+        for (part, velocities) in [(&mut self.left, true), (&mut self.right, true), (&mut self.iface, false)] {
+            part.lane.begin(depth, velocities, &part.u, &part.rows, &part.springs);
+        }
+        let Self { left, right, iface, side, slot, team, .. } = self;
+        let (side, slot) = (&side[..], &slot[..]);
+        sweeps(&mut |kind| {
+            let (l, r) = team.join(|| left.pass(kind), || right.pass(kind));
+            if kind == Pass::Check {
+                return l.merged(r).merged(iface.pass(kind));
+            }
+            Self::exchange(left, right, iface, side, slot, true);
+            let i = iface.pass(kind);
+            Self::exchange(left, right, iface, side, slot, false);
+            if let Some(slots) = mixer.due(kind) {
+                let (dl, dr) = team.join(|| left.absorb(&slots), || right.absorb(&slots));
+                let dots = dl.merged(dr).merged(iface.absorb(&slots));
+                if let Some(gamma) = mixer.solve(slots, &dots) {
+                    team.join(|| left.mix(&gamma), || right.mix(&gamma));
+                    Self::exchange(left, right, iface, side, slot, true);
+                    iface.mix(&gamma);
+                    Self::exchange(left, right, iface, side, slot, false);
+                }
+            }
             l.merged(r).merged(i)
         })
     }

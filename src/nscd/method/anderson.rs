@@ -1,0 +1,488 @@
+//! Anderson acceleration of the NLGS sweeps (`[nscd] anderson = m`; Anderson, J. ACM 12 (1965) 547; Walker &
+//! Ni, SIAM J. Numer. Anal. 49 (2011) 1715, "AA(m)"), for rows of any dimension.
+//!
+//! **Why.** On a loaded granular packing Gauss–Seidel passes information one contact per sweep, and its slow
+//! modes (a heavy sleeper on light grains, wedged grains rocking on nearly flat contacts) are nearly linear once
+//! the contacts' statuses have settled: there a sweep is a linear stationary iteration, which Anderson mixing
+//! accelerates as GMRES does (Walker & Ni, §2). The method never leaves the NLGS: the mixed point is projected
+//! on each row's law and the sweeps go on from it, so a step is judged by the same check pass
+//! ([`super::criterion`]) and ends at the same tolerance; only the path to it changes.
+//!
+//! **The map.** `G` is [`SWEEPS_PER_MIX`] Gauss–Seidel sweeps from the impulses `x` of every row (springs'
+//! scalars, contacts' `(P_N, P_T…)`), the body velocities kept consistent with them (`u = u_free + M⁻¹ H x`).
+//! Its residual `f(x) = D (G(x) − x)` is weighted by `D = diag(W)^½` (each entry the square root of the
+//! diagonal of its row's Delassus block: `f` is a velocity, so light grains and the heavy sleeper are weighed
+//! as the check's norms weigh them). After each application of `G` the last `m` differences of `G` and of `f`
+//! give `γ = argmin ‖f_k − ΔF γ‖` (normal equations with a relative Tikhonov term [`REGULARISATION`], a
+//! Cholesky of at most [`MAX_DEPTH`]² numbers) and the next point `x = G(x_k) − ΔG γ`, projected on each row's
+//! law ([`ConeRow::project`], `P ≥ 0` for a compression-only spring), its change scattered to the bodies.
+//!
+//! **Safeguard.** The mixing is a guess where contacts open, close or start to slide: when the residual grows
+//! from one application of the map to the next, the history is dropped (a restart) and that point is the base
+//! of the next differences, so a mix never compounds a bad one; the sweeps themselves always run.
+//!
+//! **Threads.** Each part of the domain split ([`super::split`]) keeps its own [`Lane`] of the history; the
+//! halves' dot products and mixes run side by side, the interface's after them, and the partial sums are added
+//! in a fixed order (left, right, interface): the numbers do not depend on the number of threads.
+//!
+//! Measured in BENCHMARKS.md ("Anderson acceleration of the NLGS sweeps").
+
+use super::apgd::{AffineRow, ConeRow};
+use super::criterion::SweepNorms;
+use super::gauss_seidel::{iterate, pass, NlgsReport, Pass};
+use super::settings::NlgsSettings;
+use super::split::SplitWorkspace;
+
+/// Largest history depth `m` (`nscd.anderson`).
+pub const MAX_DEPTH: usize = 8;
+
+/// Gauss–Seidel sweeps per application of the mixed map: 2 needs the sweeps of 1 at half the mixes (measured on
+/// the 200-grain section's cycle at `quad` 3e-5: 312 sweeps per step mixing after every sweep, 314 after every
+/// second, 358 after every third).
+pub const SWEEPS_PER_MIX: usize = 2;
+
+/// Tikhonov term of the normal equations, relative to the largest diagonal of `ΔFᵀ ΔF`.
+pub const REGULARISATION: f64 = 1e-10;
+
+/// The dot products of one application of the map, summed over a part's rows.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Dots {
+    /// `‖f‖²` of the new residual.
+    residual: f64,
+    /// `Δf_new · Δf_q` for each slot `q` of the history.
+    gram: [f64; MAX_DEPTH],
+    /// `Δf_q · f` for each slot `q`.
+    rhs: [f64; MAX_DEPTH],
+}
+
+impl Dots {
+    /// The sums of two parts (the caller fixes the order).
+    pub(crate) fn merged(mut self, other: Dots) -> Dots {
+        self.residual += other.residual;
+        for q in 0..MAX_DEPTH {
+            self.gram[q] += other.gram[q];
+            self.rhs[q] += other.rhs[q];
+        }
+        self
+    }
+}
+
+/// Which slots of the history hold a difference, and where the next one goes.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Slots {
+    /// The slot the next difference is written to; `None` before the first application (no difference yet).
+    pub(crate) new: Option<usize>,
+    /// Slots that hold a difference (the new one included once written).
+    pub(crate) valid: [bool; MAX_DEPTH],
+}
+
+/// One part's history: per entry of its impulse vector (springs first, then contacts' components) the weight,
+/// the start of the map, the last `G` and `f` and `m` differences of each; per component of its bodies'
+/// velocities the last value at `G` and `m` differences. The differences are stored by column (one slot after
+/// the other), so that the dot products and the mixing are passes over contiguous arrays.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Lane {
+    w: Vec<f64>,
+    x: Vec<f64>,
+    g: Vec<f64>,
+    f: Vec<f64>,
+    scratch: Vec<f64>,
+    dg: Vec<f64>,
+    df: Vec<f64>,
+    ug: Vec<f64>,
+    du: Vec<f64>,
+    depth: usize,
+    /// Whether the bodies' velocities are mixed from their history (false for the split's interface, whose
+    /// velocities are the halves' copies).
+    velocities: bool,
+}
+
+/// Writes the impulse vector of `rows` and `springs`, springs first, into `out`.
+fn gather<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(out: &mut Vec<f64>, rows: &[R], springs: &[S]) {
+    out.clear();
+    out.extend(springs.iter().map(|s| s.impulse()));
+    for r in rows {
+        out.extend_from_slice(r.impulse().as_ref());
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    // Four partial sums: the products are independent, so the sum is not one long chain of additions.
+    let mut s = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for j in 0..4 {
+            s[j] += x[j] * y[j];
+        }
+    }
+    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
+}
+
+impl Lane {
+    /// Starts a step's history at the rows' current impulses and the bodies' velocities `u`.
+    pub(crate) fn begin<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
+        &mut self,
+        depth: usize,
+        velocities: bool,
+        u: &[R::Dofs],
+        rows: &[R],
+        springs: &[S],
+    ) {
+        self.w.clear();
+        self.w.extend(springs.iter().map(|s| s.w().max(0.0).sqrt()));
+        for r in rows {
+            self.w.extend(r.diagonal().as_ref().iter().map(|d| d.max(0.0).sqrt()));
+        }
+        let n = self.w.len();
+        self.depth = depth;
+        self.velocities = velocities;
+        gather(&mut self.x, rows, springs);
+        for v in [&mut self.g, &mut self.f] {
+            v.clear();
+            v.resize(n, 0.0);
+        }
+        for v in [&mut self.dg, &mut self.df] {
+            v.clear();
+            v.resize(n * depth, 0.0);
+        }
+        self.ug.clear();
+        if velocities {
+            for ui in u {
+                self.ug.extend_from_slice(ui.as_ref());
+            }
+        }
+        self.du.clear();
+        self.du.resize(self.ug.len() * depth, 0.0);
+    }
+
+    /// Takes the map's value `G(x)` from the rows and `u`: the new residual, the new differences in
+    /// `slots.new`, their dot products with the valid slots; `x` becomes `G(x)` (the start of the next map if no
+    /// mix follows).
+    pub(crate) fn absorb<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
+        &mut self,
+        slots: &Slots,
+        u: &[R::Dofs],
+        rows: &[R],
+        springs: &[S],
+    ) -> Dots {
+        let n = self.w.len();
+        let mut dots = Dots::default();
+        gather(&mut self.scratch, rows, springs);
+        let (g_new, f) = (&mut self.scratch, &mut self.f);
+        // f ← D (G − x), kept in `x`'s buffer for a moment; then the differences and the swaps.
+        for ((xi, gi), wi) in self.x.iter_mut().zip(g_new.iter()).zip(&self.w) {
+            *xi = wi * (gi - *xi);
+        }
+        dots.residual = dot(&self.x, &self.x);
+        if let Some(h) = slots.new {
+            let (dg, df) = (&mut self.dg[h * n..(h + 1) * n], &mut self.df[h * n..(h + 1) * n]);
+            for (((d, fi), fnew), (e, (gi, gnew))) in
+                df.iter_mut().zip(f.iter()).zip(&self.x).zip(dg.iter_mut().zip(self.g.iter().zip(g_new.iter())))
+            {
+                *d = fnew - fi;
+                *e = gnew - gi;
+            }
+            if self.velocities {
+                let nu = self.ug.len();
+                let du = &mut self.du[h * nu..(h + 1) * nu];
+                let mut k = 0;
+                for ui in u {
+                    for &c in ui.as_ref() {
+                        du[k] = c - self.ug[k];
+                        self.ug[k] = c;
+                        k += 1;
+                    }
+                }
+            }
+        } else if self.velocities {
+            self.ug.clear();
+            for ui in u {
+                self.ug.extend_from_slice(ui.as_ref());
+            }
+        }
+        std::mem::swap(f, &mut self.x);
+        std::mem::swap(&mut self.g, g_new);
+        self.x.clear();
+        self.x.extend_from_slice(&self.g);
+        if let Some(h) = slots.new {
+            let df_h = &self.df[h * n..(h + 1) * n];
+            for q in 0..self.depth {
+                if slots.valid[q] {
+                    let df_q = &self.df[q * n..(q + 1) * n];
+                    dots.gram[q] = dot(df_h, df_q);
+                    dots.rhs[q] = dot(df_q, &self.f);
+                }
+            }
+        }
+        dots
+    }
+
+    /// Moves the rows to the mixed point `G(x) − ΔG γ` and the bodies' velocities to `u(G(x)) − ΔU γ` (the
+    /// same combination: `u` is affine in the impulses); where a row's law projects its mixed impulse, the
+    /// projection's change is scattered to `u`. `x` becomes the mixed point.
+    pub(crate) fn mix<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
+        &mut self,
+        gamma: &[f64; MAX_DEPTH],
+        u: &mut [R::Dofs],
+        inv_m: &[R::Dofs],
+        rows: &mut [R],
+        springs: &mut [S],
+    ) {
+        let n = self.w.len();
+        let x = &mut self.x;
+        x.clear();
+        x.extend_from_slice(&self.g);
+        for (q, &c) in gamma.iter().enumerate().take(self.depth) {
+            if c != 0.0 {
+                for (xi, d) in x.iter_mut().zip(&self.dg[q * n..(q + 1) * n]) {
+                    *xi -= c * d;
+                }
+            }
+        }
+        if self.velocities {
+            let nu = self.ug.len();
+            let um = &mut self.scratch;
+            um.clear();
+            um.extend_from_slice(&self.ug);
+            for (q, &c) in gamma.iter().enumerate().take(self.depth) {
+                if c != 0.0 {
+                    for (v, d) in um.iter_mut().zip(&self.du[q * nu..(q + 1) * nu]) {
+                        *v -= c * d;
+                    }
+                }
+            }
+            let mut k = 0;
+            for ui in u.iter_mut() {
+                for c in ui.as_mut() {
+                    *c = um[k];
+                    k += 1;
+                }
+            }
+        }
+        let mut i = 0;
+        for s in springs.iter_mut() {
+            let mixed = x[i];
+            let q = if s.compression_only() { mixed.max(0.0) } else { mixed };
+            if q != mixed {
+                s.add_impulse_of(u, inv_m, q - mixed, 1.0);
+            }
+            s.set_impulse(q);
+            x[i] = q;
+            i += 1;
+        }
+        for r in rows.iter_mut() {
+            let mut mixed = R::Impulse::default();
+            let len = mixed.as_ref().len();
+            mixed.as_mut().copy_from_slice(&x[i..i + len]);
+            let q = r.project(mixed, None);
+            if q != mixed {
+                let mut d = q;
+                for (dj, oj) in d.as_mut().iter_mut().zip(mixed.as_ref()) {
+                    *dj -= oj;
+                }
+                r.add_impulse_of(u, inv_m, d, 1.0);
+            }
+            r.set_impulse(q);
+            x[i..i + len].copy_from_slice(q.as_ref());
+            i += len;
+        }
+    }
+}
+
+/// The small part of the method, shared by the lanes: the history's slots, `ΔFᵀ ΔF`, the last residual.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Mixer {
+    depth: usize,
+    gram: [[f64; MAX_DEPTH]; MAX_DEPTH],
+    slots: Slots,
+    /// The slot after the newest difference.
+    head: usize,
+    /// Whether a first application has been absorbed (differences can be formed).
+    primed: bool,
+    last_residual: f64,
+    since: usize,
+    /// Mixes made and restarts of the history (for the reports).
+    pub(crate) mixes: usize,
+    pub(crate) restarts: usize,
+}
+
+impl Mixer {
+    /// The history depth `m`.
+    pub(crate) fn depth(&self) -> usize {
+        self.depth
+    }
+
+    pub(crate) fn new(depth: usize) -> Self {
+        Self {
+            depth: depth.min(MAX_DEPTH),
+            gram: [[0.0; MAX_DEPTH]; MAX_DEPTH],
+            slots: Slots::default(),
+            head: 0,
+            primed: false,
+            last_residual: f64::INFINITY,
+            since: 0,
+            mixes: 0,
+            restarts: 0,
+        }
+    }
+
+    /// After a pass: whether the map has been applied (its sweeps made) and the lanes should absorb it; then the
+    /// slots they write and read.
+    pub(crate) fn due(&mut self, kind: Pass) -> Option<Slots> {
+        if kind == Pass::Check {
+            return None;
+        }
+        self.since += 1;
+        if self.since < SWEEPS_PER_MIX {
+            return None;
+        }
+        self.since = 0;
+        let mut slots = self.slots;
+        if self.primed {
+            slots.new = Some(self.head);
+            slots.valid[self.head] = true;
+        }
+        Some(slots)
+    }
+
+    /// Takes the lanes' summed dot products for `slots` (as [`Mixer::due`] gave them); returns the mixing
+    /// coefficients `γ` per slot (zero for the others), or `None` when there is nothing to mix.
+    pub(crate) fn solve(&mut self, slots: Slots, dots: &Dots) -> Option<[f64; MAX_DEPTH]> {
+        let m = self.depth;
+        let grew = dots.residual > self.last_residual;
+        self.last_residual = dots.residual;
+        if grew {
+            // A restart: the history is dropped and this point becomes the base of the next differences.
+            self.restarts += 1;
+            self.slots = Slots::default();
+            self.head = 0;
+            self.primed = true;
+            return None;
+        }
+        self.primed = true;
+        let h = slots.new?;
+        self.slots = slots;
+        self.slots.new = None;
+        for q in 0..m {
+            if slots.valid[q] {
+                self.gram[h][q] = dots.gram[q];
+                self.gram[q][h] = dots.gram[q];
+            }
+        }
+        self.head = (h + 1) % m;
+        let gamma = self.least_squares(&dots.rhs)?;
+        self.mixes += 1;
+        Some(gamma)
+    }
+
+    /// `(ΔFᵀ ΔF + ε I) γ = ΔFᵀ f` over the valid slots, by Cholesky; `None` if it is not positive.
+    fn least_squares(&self, rhs: &[f64; MAX_DEPTH]) -> Option<[f64; MAX_DEPTH]> {
+        let mut idx = [0usize; MAX_DEPTH];
+        let mut k = 0;
+        for q in 0..self.depth {
+            if self.slots.valid[q] {
+                idx[k] = q;
+                k += 1;
+            }
+        }
+        let largest = (0..k).map(|a| self.gram[idx[a]][idx[a]]).fold(0.0, f64::max);
+        if k == 0 || !(largest > 0.0 && largest.is_finite()) {
+            return None;
+        }
+        let mut l = [[0.0; MAX_DEPTH]; MAX_DEPTH];
+        for a in 0..k {
+            for b in 0..=a {
+                let mut s = self.gram[idx[a]][idx[b]];
+                if a == b {
+                    s += REGULARISATION * largest;
+                }
+                for c in 0..b {
+                    s -= l[a][c] * l[b][c];
+                }
+                if a == b {
+                    if !(s > 0.0) {
+                        return None;
+                    }
+                    l[a][a] = s.sqrt();
+                } else {
+                    l[a][b] = s / l[b][b];
+                }
+            }
+        }
+        let mut y = [0.0; MAX_DEPTH];
+        for a in 0..k {
+            let s = rhs[idx[a]] - (0..a).map(|c| l[a][c] * y[c]).sum::<f64>();
+            y[a] = s / l[a][a];
+        }
+        let mut z = [0.0; MAX_DEPTH];
+        for a in (0..k).rev() {
+            let s = y[a] - (a + 1..k).map(|c| l[c][a] * z[c]).sum::<f64>();
+            z[a] = s / l[a][a];
+        }
+        let mut gamma = [0.0; MAX_DEPTH];
+        for a in 0..k {
+            gamma[idx[a]] = z[a];
+        }
+        gamma.iter().all(|g| g.is_finite()).then_some(gamma)
+    }
+}
+
+/// [`solve_nlgs_anderson`] on the domain split of [`super::solve_nlgs_split`] (the same rule for when to
+/// split; the numbers do not depend on `threads`).
+#[allow(clippy::too_many_arguments)]
+pub fn solve_nlgs_anderson_split<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
+    settings: &NlgsSettings,
+    ws: &mut AndersonWorkspace,
+    split: &mut SplitWorkspace<R, S>,
+    threads: usize,
+    abscissa: impl Fn(usize) -> f64,
+    u: &mut [R::Dofs],
+    inv_m: &[R::Dofs],
+    rows: &mut [R],
+    springs: &mut [S],
+) -> NlgsReport {
+    let n = rows.len() + springs.len();
+    if settings.split_min_rows == 0 || n < settings.split_min_rows {
+        return solve_nlgs_anderson(settings, ws, u, inv_m, rows, springs);
+    }
+    let mut mixer = Mixer::new(settings.anderson);
+    split.load(abscissa, u, inv_m, rows, springs);
+    let report = split.run_mixed(threads, &mut mixer, |sweep| iterate(settings, sweep));
+    split.store(u, rows, springs);
+    report
+}
+
+/// Buffers of the accelerated sweeps on one part (the problems too small to split).
+#[derive(Debug, Clone, Default)]
+pub struct AndersonWorkspace {
+    lane: Lane,
+}
+
+/// NLGS ([`super::solve_nlgs`]) with Anderson mixing of depth `settings.anderson` on the whole problem, one
+/// thread.
+pub fn solve_nlgs_anderson<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
+    settings: &NlgsSettings,
+    ws: &mut AndersonWorkspace,
+    u: &mut [R::Dofs],
+    inv_m: &[R::Dofs],
+    rows: &mut [R],
+    springs: &mut [S],
+) -> NlgsReport {
+    if rows.is_empty() && springs.is_empty() {
+        return NlgsReport { iterations: 0, criterion: 0.0, converged: true };
+    }
+    let mut mixer = Mixer::new(settings.anderson);
+    ws.lane.begin(mixer.depth, true, u, rows, springs);
+    iterate(settings, |kind| {
+        let norms: SweepNorms = pass(kind, u, inv_m, rows, springs);
+        if let Some(slots) = mixer.due(kind) {
+            let dots = ws.lane.absorb(&slots, u, rows, springs);
+            if let Some(gamma) = mixer.solve(slots, &dots) {
+                ws.lane.mix(&gamma, u, inv_m, rows, springs);
+            }
+        }
+        norms
+    })
+}
