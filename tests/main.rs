@@ -39,6 +39,7 @@ mod nscd3d_drives;
 mod nscd3d_overlaps;
 mod nscd3d_relax;
 mod nscd3d_run;
+mod nscd_anderson;
 mod nscd_compound;
 mod nscd_detection;
 mod nscd_interior;

@@ -174,9 +174,26 @@ fn the_interior_point_is_refused_in_3d() {
     assert_eq!(sys.steps, 0);
 }
 
+/// The same with the sweeps mixed by Anderson acceleration (`nscd.anderson = 5`): the mixing moves the path, not
+/// the fixed point, and the worst step needs fewer sweeps than plain Gauss–Seidel's (measured 107 mixed against
+/// 3 723 plain).
+#[test]
+fn anderson_a_column_of_cubes_carries_the_weight_above_each_interface() {
+    let plain = column_of_cubes(Solver::Nlgs);
+    let mixed = column_of_cubes_with(Solver::Nlgs, 5);
+    eprintln!("worst step: {mixed} sweeps mixed, {plain} plain");
+    assert!(mixed < plain, "worst step: {mixed} sweeps mixed, {plain} plain");
+}
+
 /// The column's check; returns the most sweeps (or sweep-equivalents) a step took.
 fn column_of_cubes(solver: Solver) -> usize {
+    column_of_cubes_with(solver, 0)
+}
+
+/// [`column_of_cubes`] with the sweeps' Anderson depth `anderson` (0: plain).
+fn column_of_cubes_with(solver: Solver, anderson: usize) -> usize {
     let mut sys = system_with(1e-3, Vec3::new(0.0, 0.0, -G), 0.3, solver);
+    sys.params.nlgs.anderson = anderson;
     floor(&mut sys);
     let (half, n) = (0.05, 5);
     let mut weight = 0.0;

@@ -165,6 +165,9 @@ pub struct LoadingArgs {
     /// overlap may not grow past the shallowest the point has had).
     #[arg(long, default_value_t = LoadingSpec::default().overlaps)]
     pub overlaps: String,
+    /// Depth of the Anderson mixing of the sweeps, 0 to 8 (0: plain Gauss–Seidel sweeps).
+    #[arg(long, default_value_t = LoadingSpec::default().anderson)]
+    pub anderson: usize,
     /// Width of the sleeper along the track (m); default: half the box's length (0.3 m on the full section).
     #[arg(long)]
     pub sleeper_width: Option<f64>,
@@ -198,6 +201,7 @@ impl LoadingArgs {
             max_iterations: self.max_iterations,
             face_gaps: self.face_gaps.clone(),
             overlaps: self.overlaps.clone(),
+            anderson: self.anderson,
             sleeper_width: self.sleeper_width,
             sleeper_length: self.sleeper_length,
             mean_pressure: self.mean_pressure,
@@ -211,7 +215,7 @@ impl LoadingArgs {
 
 /// The spec fields of this command's library calls and their flags (the shared ones, `dt`, `cycles`, …, are
 /// mapped by `flags.rs` too).
-const FLAGS: [(&str, &str); 24] = [
+const FLAGS: [(&str, &str); 25] = [
     ("grains", "--grains"),
     ("dt", "--dt"),
     ("max_duration", "--max-duration"),
@@ -223,6 +227,7 @@ const FLAGS: [(&str, &str); 24] = [
     ("max_iterations", "--max-iterations"),
     ("face_gaps", "--face-gaps"),
     ("overlaps", "--overlaps"),
+    ("anderson", "--anderson"),
     ("sleeper_width", "--sleeper-width"),
     ("sleeper_length", "--sleeper-length"),
     ("mean_pressure", "--mean-pressure"),

@@ -181,6 +181,17 @@ impl System {
         apply_impulses(&mut self.bodies.u, &self.bodies.inv_m, &ws.rows, &ws.spring_rows);
         let settings = &self.params.nlgs;
         match settings.solver {
+            Solver::Nlgs if settings.anderson > 0 => super::method::anderson::solve_nlgs_anderson_split(
+                settings,
+                &mut ws.anderson,
+                &mut ws.split,
+                ws.threads,
+                |i| ws.q_m[i][0],
+                &mut self.bodies.u,
+                &self.bodies.inv_m,
+                &mut ws.rows,
+                &mut ws.spring_rows,
+            ),
             Solver::Nlgs => solve_nlgs_split(
                 settings,
                 &mut ws.split,

@@ -123,6 +123,8 @@ pub(crate) struct Workspace {
     pub spring_rows: Vec<SpringRow>,
     pub detector: Detector,
     pub split: super::nlgs::SplitWorkspace,
+    /// Buffers of the Anderson mixing of the sweeps (`nscd.anderson`) when the problem is not split.
+    pub anderson: super::method::anderson::AndersonWorkspace,
     /// Buffers of the accelerated solver ([`super::apgd`]).
     pub apgd: super::apgd::ApgdWorkspace,
     /// Buffers of the interior-point solver (`super::interior`).

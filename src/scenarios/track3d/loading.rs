@@ -81,9 +81,16 @@ pub struct LoadingSpec {
     /// What a closed contact does with an overlap (`nscd.overlaps`): `kept` (default, Moreau–Jean's
     /// velocity-level law) or `held` (an overlap may not grow; [`crate::nscd::d3::overlaps::Overlaps`]).
     pub overlaps: String,
+    /// Depth of the Anderson mixing of the sweeps (`nscd.anderson`, 0 to
+    /// [`crate::nscd::method::anderson::MAX_DEPTH`]; 0: plain sweeps).
+    pub anderson: usize,
     /// Steps between rows of `series.csv`.
     pub output_every: u64,
 }
+
+/// Default of [`LoadingSpec::anderson`]: the sweeps mixed over the last 5 differences (BENCHMARKS.md, "Anderson
+/// acceleration of the NLGS sweeps").
+pub const DEFAULT_ANDERSON: usize = 5;
 
 impl LoadingSpec {
     /// The 2D paper's load carried over as a pressure, on a concrete sleeper (module doc), `cycles` cycles.
@@ -107,6 +114,7 @@ impl LoadingSpec {
             max_iterations: 20_000,
             face_gaps: crate::space::detection::FaceGaps::Exact.name().into(),
             overlaps: crate::nscd::d3::overlaps::Overlaps::Kept.name().into(),
+            anderson: DEFAULT_ANDERSON,
             output_every: 10,
         }
     }
@@ -148,6 +156,13 @@ impl LoadingSpec {
         }
         if crate::nscd::d3::overlaps::Overlaps::from_name(&self.overlaps).is_none() {
             return refuse(format!("overlaps: '{}' is not one of 'kept', 'held'", self.overlaps));
+        }
+        if self.anderson > crate::nscd::method::anderson::MAX_DEPTH {
+            return Err(Error::Scene(format!(
+                "anderson: the depth of the mixing must be 0 to {}, got {}",
+                crate::nscd::method::anderson::MAX_DEPTH,
+                self.anderson
+            )));
         }
         if self.min_iterations == 0 || self.max_iterations < self.min_iterations {
             return refuse(format!(
@@ -245,6 +260,7 @@ pub fn loaded_scene(sample: &Scene3, spec: &LoadingSpec) -> Result<Scene3> {
     nscd.max_iterations = Some(spec.max_iterations);
     nscd.face_gaps = Some(spec.face_gaps.clone());
     nscd.overlaps = Some(spec.overlaps.clone());
+    nscd.anderson = Some(spec.anderson);
     out.output = Some(OutputSection {
         every: Some(spec.output_every),
         cycles: Some(CyclesSpec { frequency: spec.frequency, body: Some(SLEEPER.into()), positions: Some(true) }),
