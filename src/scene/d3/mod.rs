@@ -14,7 +14,7 @@
 //! equilibrium = { kinetic_energy = 1e-9 }
 //!
 //! [nscd]                          # the 2D scene's [nscd]: theta, criterion, tolerance, min/max_iterations,
-//! theta = 0.5                     # max_factor, symmetric, relaxation, measure, on_stall ("accept",
+//! theta = 0.5                     # max_factor, symmetric, relaxation, anderson, measure, on_stall ("accept",
 //! criterion = "quad"              # "extend" or "stop"), stall_max_iterations, alert_distance, solver
 //! tolerance = 1e-6                # ("nlgs" or "apgd"); "interior_point" (2D only) is refused
 //! alert_distance = 1e-3
