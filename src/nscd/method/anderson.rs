@@ -106,6 +106,38 @@ fn gather<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(out: &mut Vec<f64>, rows: &[
     }
 }
 
+/// `(a · b, a · c)` in one pass over `a` (it is read once for both).
+fn dot_pair(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
+    let (mut s, mut t) = ([0.0; 4], [0.0; 4]);
+    let (ca, cb, cc) = (a.chunks_exact(4), b.chunks_exact(4), c.chunks_exact(4));
+    let tail = ca.remainder().iter().zip(cb.remainder()).zip(cc.remainder());
+    let (ts, tt) = tail.fold((0.0, 0.0), |(s, t), ((x, y), z)| (s + x * y, t + x * z));
+    for ((x, y), z) in ca.zip(cb).zip(cc) {
+        for j in 0..4 {
+            s[j] += x[j] * y[j];
+            t[j] += x[j] * z[j];
+        }
+    }
+    ((s[0] + s[1]) + (s[2] + s[3]) + ts, (t[0] + t[1]) + (t[2] + t[3]) + tt)
+}
+
+/// `x − Σ_q γ_q d_q` into `x`, the columns `d_q` (each `x.len()` long, one after the other in `d`) taken a
+/// block of entries at a time, so that `x`'s block stays in cache while the columns stream past.
+fn subtract_columns(x: &mut [f64], d: &[f64], gamma: &[f64; MAX_DEPTH], depth: usize) {
+    const BLOCK: usize = 512;
+    let n = x.len();
+    for (b, xb) in x.chunks_mut(BLOCK).enumerate() {
+        let (at, len) = (b * BLOCK, xb.len());
+        for (q, &c) in gamma.iter().enumerate().take(depth) {
+            if c != 0.0 {
+                for (xi, di) in xb.iter_mut().zip(&d[q * n + at..q * n + at + len]) {
+                    *xi -= c * di;
+                }
+            }
+        }
+    }
+}
+
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     // Four partial sums: the products are independent, so the sum is not one long chain of additions.
     let mut s = [0.0; 4];
@@ -210,9 +242,7 @@ impl Lane {
             let df_h = &self.df[h * n..(h + 1) * n];
             for q in 0..self.depth {
                 if slots.valid[q] {
-                    let df_q = &self.df[q * n..(q + 1) * n];
-                    dots.gram[q] = dot(df_h, df_q);
-                    dots.rhs[q] = dot(df_q, &self.f);
+                    (dots.gram[q], dots.rhs[q]) = dot_pair(&self.df[q * n..(q + 1) * n], df_h, &self.f);
                 }
             }
         }
@@ -230,29 +260,15 @@ impl Lane {
         rows: &mut [R],
         springs: &mut [S],
     ) {
-        let n = self.w.len();
         let x = &mut self.x;
         x.clear();
         x.extend_from_slice(&self.g);
-        for (q, &c) in gamma.iter().enumerate().take(self.depth) {
-            if c != 0.0 {
-                for (xi, d) in x.iter_mut().zip(&self.dg[q * n..(q + 1) * n]) {
-                    *xi -= c * d;
-                }
-            }
-        }
+        subtract_columns(x, &self.dg, gamma, self.depth);
         if self.velocities {
-            let nu = self.ug.len();
             let um = &mut self.scratch;
             um.clear();
             um.extend_from_slice(&self.ug);
-            for (q, &c) in gamma.iter().enumerate().take(self.depth) {
-                if c != 0.0 {
-                    for (v, d) in um.iter_mut().zip(&self.du[q * nu..(q + 1) * nu]) {
-                        *v -= c * d;
-                    }
-                }
-            }
+            subtract_columns(um, &self.du, gamma, self.depth);
             let mut k = 0;
             for ui in u.iter_mut() {
                 for c in ui.as_mut() {
