@@ -21,7 +21,7 @@
 //! from one application of the map to the next, the history is dropped (a restart) and that point is the base
 //! of the next differences, so a mix never compounds a bad one; the sweeps themselves always run.
 //!
-//! **Threads.** Each part of the domain split ([`super::split`]) keeps its own [`Lane`] of the history; the
+//! **Threads.** Each part of the domain split ([`super::split`]) keeps its own lane of the history; the
 //! halves' dot products and mixes run side by side, the interface's after them, and the partial sums are added
 //! in a fixed order (left, right, interface): the numbers do not depend on the number of threads.
 //!
