@@ -15,7 +15,7 @@
 
 use super::apgd::{solve_apgd_with, ApgdOptions};
 use super::contact::ContactRow;
-use super::nlgs::{apply_impulses, solve_nlgs_split, NlgsReport, NlgsSettings, OnStall, Solver};
+use super::nlgs::{apply_impulses, NlgsReport, NlgsSettings, OnStall, Solver};
 use super::system::{StepStats, System, Workspace};
 use crate::error::{Error, Result};
 use crate::geometry::Vec2;
@@ -181,19 +181,10 @@ impl System {
         apply_impulses(&mut self.bodies.u, &self.bodies.inv_m, &ws.rows, &ws.spring_rows);
         let settings = &self.params.nlgs;
         match settings.solver {
-            Solver::Nlgs if settings.anderson > 0 => super::method::anderson::solve_nlgs_anderson_split(
+            // Plain sweeps when `anderson` is 0.
+            Solver::Nlgs => super::method::anderson::solve_nlgs_anderson_split(
                 settings,
                 &mut ws.anderson,
-                &mut ws.split,
-                ws.threads,
-                |i| ws.q_m[i][0],
-                &mut self.bodies.u,
-                &self.bodies.inv_m,
-                &mut ws.rows,
-                &mut ws.spring_rows,
-            ),
-            Solver::Nlgs => solve_nlgs_split(
-                settings,
                 &mut ws.split,
                 ws.threads,
                 |i| ws.q_m[i][0],

@@ -124,7 +124,7 @@ pub(crate) struct Workspace {
     pub detector: Detector,
     pub split: super::nlgs::SplitWorkspace,
     /// Buffers of the Anderson mixing of the sweeps (`nscd.anderson`) when the problem is not split.
-    pub anderson: super::method::anderson::AndersonWorkspace,
+    pub anderson: super::method::anderson::AndersonWorkspace<[f64; 3]>,
     /// Buffers of the accelerated solver ([`super::apgd`]).
     pub apgd: super::apgd::ApgdWorkspace,
     /// Buffers of the interior-point solver (`super::interior`).

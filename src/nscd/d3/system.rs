@@ -36,9 +36,7 @@ use crate::nscd::contact::ContactLaw;
 use crate::nscd::method::anderson::{solve_nlgs_anderson_split, AndersonWorkspace};
 use crate::nscd::method::apgd::{solve_apgd_with, ApgdOptions, ApgdWorkspace};
 use crate::nscd::method::split::SplitWorkspace;
-use crate::nscd::method::{
-    apply_impulses, check_by_row, solve_nlgs_split, NlgsReport, NlgsSettings, OnStall, Solver, SweepNorms,
-};
+use crate::nscd::method::{apply_impulses, check_by_row, NlgsReport, NlgsSettings, OnStall, Solver, SweepNorms};
 use crate::space::bodies::{advance, Bodies, Dofs6};
 use crate::space::detection::{Detector, FaceGaps};
 use crate::space::loads::LoadKind;
@@ -206,7 +204,7 @@ pub struct System3 {
     apgd: ApgdWorkspace<ContactRow3>,
     /// Buffers of the Anderson mixing of the sweeps (`nscd.anderson`) when the problem is not split.
     #[serde(skip)]
-    anderson: AndersonWorkspace,
+    anderson: AndersonWorkspace<Dofs6>,
     /// Threads of the step (0 or 1: one); not part of the state (the numbers do not depend on it).
     #[serde(skip)]
     threads: usize,
@@ -470,20 +468,11 @@ impl System3 {
                 &mut self.rows,
                 &mut self.spring_rows,
             ),
-            _ if settings.anderson > 0 => solve_nlgs_anderson_split(
+            // `check` refuses the interior point (a polyhedral cone's LCP, 2D only) before a step runs.
+            // Plain sweeps when `anderson` is 0.
+            Solver::Nlgs | Solver::InteriorPoint => solve_nlgs_anderson_split(
                 settings,
                 &mut self.anderson,
-                &mut self.split,
-                self.threads,
-                |i| poses_m[i].position.x,
-                &mut self.u,
-                &self.bodies.inv_m,
-                &mut self.rows,
-                &mut self.spring_rows,
-            ),
-            // `check` refuses the interior point (a polyhedral cone's LCP, 2D only) before a step runs.
-            Solver::Nlgs | Solver::InteriorPoint => solve_nlgs_split(
-                settings,
                 &mut self.split,
                 self.threads,
                 |i| poses_m[i].position.x,

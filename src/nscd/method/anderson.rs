@@ -15,7 +15,9 @@
 //! as the check's norms weigh them). After each application of `G` the last `m` differences of `G` and of `f`
 //! give `γ = argmin ‖f_k − ΔF γ‖` (normal equations with a relative Tikhonov term [`REGULARISATION`], a
 //! Cholesky of at most [`MAX_DEPTH`]² numbers) and the next point `x = G(x_k) − ΔG γ`, projected on each row's
-//! law ([`ConeRow::project`], `P ≥ 0` for a compression-only spring), its change scattered to the bodies.
+//! law ([`ConeRow::project`], `P ≥ 0` for a compression-only spring). The bodies' velocities are mixed with the
+//! same coefficients from their own history (they are affine in the impulses), so only a projection's change is
+//! scattered to the bodies; at the end of the solve they are set to `u_free + M⁻¹ H P` of the final impulses.
 //!
 //! **Safeguard.** The mixing is a guess where contacts open, close or start to slide: when the residual grows
 //! from one application of the map to the next, the history is dropped (a restart) and that point is the base
@@ -37,8 +39,8 @@ use super::split::SplitWorkspace;
 pub const MAX_DEPTH: usize = 8;
 
 /// Gauss–Seidel sweeps per application of the mixed map: 2 needs the sweeps of 1 at half the mixes (measured on
-/// the 200-grain section's cycle at `quad` 3e-5: 312 sweeps per step mixing after every sweep, 314 after every
-/// second, 358 after every third).
+/// the 200-grain section's first cycle at `quad` 3e-5 with the session's first build: 312 sweeps per step mixing
+/// after every sweep, 314 after every second, 358 after every third).
 pub const SWEEPS_PER_MIX: usize = 2;
 
 /// Tikhonov term of the normal equations, relative to the largest diagonal of `ΔFᵀ ΔF`.
@@ -411,7 +413,7 @@ impl Mixer {
 #[allow(clippy::too_many_arguments)]
 pub fn solve_nlgs_anderson_split<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
     settings: &NlgsSettings,
-    ws: &mut AndersonWorkspace,
+    ws: &mut AndersonWorkspace<R::Dofs>,
     split: &mut SplitWorkspace<R, S>,
     threads: usize,
     abscissa: impl Fn(usize) -> f64,
@@ -437,46 +439,43 @@ pub fn solve_nlgs_anderson_split<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
 }
 
 /// Buffers of the accelerated sweeps on one part (the problems too small to split), and the free velocities
-/// of the step.
-#[derive(Debug, Clone, Default)]
-pub struct AndersonWorkspace {
+/// of the step (`D`: a body's generalised velocity, [`super::Row::Dofs`]).
+#[derive(Debug, Clone)]
+pub struct AndersonWorkspace<D> {
     lane: Lane,
-    u_free: Vec<f64>,
+    u_free: Vec<D>,
 }
 
-impl AndersonWorkspace {
+impl<D> Default for AndersonWorkspace<D> {
+    fn default() -> Self {
+        Self { lane: Lane::default(), u_free: Vec::new() }
+    }
+}
+
+impl<D: Copy> AndersonWorkspace<D> {
     /// Keeps the free velocities `u − M⁻¹ H P` of the start of the solve.
-    fn keep_free<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
+    fn keep_free<R: ConeRow<Dofs = D>, S: AffineRow<Dofs = D>>(
         &mut self,
-        u: &[R::Dofs],
-        inv_m: &[R::Dofs],
+        u: &[D],
+        inv_m: &[D],
         rows: &[R],
         springs: &[S],
     ) {
-        let mut free = u.to_vec();
-        remove_impulses(&mut free, inv_m, rows, springs);
         self.u_free.clear();
-        for ui in &free {
-            self.u_free.extend_from_slice(ui.as_ref());
-        }
+        self.u_free.extend_from_slice(u);
+        remove_impulses(&mut self.u_free, inv_m, rows, springs);
     }
 
     /// Sets `u = u_free + M⁻¹ H P` of the final impulses: the mixed velocities carry the round-off of the
-    /// mixing (up to 1e-8 m/s after 40 000 sweeps on the loaded 536 pile), the impulses are the solution.
-    fn restore<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
+    /// mixing (up to 3e-10 m/s on a step of the loaded 536 pile), the impulses are the solution.
+    fn restore<R: ConeRow<Dofs = D>, S: AffineRow<Dofs = D>>(
         &self,
-        u: &mut [R::Dofs],
-        inv_m: &[R::Dofs],
+        u: &mut [D],
+        inv_m: &[D],
         rows: &[R],
         springs: &[S],
     ) {
-        let mut k = 0;
-        for ui in u.iter_mut() {
-            for c in ui.as_mut() {
-                *c = self.u_free[k];
-                k += 1;
-            }
-        }
+        u.copy_from_slice(&self.u_free);
         apply_impulses(u, inv_m, rows, springs);
     }
 }
@@ -486,7 +485,7 @@ impl AndersonWorkspace {
 /// impulses.
 pub fn solve_nlgs_anderson<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
     settings: &NlgsSettings,
-    ws: &mut AndersonWorkspace,
+    ws: &mut AndersonWorkspace<R::Dofs>,
     u: &mut [R::Dofs],
     inv_m: &[R::Dofs],
     rows: &mut [R],

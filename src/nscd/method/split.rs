@@ -273,23 +273,36 @@ impl<R: Row, S: Row<Dofs = R::Dofs>> SplitWorkspace<R, S> {
     /// Runs `sweeps` with a function doing one split sweep (on one thread, or on
     /// two when `threads ≥ 2`), then nothing more: call [`Self::store`] after.
     pub(crate) fn run<T>(&mut self, threads: usize, sweeps: impl FnOnce(&mut dyn FnMut(Pass) -> SweepNorms) -> T) -> T {
+        self.set_threads(threads);
+        let Self { left, right, iface, side, slot, team, .. } = self;
+        let (side, slot) = (&side[..], &slot[..]);
+        sweeps(&mut |kind| Self::split_pass(kind, [&mut *left, &mut *right, &mut *iface], team, side, slot))
+    }
+
+    fn set_threads(&mut self, threads: usize) {
         if (threads >= 2) != (self.team.threads() >= 2) {
             self.team = Team::new(threads);
         }
-        let Self { left, right, iface, side, slot, team, .. } = self;
-        let (side, slot) = (&side[..], &slot[..]);
-        sweeps(&mut |kind| {
-            // Left and right side by side (in turn on one thread), then the interface.
-            // A check updates nothing: the interface bodies' velocities are already equal.
-            let (l, r) = team.join(|| left.pass(kind), || right.pass(kind));
-            if kind == Pass::Check {
-                return l.merged(r).merged(iface.pass(kind));
-            }
-            Self::exchange(left, right, iface, side, slot, true);
-            let i = iface.pass(kind);
-            Self::exchange(left, right, iface, side, slot, false);
-            l.merged(r).merged(i)
-        })
+    }
+
+    /// One pass of `kind` over the three parts: left and right side by side (in turn on one thread), then the
+    /// interface between two exchanges of its bodies' velocities. A check updates nothing: the interface bodies'
+    /// velocities are already equal.
+    fn split_pass(
+        kind: Pass,
+        [left, right, iface]: [&mut Part<R, S>; 3],
+        team: &mut Team,
+        side: &[u8],
+        slot: &[u32],
+    ) -> SweepNorms {
+        let (l, r) = team.join(|| left.pass(kind), || right.pass(kind));
+        if kind == Pass::Check {
+            return l.merged(r).merged(iface.pass(kind));
+        }
+        Self::exchange(left, right, iface, side, slot, true);
+        let i = iface.pass(kind);
+        Self::exchange(left, right, iface, side, slot, false);
+        l.merged(r).merged(i)
     }
 
     /// [`Self::run`] with the Anderson mixing of `mixer` after its sweeps ([`super::anderson`]): each part
@@ -306,9 +319,7 @@ impl<R: Row, S: Row<Dofs = R::Dofs>> SplitWorkspace<R, S> {
         R: ConeRow,
         S: AffineRow<Dofs = R::Dofs>,
     {
-        if (threads >= 2) != (self.team.threads() >= 2) {
-            self.team = Team::new(threads);
-        }
+        self.set_threads(threads);
         let depth = mixer.depth();
         for (part, velocities) in [(&mut self.left, true), (&mut self.right, true), (&mut self.iface, false)] {
             part.lane.begin(depth, velocities, &part.u, &part.rows, &part.springs);
@@ -316,13 +327,7 @@ impl<R: Row, S: Row<Dofs = R::Dofs>> SplitWorkspace<R, S> {
         let Self { left, right, iface, side, slot, team, .. } = self;
         let (side, slot) = (&side[..], &slot[..]);
         sweeps(&mut |kind| {
-            let (l, r) = team.join(|| left.pass(kind), || right.pass(kind));
-            if kind == Pass::Check {
-                return l.merged(r).merged(iface.pass(kind));
-            }
-            Self::exchange(left, right, iface, side, slot, true);
-            let i = iface.pass(kind);
-            Self::exchange(left, right, iface, side, slot, false);
+            let norms = Self::split_pass(kind, [&mut *left, &mut *right, &mut *iface], team, side, slot);
             if let Some(slots) = mixer.due(kind) {
                 let (dl, dr) = team.join(|| left.absorb(&slots), || right.absorb(&slots));
                 let dots = dl.merged(dr).merged(iface.absorb(&slots));
@@ -333,7 +338,7 @@ impl<R: Row, S: Row<Dofs = R::Dofs>> SplitWorkspace<R, S> {
                     Self::exchange(left, right, iface, side, slot, false);
                 }
             }
-            l.merged(r).merged(i)
+            norms
         })
     }
 
