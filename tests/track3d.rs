@@ -329,7 +329,7 @@ fn bad_flags_are_named_on_one_line() {
     let sample = s.path.to_str().unwrap();
     let out = dir.join("x.toml");
     let out = out.to_str().unwrap();
-    let cases: [(&[&str], &str); 8] = [
+    let cases: [(&[&str], &str); 9] = [
         (&["track3d", "sample", "--grains", "0", "--out", out], "--grains:"),
         (&["track3d", "sample", "--grains", "10", "--tolerance", "2", "--out", out], "--tolerance:"),
         (&["track3d", "sample", "--grains", "10", "--dt=-1", "--out", out], "--dt:"),
@@ -338,6 +338,7 @@ fn bad_flags_are_named_on_one_line() {
         (&["track3d", "load", "--sample", sample, "--out", out, "--mean-pressure", "inf"], "--mean-pressure:"),
         (&["track3d", "load", "--sample", sample, "--out", out, "--face-gaps", "flat"], "--face-gaps:"),
         (&["track3d", "load", "--sample", sample, "--out", out, "--overlaps", "gap"], "--overlaps:"),
+        (&["track3d", "load", "--sample", sample, "--out", out, "--anderson", "9"], "--anderson:"),
     ];
     for (args, flag) in cases {
         refused(args, flag);

@@ -158,11 +158,11 @@ impl LoadingSpec {
             return refuse(format!("overlaps: '{}' is not one of 'kept', 'held'", self.overlaps));
         }
         if self.anderson > crate::nscd::method::anderson::MAX_DEPTH {
-            return Err(Error::Scene(format!(
+            return refuse(format!(
                 "anderson: the depth of the mixing must be 0 to {}, got {}",
                 crate::nscd::method::anderson::MAX_DEPTH,
                 self.anderson
-            )));
+            ));
         }
         if self.min_iterations == 0 || self.max_iterations < self.min_iterations {
             return refuse(format!(
