@@ -123,7 +123,8 @@ pub(crate) struct Workspace {
     pub spring_rows: Vec<SpringRow>,
     pub detector: Detector,
     pub split: super::nlgs::SplitWorkspace,
-    /// Buffers of the Anderson mixing of the sweeps (`nscd.anderson`) when the problem is not split.
+    /// Buffers of the Anderson mixing of the sweeps (`nscd.anderson`): the history when the problem is not
+    /// split, and the step's free velocities.
     pub anderson: super::method::anderson::AndersonWorkspace<[f64; 3]>,
     /// Buffers of the accelerated solver ([`super::apgd`]).
     pub apgd: super::apgd::ApgdWorkspace,

@@ -202,7 +202,8 @@ pub struct System3 {
     /// Buffers of the accelerated solver (`solver = "apgd"`).
     #[serde(skip)]
     apgd: ApgdWorkspace<ContactRow3>,
-    /// Buffers of the Anderson mixing of the sweeps (`nscd.anderson`) when the problem is not split.
+    /// Buffers of the Anderson mixing of the sweeps (`nscd.anderson`): the history when the problem is not
+    /// split, and the step's free velocities.
     #[serde(skip)]
     anderson: AndersonWorkspace<Dofs6>,
     /// Threads of the step (0 or 1: one); not part of the state (the numbers do not depend on it).
