@@ -422,11 +422,10 @@ pub fn solve_nlgs_anderson_split<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
     rows: &mut [R],
     springs: &mut [S],
 ) -> NlgsReport {
-    let n = rows.len() + springs.len();
     if settings.anderson == 0 {
         return super::solve_nlgs_split(settings, split, threads, abscissa, u, inv_m, rows, springs);
     }
-    if settings.split_min_rows == 0 || n < settings.split_min_rows {
+    if !settings.splits(rows.len() + springs.len()) {
         return solve_nlgs_anderson(settings, ws, u, inv_m, rows, springs);
     }
     let mut mixer = Mixer::new(settings.anderson);

@@ -224,8 +224,7 @@ pub fn solve_nlgs_split<R: Row, S: Row<Dofs = R::Dofs>>(
     rows: &mut [R],
     springs: &mut [S],
 ) -> NlgsReport {
-    let n = rows.len() + springs.len();
-    if settings.split_min_rows == 0 || n < settings.split_min_rows {
+    if !settings.splits(rows.len() + springs.len()) {
         return solve_nlgs(settings, u, inv_m, rows, springs);
     }
     ws.load(abscissa, u, inv_m, rows, springs);

@@ -166,6 +166,12 @@ fn default_split_min_rows() -> usize {
 }
 
 impl NlgsSettings {
+    /// Whether a problem of `rows` rows (contacts + springs) is solved split in two halves
+    /// ([`Self::split_min_rows`]; 0: never).
+    pub fn splits(&self, rows: usize) -> bool {
+        self.split_min_rows > 0 && rows >= self.split_min_rows
+    }
+
     /// Sweeps a step may make: `max_iterations`, or under [`OnStall::Extend`] the
     /// larger of it and `stall_max_iterations`.
     pub fn sweep_cap(&self) -> usize {
