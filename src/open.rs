@@ -211,6 +211,11 @@ impl Loaded {
         if !self.settles() {
             return Ok(None);
         }
+        if opts.change_solver {
+            return Err(Error::Scene(
+                "change_solver: a run with [settlement] resumes only with the scene it started from".into(),
+            ));
+        }
         let opts = RunOptions { length: None, engine: None, ..opts.clone() };
         let request = SettleRequest::default();
         let summary = self.settle_on(out, &opts, &request, &mut |p| {

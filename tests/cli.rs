@@ -181,6 +181,29 @@ fn diverging_run_exits_with_code_1_and_keeps_the_last_good_state() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `--change-solver` resumes a run with another tolerance, says so and records it; it needs `--resume`.
+#[test]
+fn a_run_resumes_with_another_tolerance() {
+    let dir = scratch::dir("change-solver");
+    let (a, b) = (dir.join("a.toml"), dir.join("b.toml"));
+    let text = scene_text();
+    std::fs::write(&a, &text).unwrap();
+    std::fs::write(&b, text.replacen("[output]", "[nscd]\ntolerance = 3e-6\n\n[output]", 1)).unwrap();
+    let out = dir.join("out");
+    let run = |scene: &std::path::Path, extra: &[&str]| {
+        ballast().arg("run").arg(scene).arg("--out").arg(&out).arg("--quiet").args(extra).output().unwrap()
+    };
+    assert!(run(&a, &["--stop-after", "20"]).status.success());
+    let refused = run(&b, &["--change-solver"]);
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("--resume"));
+    let r = run(&b, &["--resume", "--change-solver"]);
+    assert!(r.status.success(), "stderr: {}", String::from_utf8_lossy(&r.stderr));
+    let stdout = String::from_utf8_lossy(&r.stdout);
+    assert!(stdout.contains("resumed at step 20") && stdout.contains("nscd.tolerance = 0.000003"), "{stdout}");
+    assert!(out.join("solver_changes.csv").is_file() && out.join("final.json").is_file());
+}
+
 /// A run stopped twice and resumed from its checkpoints writes, byte for byte,
 /// the series and final state of the uninterrupted run; a checkpoint is refused
 /// for another scene.

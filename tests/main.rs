@@ -49,6 +49,7 @@ mod nscd_solver;
 mod nscd_sublayer;
 mod readme_commands;
 mod replicas;
+mod resume_solver;
 mod run_loop;
 mod saussine;
 mod saussine_studies;

@@ -250,6 +250,17 @@ pub(crate) fn print_acceleration(s: &ballast::settlement::AccelerationSummary, o
 /// The last line of a run.
 pub(crate) fn print_outcome(o: &RunOutcome) {
     let r = &o.report;
+    for c in &o.solver_changes {
+        println!(
+            "resumed at step {} (t = {:.6} s) with {} = {} (was {}); recorded in {}",
+            c.step,
+            c.time_s,
+            c.key,
+            c.after,
+            c.before,
+            o.out.join(ballast::io::layout::SOLVER_CHANGES).display()
+        );
+    }
     match o.status {
         Status::Stopped => println!(
             "stopped at step {} of {} (t = {:.6} s) after {:.2} s; continue with --resume",

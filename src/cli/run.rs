@@ -29,6 +29,11 @@ pub struct RunArgs {
     /// Continue a killed or stopped run from `DIR/checkpoint.json` (same scene file).
     #[arg(long)]
     resume: bool,
+    /// With --resume: the scene may differ from the run's in its `[nscd]` solver keys (criterion, tolerance,
+    /// sweep caps, anderson, solver, …), every other key the same; the run goes on from its checkpoint with the
+    /// new settings and records them in `DIR/solver_changes.csv` (not for runs with `[settlement]`)
+    #[arg(long, requires = "resume")]
+    change_solver: bool,
     /// Stop after this many steps in this invocation, with a checkpoint to resume from.
     #[arg(long, value_name = "STEPS")]
     stop_after: Option<u64>,
@@ -80,6 +85,7 @@ pub fn main(a: RunArgs) -> Result<(), Failure> {
     let opts = RunOptions {
         checkpoint_every_s: a.checkpoint_every,
         resume: a.resume,
+        change_solver: a.change_solver,
         stop_after: a.stop_after,
         vtk_every: a.vtk_every,
         threads: a.threads.unwrap_or_else(default_threads),

@@ -133,6 +133,16 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// (built from the scene): same bodies, materials and walls.
     fn check_same_model(&self, fresh: &Self) -> Result<()>;
 
+    /// Takes the settings of the per-step solve from `fresh`, the system built from the scene a run resumes
+    /// with ([`crate::run::RunOptions::change_solver`]), and returns those that changed as `[scene key, before,
+    /// after]`. The default refuses: the engine has no such settings (the MD engines).
+    ///
+    /// # Errors
+    /// [`crate::Error::Scene`] naming the engine when it has no solver settings to change.
+    fn change_solver(&mut self, _fresh: &Self) -> Result<Vec<[String; 3]>> {
+        Err(no_solver_settings(Self::NAME))
+    }
+
     /// Starts the per-cycle output: `body` is the index of the followed body
     /// (NSCD: the sleeper, required; MD: none).
     fn cycle_start(&self, body: Option<usize>) -> Result<Self::CycleState>;
@@ -233,4 +243,12 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// [`crate::Error::Scene`] for settings out of range; an engine error if a
     /// configuration tried cannot be evaluated. The positions are then unchanged.
     fn relax(&mut self, settings: &RelaxSettings) -> Result<RelaxReport>;
+}
+
+/// The refusal of [`Engine::change_solver`] by an engine without solver settings.
+pub fn no_solver_settings(engine: &str) -> crate::Error {
+    crate::Error::Scene(format!(
+        "change_solver: the {engine} engine has no solver settings to change; resume with the scene the run \
+         started from"
+    ))
 }

@@ -47,6 +47,8 @@ pub const PVD: &str = "run.pvd";
 pub const VTK_DIR: &str = "vtk";
 /// The checkpoint to resume from.
 pub const CHECKPOINT: &str = "checkpoint.json";
+/// The solver settings a resumed run changed (`crate::run::solver_change`).
+pub const SOLVER_CHANGES: &str = "solver_changes.csv";
 /// The one-line error of a study's run that failed (a diverged run), which the study's summary reports
 /// however the run was launched; removed when the run is run again and ends.
 pub const FAILED: &str = "failed.txt";

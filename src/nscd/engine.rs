@@ -77,6 +77,12 @@ impl PlaneEngine for System {
         System::check_same_model(self, fresh)
     }
 
+    fn plane_change_solver(&mut self, fresh: &Self) -> Result<Vec<[String; 3]>> {
+        let changes = self.params.nlgs.changes(&fresh.params.nlgs);
+        self.params.nlgs = fresh.params.nlgs;
+        Ok(changes)
+    }
+
     fn plane_set_configuration(&mut self, c: &Configuration) -> Result<()> {
         System::set_configuration(self, c)
     }

@@ -85,6 +85,14 @@ pub trait PlaneEngine: PlaneSystem + Clone + Send + Serialize + DeserializeOwned
     /// As [`Engine::check_same_model`].
     fn plane_check_same_model(&self, fresh: &Self) -> Result<()>;
 
+    /// As [`Engine::change_solver`] (the default refuses, as the trait's).
+    ///
+    /// # Errors
+    /// As [`Engine::change_solver`].
+    fn plane_change_solver(&mut self, _fresh: &Self) -> Result<Vec<[String; 3]>> {
+        Err(crate::engine::contract::no_solver_settings(Self::NAME))
+    }
+
     /// As [`Engine::set_configuration`].
     ///
     /// # Errors
@@ -191,6 +199,10 @@ impl<T: PlaneEngine> Engine for T {
 
     fn check_same_model(&self, fresh: &Self) -> Result<()> {
         self.plane_check_same_model(fresh)
+    }
+
+    fn change_solver(&mut self, fresh: &Self) -> Result<Vec<[String; 3]>> {
+        self.plane_change_solver(fresh)
     }
 
     fn cycle_start(&self, body: Option<usize>) -> Result<PlaneCycleState> {

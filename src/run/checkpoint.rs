@@ -39,6 +39,11 @@ pub struct Checkpoint<S, C> {
     /// CRC-32 of the text of the scene the run started from (of the serde form
     /// of the initial system for a system built in code).
     pub source_crc32: u32,
+    /// CRC-32 of that scene without its `[nscd]` solver keys ([`super::solver_change::model_crc32`]), which a run
+    /// resumed with other solver settings must share; `None` for a system built in code (and in checkpoints
+    /// written before it was kept).
+    #[serde(default)]
+    pub model_crc32: Option<u32>,
     /// Step of the engine when the run started (0 from a scene).
     pub first_step: u64,
     /// Steps made by the engine when the checkpoint was written.

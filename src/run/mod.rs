@@ -19,6 +19,7 @@ pub mod folder;
 pub mod plan;
 pub mod positions;
 mod runner;
+pub mod solver_change;
 pub mod summary;
 
 pub use checkpoint::Checkpoint;
@@ -26,4 +27,5 @@ pub use equilibrium::{Equilibrium, EquilibriumWatch, DEFAULT_EQUILIBRIUM_STEPS};
 pub use plan::{check_built, check_options, cores, default_threads, CyclePlan, Prior, RunLength, RunOptions, RunPlan};
 pub(crate) use runner::body_names;
 pub use runner::{Figures, Progress, Restart, RunOutcome, Runner, Status};
+pub use solver_change::SolverChange;
 pub use summary::{RunEnd, RunReport, RunSummary};

@@ -49,6 +49,10 @@ pub struct RunOptions {
     pub checkpoint_every_s: f64,
     /// Continue from the checkpoint in the output folder.
     pub resume: bool,
+    /// With `resume`: accept a scene whose `[nscd]` solver keys differ from those the run was checkpointed with,
+    /// every other key the same ([`super::solver_change`]); the run goes on with the new settings and records
+    /// the change in `solver_changes.csv`. A run of a system built in code, or with `[settlement]`, refuses it.
+    pub change_solver: bool,
     /// Stop after this many steps in this invocation, leaving a checkpoint.
     pub stop_after: Option<u64>,
     /// A VTK snapshot every this many steps (0: none).
@@ -85,6 +89,7 @@ impl Default for RunOptions {
         Self {
             checkpoint_every_s: 300.0,
             resume: false,
+            change_solver: false,
             stop_after: None,
             vtk_every: 0,
             threads: default_threads(),
@@ -119,6 +124,9 @@ pub fn check_options(opts: &RunOptions) -> Result<()> {
     }
     if opts.threads == 0 {
         return Err(Error::Scene("threads: must be at least 1, got 0".into()));
+    }
+    if opts.change_solver && !opts.resume {
+        return Err(Error::Scene("change_solver: changes the solver of a resumed run; set resume too".into()));
     }
     Ok(())
 }

@@ -26,6 +26,7 @@ use crate::io::vtk::PvdCollection;
 use crate::io::{self, RunInfo};
 use crate::run::checkpoint::Checkpoint;
 use crate::run::positions::PositionsWriter;
+use crate::run::solver_change::{self, SolverChange};
 use crate::run::summary::{RunEnd, RunReport, RunSummary};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -79,6 +80,9 @@ pub struct RunOutcome {
     pub elapsed_s: f64,
     /// The output folder.
     pub out: PathBuf,
+    /// The solver settings this call changed on resuming ([`RunOptions::change_solver`]; empty otherwise), as
+    /// appended to `solver_changes.csv`.
+    pub solver_changes: Vec<SolverChange>,
 }
 
 /// Writes the final state of a system as a scene text.
@@ -96,6 +100,8 @@ pub struct Runner<E: Engine> {
     plan: RunPlan,
     /// The scene's text or the system's serde form ([`Source`]).
     source: Source,
+    /// [`solver_change::model_crc32`] of the scene's text (`None` for a system built in code).
+    model_crc32: Option<u32>,
     /// The scene file's path, for the header of `final_scene.toml`.
     scene_path: Option<PathBuf>,
     restart: Option<Restart<E>>,
@@ -123,6 +129,8 @@ struct Live<E: Engine> {
     cycles_done: u64,
     positions: Option<PositionsWriter>,
     first_step: u64,
+    /// The solver settings changed on resuming.
+    solver_changes: Vec<SolverChange>,
 }
 
 impl<E: Engine> Runner<E> {
@@ -133,6 +141,7 @@ impl<E: Engine> Runner<E> {
         Self {
             system,
             plan,
+            model_crc32: solver_change::model_crc32(&text),
             source: Source::Scene { text },
             scene_path: Some(path.to_path_buf()),
             restart,
@@ -177,6 +186,7 @@ impl<E: Engine> Runner<E> {
             system,
             plan,
             source: Source::Code { json },
+            model_crc32: None,
             scene_path: None,
             restart: None,
             model: None,
@@ -246,7 +256,7 @@ impl<E: Engine> Runner<E> {
         if self.plan.output_every == 0 {
             return Err(Error::Scene("output.every: must be at least 1, got 0".into()));
         }
-        let mut live = if opts.resume { self.resume(out)? } else { self.start(out, opts)? };
+        let mut live = if opts.resume { self.resume(out, opts.change_solver)? } else { self.start(out, opts)? };
         live.sys.set_threads(opts.threads.max(1));
         Ok(live)
     }
@@ -380,6 +390,7 @@ impl<E: Engine> Runner<E> {
         );
         let kinetic_energy = last_stats.map_or(0.0, |(s, _)| E::summary(&s).kinetic_energy);
         let (step, time) = (live.sys.steps_done(), live.sys.time());
+        let solver_changes = live.solver_changes.clone();
         let outcome = |status| RunOutcome {
             status,
             step,
@@ -389,6 +400,7 @@ impl<E: Engine> Runner<E> {
             report: report.clone(),
             elapsed_s: started.elapsed().as_secs_f64(),
             out: out.to_path_buf(),
+            solver_changes: solver_changes.clone(),
         };
         if diverged.is_none() && !at_equilibrium && step < end_step {
             // Stopped on request: a checkpoint and nothing that looks final.
@@ -480,7 +492,17 @@ impl<E: Engine> Runner<E> {
             None => (None, None),
         };
         let first_step = sys.steps_done();
-        Ok(Live { sys, summary, series, snapshots, cycles, cycles_done: 0, positions, first_step })
+        Ok(Live {
+            sys,
+            summary,
+            series,
+            snapshots,
+            cycles,
+            cycles_done: 0,
+            positions,
+            first_step,
+            solver_changes: vec![],
+        })
     }
 
     /// Writes the record of the run's input: the copy of the scene (or the
@@ -492,11 +514,17 @@ impl<E: Engine> Runner<E> {
 
     /// The run continued from the checkpoint in `out`, checked against the plan,
     /// the initial system and the files. The record of the input is written
-    /// again (the checkpoint holds the CRC-32 of the scene text: it is the same).
-    fn resume(&self, out: &Path) -> Result<Live<E>> {
+    /// again (the checkpoint holds the CRC-32 of the scene text: it is the same, or with `change_solver` the
+    /// same but for the solver keys, whose changes are recorded and checkpointed at once).
+    fn resume(&self, out: &Path, change_solver: bool) -> Result<Live<E>> {
         let path = folder::checkpoint_to_resume(out)?;
-        let cp = Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source.crc32())?;
+        let mut cp = if change_solver {
+            solver_change::load(out, E::NAME, (self.source.crc32(), self.model_crc32))?
+        } else {
+            Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source.crc32())?
+        };
         let bad = |msg: String| folder::invalid_checkpoint(&path, msg);
+        let changed = if change_solver { cp.system.change_solver(&self.system)? } else { Vec::new() };
         folder::check_resumed(&path, "", &cp.system, &self.system)?;
         let plan = &self.plan;
         let first = self.system.steps_done();
@@ -565,7 +593,10 @@ impl<E: Engine> Runner<E> {
         }
         io::remove_stale(out, layout::FINAL_SCENE)?;
         self.write_records(out)?;
-        Ok(Live {
+        let (step, time_s) = (cp.system.steps_done(), cp.system.time());
+        let solver_changes: Vec<SolverChange> =
+            changed.into_iter().map(|[key, before, after]| SolverChange { step, time_s, key, before, after }).collect();
+        let mut live = Live {
             sys: cp.system,
             summary: cp.summary,
             series,
@@ -574,7 +605,14 @@ impl<E: Engine> Runner<E> {
             cycles_done: cp.cycles_done,
             positions,
             first_step: first,
-        })
+            solver_changes,
+        };
+        if !live.solver_changes.is_empty() {
+            // The change is recorded, then the checkpoint takes the new scene: a later plain resume goes on.
+            solver_change::record(out, &live.solver_changes)?;
+            self.checkpoint(out, &mut live)?;
+        }
+        Ok(live)
     }
 
     /// Writes `checkpoint.json` for the run in progress.
@@ -591,6 +629,7 @@ impl<E: Engine> Runner<E> {
             version: env!("CARGO_PKG_VERSION").to_string(),
             engine: E::NAME.to_string(),
             source_crc32: self.source.crc32(),
+            model_crc32: self.model_crc32,
             first_step: live.first_step,
             step: live.sys.steps_done(),
             series_bytes,

@@ -194,6 +194,12 @@ impl Engine for System3 {
         System3::check_same_model(self, fresh)
     }
 
+    fn change_solver(&mut self, fresh: &Self) -> Result<Vec<[String; 3]>> {
+        let changes = self.params.nlgs.changes(&fresh.params.nlgs);
+        self.params.nlgs = fresh.params.nlgs;
+        Ok(changes)
+    }
+
     /// Follows body `body` (required: the settlement of a body is what the 3D cycles report).
     fn cycle_start(&self, body: Option<usize>) -> Result<CycleState3> {
         let body = body.ok_or_else(|| Error::Scene("output.cycles.body: name the followed body".into()))?;
