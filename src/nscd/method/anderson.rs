@@ -78,10 +78,16 @@ pub(crate) struct Slots {
     pub(crate) valid: [bool; MAX_DEPTH],
 }
 
-/// One part's history: per entry of its impulse vector (springs first, then contacts' components) the weight,
-/// the start of the map, the last `G` and `f` and `m` differences of each; per component of its bodies'
-/// velocities the last value at `G` and `m` differences. The differences are stored by column (one slot after
-/// the other), so that the dot products and the mixing are passes over contiguous arrays.
+/// One part's history. Its vectors hold the **live** entries only: the springs' scalars, then the components of
+/// each contact row that has carried an impulse at the start or at an application of the map during this
+/// solve, in the order the rows became live. A row that never did is zero in `x`, `G(x)` and every difference,
+/// and stays zero in the mixed point, so it adds nothing to a dot product and the mix leaves it alone: on a
+/// packing most points within the alert distance are open (two thirds on the seated 2 000-grain section), and
+/// the passes over the history cost what the loaded points make them cost. Per live entry: the weight, the start
+/// of the map, the last `G` and `f` and `m` differences of each; per component of the bodies' velocities the
+/// last value at `G` and `m` differences. The differences are stored by column, each column `stride` long (the
+/// part's full impulse vector), the live entries at its head, so that the dot products and the mixing are
+/// passes over contiguous arrays and a row that becomes live appends its entries without moving any.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Lane {
     w: Vec<f64>,
@@ -94,18 +100,23 @@ pub(crate) struct Lane {
     ug: Vec<f64>,
     du: Vec<f64>,
     depth: usize,
+    /// Length of a column of `dg` and `df`: springs plus every row's components.
+    stride: usize,
+    /// Where each row's entries start in the live vectors (`NOT_LIVE` for a row not live).
+    at: Vec<u32>,
+    /// The live rows, in the order their entries are stored.
+    live: Vec<u32>,
     /// Whether the bodies' velocities are mixed from their history (false for the split's interface, whose
     /// velocities are the halves' copies).
     velocities: bool,
 }
 
-/// Writes the impulse vector of `rows` and `springs`, springs first, into `out`.
-fn gather<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(out: &mut Vec<f64>, rows: &[R], springs: &[S]) {
-    out.clear();
-    out.extend(springs.iter().map(|s| s.impulse()));
-    for r in rows {
-        out.extend_from_slice(r.impulse().as_ref());
-    }
+/// [`Lane::at`] of a row that is not live.
+const NOT_LIVE: u32 = u32::MAX;
+
+/// Whether an impulse is not zero.
+fn carries(p: &[f64]) -> bool {
+    p.iter().any(|&c| c != 0.0)
 }
 
 /// `(a · b, a · c)` in one pass over `a` (it is read once for both).
@@ -123,16 +134,15 @@ fn dot_pair(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
     ((s[0] + s[1]) + (s[2] + s[3]) + ts, (t[0] + t[1]) + (t[2] + t[3]) + tt)
 }
 
-/// `x − Σ_q γ_q d_q` into `x`, the columns `d_q` (each `x.len()` long, one after the other in `d`) taken a
-/// block of entries at a time, so that `x`'s block stays in cache while the columns stream past.
-fn subtract_columns(x: &mut [f64], d: &[f64], gamma: &[f64; MAX_DEPTH], depth: usize) {
+/// `x − Σ_q γ_q d_q` into `x`, the columns `d_q` (`stride` apart in `d`, the first `x.len()` entries of each
+/// used) taken a block of entries at a time, so that `x`'s block stays in cache while the columns stream past.
+fn subtract_columns(x: &mut [f64], d: &[f64], stride: usize, gamma: &[f64; MAX_DEPTH], depth: usize) {
     const BLOCK: usize = 512;
-    let n = x.len();
     for (b, xb) in x.chunks_mut(BLOCK).enumerate() {
         let (at, len) = (b * BLOCK, xb.len());
         for (q, &c) in gamma.iter().enumerate().take(depth) {
             if c != 0.0 {
-                for (xi, di) in xb.iter_mut().zip(&d[q * n + at..q * n + at + len]) {
+                for (xi, di) in xb.iter_mut().zip(&d[q * stride + at..q * stride + at + len]) {
                     *xi -= c * di;
                 }
             }
@@ -155,7 +165,8 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 impl Lane {
-    /// Starts a step's history at the rows' current impulses and the bodies' velocities `u`.
+    /// Starts a step's history at the rows' current impulses and the bodies' velocities `u`: the springs and the
+    /// rows that carry an impulse are live.
     pub(crate) fn begin<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
         &mut self,
         depth: usize,
@@ -164,22 +175,38 @@ impl Lane {
         rows: &[R],
         springs: &[S],
     ) {
-        self.w.clear();
-        self.w.extend(springs.iter().map(|s| s.w().max(0.0).sqrt()));
-        for r in rows {
-            self.w.extend(r.diagonal().as_ref().iter().map(|d| d.max(0.0).sqrt()));
-        }
-        let n = self.w.len();
+        let dim = R::Impulse::default().as_ref().len();
         self.depth = depth;
         self.velocities = velocities;
-        gather(&mut self.x, rows, springs);
+        self.stride = springs.len() + dim * rows.len();
+        self.w.clear();
+        self.x.clear();
+        for s in springs {
+            self.w.push(s.w().max(0.0).sqrt());
+            self.x.push(s.impulse());
+        }
+        self.at.clear();
+        self.at.resize(rows.len(), NOT_LIVE);
+        self.live.clear();
+        for (i, r) in rows.iter().enumerate() {
+            let p = r.impulse();
+            if carries(p.as_ref()) {
+                self.at[i] = self.x.len() as u32;
+                self.live.push(i as u32);
+                self.w.extend(r.diagonal().as_ref().iter().map(|d| d.max(0.0).sqrt()));
+                self.x.extend_from_slice(p.as_ref());
+            }
+        }
+        let k = self.x.len();
         for v in [&mut self.g, &mut self.f] {
             v.clear();
-            v.resize(n, 0.0);
+            v.resize(k, 0.0);
         }
+        // Columns are written over their live head before they are read; a row made live zeroes its entries.
         for v in [&mut self.dg, &mut self.df] {
-            v.clear();
-            v.resize(n * depth, 0.0);
+            if v.len() < self.stride * depth {
+                v.resize(self.stride * depth, 0.0);
+            }
         }
         self.ug.clear();
         if velocities {
@@ -191,9 +218,9 @@ impl Lane {
         self.du.resize(self.ug.len() * depth, 0.0);
     }
 
-    /// Takes the map's value `G(x)` from the rows and `u`: the new residual, the new differences in
-    /// `slots.new`, their dot products with the valid slots; `x` becomes `G(x)` (the start of the next map if no
-    /// mix follows).
+    /// Takes the map's value `G(x)` from the rows and `u`: rows that carry an impulse for the first time become
+    /// live (zero in the history so far); then the new residual, the new differences in `slots.new`, their dot
+    /// products with the valid slots; `x` becomes `G(x)` (the start of the next map if no mix follows).
     pub(crate) fn absorb<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
         &mut self,
         slots: &Slots,
@@ -201,17 +228,44 @@ impl Lane {
         rows: &[R],
         springs: &[S],
     ) -> Dots {
-        let n = self.w.len();
         let mut dots = Dots::default();
-        gather(&mut self.scratch, rows, springs);
-        let (g_new, f) = (&mut self.scratch, &mut self.f);
+        let g_new = &mut self.scratch;
+        g_new.clear();
+        g_new.extend(springs.iter().map(|s| s.impulse()));
+        g_new.resize(self.x.len(), 0.0);
+        for (i, r) in rows.iter().enumerate() {
+            let p = r.impulse();
+            let p = p.as_ref();
+            let at = self.at[i];
+            if at != NOT_LIVE {
+                let at = at as usize;
+                g_new[at..at + p.len()].copy_from_slice(p);
+            } else if carries(p) {
+                let at = g_new.len();
+                self.at[i] = at as u32;
+                self.live.push(i as u32);
+                g_new.extend_from_slice(p);
+                self.w.extend(r.diagonal().as_ref().iter().map(|d| d.max(0.0).sqrt()));
+                for v in [&mut self.x, &mut self.g, &mut self.f] {
+                    v.resize(at + p.len(), 0.0);
+                }
+                for q in (0..self.depth).filter(|&q| slots.valid[q]) {
+                    let column = q * self.stride + at;
+                    self.dg[column..column + p.len()].fill(0.0);
+                    self.df[column..column + p.len()].fill(0.0);
+                }
+            }
+        }
+        let n = g_new.len();
+        let f = &mut self.f;
         // f ← D (G − x), kept in `x`'s buffer for a moment; then the differences and the swaps.
         for ((xi, gi), wi) in self.x.iter_mut().zip(g_new.iter()).zip(&self.w) {
             *xi = wi * (gi - *xi);
         }
         dots.residual = dot(&self.x, &self.x);
+        let column = |q: usize| q * self.stride..q * self.stride + n;
         if let Some(h) = slots.new {
-            let (dg, df) = (&mut self.dg[h * n..(h + 1) * n], &mut self.df[h * n..(h + 1) * n]);
+            let (dg, df) = (&mut self.dg[column(h)], &mut self.df[column(h)]);
             for (((d, fi), fnew), (e, (gi, gnew))) in
                 df.iter_mut().zip(f.iter()).zip(&self.x).zip(dg.iter_mut().zip(self.g.iter().zip(g_new.iter())))
             {
@@ -241,19 +295,20 @@ impl Lane {
         self.x.clear();
         self.x.extend_from_slice(&self.g);
         if let Some(h) = slots.new {
-            let df_h = &self.df[h * n..(h + 1) * n];
+            let df_h = &self.df[column(h)];
             for q in 0..self.depth {
                 if slots.valid[q] {
-                    (dots.gram[q], dots.rhs[q]) = dot_pair(&self.df[q * n..(q + 1) * n], df_h, &self.f);
+                    (dots.gram[q], dots.rhs[q]) = dot_pair(&self.df[column(q)], df_h, &self.f);
                 }
             }
         }
         dots
     }
 
-    /// Moves the rows to the mixed point `G(x) − ΔG γ` and the bodies' velocities to `u(G(x)) − ΔU γ` (the
+    /// Moves the live rows to the mixed point `G(x) − ΔG γ` and the bodies' velocities to `u(G(x)) − ΔU γ` (the
     /// same combination: `u` is affine in the impulses); where a row's law projects its mixed impulse, the
-    /// projection's change is scattered to `u`. `x` becomes the mixed point.
+    /// projection's change is scattered to `u`. `x` becomes the mixed point. The other rows carry no impulse and
+    /// keep none.
     pub(crate) fn mix<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
         &mut self,
         gamma: &[f64; MAX_DEPTH],
@@ -265,12 +320,12 @@ impl Lane {
         let x = &mut self.x;
         x.clear();
         x.extend_from_slice(&self.g);
-        subtract_columns(x, &self.dg, gamma, self.depth);
+        subtract_columns(x, &self.dg, self.stride, gamma, self.depth);
         if self.velocities {
             let um = &mut self.scratch;
             um.clear();
             um.extend_from_slice(&self.ug);
-            subtract_columns(um, &self.du, gamma, self.depth);
+            subtract_columns(um, &self.du, self.ug.len(), gamma, self.depth);
             let mut k = 0;
             for ui in u.iter_mut() {
                 for c in ui.as_mut() {
@@ -279,8 +334,7 @@ impl Lane {
                 }
             }
         }
-        let mut i = 0;
-        for s in springs.iter_mut() {
+        for (i, s) in springs.iter_mut().enumerate() {
             let mixed = x[i];
             let q = if s.compression_only() { mixed.max(0.0) } else { mixed };
             if q != mixed {
@@ -288,12 +342,13 @@ impl Lane {
             }
             s.set_impulse(q);
             x[i] = q;
-            i += 1;
         }
-        for r in rows.iter_mut() {
+        for &row in &self.live {
+            let r = &mut rows[row as usize];
+            let at = self.at[row as usize] as usize;
             let mut mixed = R::Impulse::default();
             let len = mixed.as_ref().len();
-            mixed.as_mut().copy_from_slice(&x[i..i + len]);
+            mixed.as_mut().copy_from_slice(&x[at..at + len]);
             let q = r.project(mixed, None);
             if q != mixed {
                 let mut d = q;
@@ -303,8 +358,7 @@ impl Lane {
                 r.add_impulse_of(u, inv_m, d, 1.0);
             }
             r.set_impulse(q);
-            x[i..i + len].copy_from_slice(q.as_ref());
-            i += len;
+            x[at..at + len].copy_from_slice(q.as_ref());
         }
     }
 }
