@@ -181,17 +181,20 @@ impl Simulation {
     /// `False` stops the run as Ctrl-C does, without an exception. `stop_after`: stop after this many steps of this
     /// call. `vtk_every`: a VTK snapshot every this many steps (0: none). `figures`: draw the run's figures.
     /// `threads`: threads of a step (1 or 2; `None`: 2 on a machine with 2 cores; the numbers do not depend on
-    /// it).
+    /// it). `change_solver` (with `resume`): the simulation's scene may differ from the run's in its `[nscd]`
+    /// solver keys (tolerance, sweep caps, `anderson`, …), every other key the same; the run goes on with the new
+    /// settings and records them in `solver_changes.csv` (docs/scene-format.md).
     ///
     /// Returns a dict: `status` (`finished`, `equilibrium` or `stopped`), `step`, `end_step`, `time` (s),
-    /// `kinetic_energy` (J), `elapsed_s`, `out` (`None` for a temporary folder) and `report` (the contents of
-    /// `summary.json`). The interpreter's lock is released while stepping. Ctrl-C (SIGINT) stops the run
+    /// `kinetic_energy` (J), `elapsed_s`, `out` (`None` for a temporary folder), `report` (the contents of
+    /// `summary.json`) and `solver_changes` (a list of dicts `step`, `time_s`, `key`, `before`, `after`: the
+    /// settings `change_solver` changed, empty otherwise). The interpreter's lock is released while stepping. Ctrl-C (SIGINT) stops the run
     /// between two steps, leaves a checkpoint in `out` (resume with `resume=True`) and raises
     /// `KeyboardInterrupt`; an exception of `progress` does the same and is raised. A step that blows up
     /// raises `DivergedError` (the outputs and the simulation hold the last good step).
     #[pyo3(signature = (
         out = None, steps = None, checkpoint_every = None, resume = false, progress = None, stop_after = None,
-        vtk_every = 0, figures = false, threads = None
+        vtk_every = 0, figures = false, threads = None, change_solver = false
     ))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
@@ -206,6 +209,7 @@ impl Simulation {
         vtk_every: u64,
         figures: bool,
         threads: Option<usize>,
+        change_solver: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         if resume && out.is_none() {
             return Err(PyValueError::new_err("resume: needs the folder `out` of the run to continue"));
@@ -214,6 +218,7 @@ impl Simulation {
         let opts = RunOptions {
             vtk_every,
             length: steps.map(RunLength::Steps),
+            change_solver,
             ..options(&folder, checkpoint_every, resume, stop_after, figures, threads)
         };
         let loaded = &mut self.loaded;
@@ -244,6 +249,7 @@ impl Simulation {
         d.set_item("elapsed_s", outcome.elapsed_s)?;
         d.set_item("out", folder.shown())?;
         d.set_item("report", to_python(py, &outcome.report)?)?;
+        d.set_item("solver_changes", to_python(py, &outcome.solver_changes)?)?;
         Ok(d)
     }
 

@@ -61,6 +61,19 @@ def test_a_stopped_run_resumes_to_the_bytes_of_an_uninterrupted_one(tmp_path, ho
         sim.run(tmp_path / "parts", steps=steps, resume=True)
 
 
+def test_a_run_resumes_with_another_tolerance(tmp_path):
+    changed = tmp_path / "tight.toml"
+    changed.write_text(BLOCK.read_text().replace("[output]", "[nscd]\ntolerance = 1e-6\n\n[output]", 1))
+    first = ballast.load(BLOCK).run(tmp_path / "run", steps=40, stop_after=20)
+    assert first["status"] == "stopped" and first["solver_changes"] == []
+    with pytest.raises(ballast.CheckpointError, match="another scene"):
+        ballast.load(changed).run(tmp_path / "run", steps=40, resume=True)
+    end = ballast.load(changed).run(tmp_path / "run", steps=40, resume=True, change_solver=True)
+    assert end["status"] == "finished" and end["step"] == 40
+    assert [(c["step"], c["key"], c["after"]) for c in end["solver_changes"]] == [(20, "nscd.tolerance", "0.000001")]
+    assert (tmp_path / "run" / "solver_changes.csv").read_text().startswith("step,time_s,key,before,after\n20,")
+
+
 def test_ctrl_c_stops_a_run_with_keyboard_interrupt_and_a_checkpoint(tmp_path):
     sim = ballast.load(SPHERES)
     with ctrl_c_after(0.5), pytest.raises(KeyboardInterrupt):
