@@ -24,6 +24,14 @@ fn variant(dir: &Path, name: &str, text: &str, from: &str, to: &str) -> PathBuf 
     path
 }
 
+/// The text of `examples/cubes3d.toml` lasting `duration` seconds, and its copy `dir/a.toml`.
+fn cubes(dir: &Path, duration: &str) -> (String, PathBuf) {
+    let text = std::fs::read_to_string("examples/cubes3d.toml").unwrap();
+    let text = text.replacen("duration = 0.5", &format!("duration = {duration}"), 1);
+    let a = variant(dir, "a.toml", &text, "duration", "duration");
+    (text, a)
+}
+
 fn read_final(dir: &Path) -> FinalState {
     serde_json::from_str(&std::fs::read_to_string(dir.join("final.json")).unwrap()).unwrap()
 }
@@ -35,9 +43,7 @@ fn read_final(dir: &Path) -> FinalState {
 #[test]
 fn a_resumed_run_takes_the_new_solver_settings_at_its_step() {
     let dir = scratch::path("cubes");
-    let text =
-        std::fs::read_to_string("examples/cubes3d.toml").unwrap().replacen("duration = 0.5", "duration = 0.06", 1);
-    let a = variant(&dir, "a.toml", &text, "tolerance = 1.0e-6", "tolerance = 1.0e-6");
+    let (text, a) = cubes(&dir, "0.06");
     let b = variant(&dir, "b.toml", &text, "tolerance = 1.0e-6", "tolerance = 1.0e-4\nanderson = 3");
     let out = dir.join("run");
     let first = run_file(&a, &out, &RunOptions { stop_after: Some(30), ..quiet() }, &mut |_| {}).unwrap();
@@ -93,9 +99,7 @@ fn a_resumed_run_takes_the_new_solver_settings_at_its_step() {
 #[test]
 fn what_the_change_of_solver_refuses() {
     let dir = scratch::path("refused");
-    let text =
-        std::fs::read_to_string("examples/cubes3d.toml").unwrap().replacen("duration = 0.5", "duration = 0.02", 1);
-    let a = variant(&dir, "a.toml", &text, "tolerance = 1.0e-6", "tolerance = 1.0e-6");
+    let (text, a) = cubes(&dir, "0.02");
     let out = dir.join("run");
     run_file(&a, &out, &RunOptions { stop_after: Some(10), ..quiet() }, &mut |_| {}).unwrap();
     let opts = RunOptions { resume: true, change_solver: true, ..quiet() };
