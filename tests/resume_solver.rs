@@ -140,4 +140,8 @@ fn a_2d_run_takes_a_new_tolerance() {
     assert_eq!(end.step, 40);
     let keys: Vec<_> = end.solver_changes.iter().map(|c| (c.step, c.key.as_str(), c.after.as_str())).collect();
     assert_eq!(keys, [(20, "nscd.tolerance", "0.000001")]);
+    // A fresh run in the folder leaves no record of the earlier run's change.
+    assert!(out.join("solver_changes.csv").is_file());
+    run_file(&b, &out, &quiet(), &mut |_| {}).unwrap();
+    assert!(!out.join("solver_changes.csv").exists());
 }

@@ -31,7 +31,7 @@ pub struct RunArgs {
     resume: bool,
     /// With --resume: the scene may differ from the run's in its `[nscd]` solver keys (criterion, tolerance,
     /// sweep caps, anderson, solver, …), every other key the same; the run goes on from its checkpoint with the
-    /// new settings and records them in `DIR/solver_changes.csv` (not for runs with `[settlement]`)
+    /// new settings and records them in `DIR/solver_changes.csv` (not for runs with `[settlement]`).
     #[arg(long, requires = "resume")]
     change_solver: bool,
     /// Stop after this many steps in this invocation, with a checkpoint to resume from.

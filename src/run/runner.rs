@@ -100,8 +100,9 @@ pub struct Runner<E: Engine> {
     plan: RunPlan,
     /// The scene's text or the system's serde form ([`Source`]).
     source: Source,
-    /// [`solver_change::model_crc32`] of the scene's text (`None` for a system built in code).
-    model_crc32: Option<u32>,
+    /// [`solver_change::model_crc32`] of the scene's text (`None` for a system built in code), computed when a
+    /// checkpoint first needs it (a parse of the whole scene).
+    model_crc32: std::sync::OnceLock<Option<u32>>,
     /// The scene file's path, for the header of `final_scene.toml`.
     scene_path: Option<PathBuf>,
     restart: Option<Restart<E>>,
@@ -141,7 +142,7 @@ impl<E: Engine> Runner<E> {
         Self {
             system,
             plan,
-            model_crc32: solver_change::model_crc32(&text),
+            model_crc32: std::sync::OnceLock::new(),
             source: Source::Scene { text },
             scene_path: Some(path.to_path_buf()),
             restart,
@@ -186,7 +187,7 @@ impl<E: Engine> Runner<E> {
             system,
             plan,
             source: Source::Code { json },
-            model_crc32: None,
+            model_crc32: std::sync::OnceLock::new(),
             scene_path: None,
             restart: None,
             model: None,
@@ -451,6 +452,7 @@ impl<E: Engine> Runner<E> {
             &[
                 layout::FINAL_SCENE,
                 layout::CHECKPOINT,
+                layout::SOLVER_CHANGES,
                 layout::CYCLES,
                 layout::FINAL,
                 layout::CONTACTS,
@@ -519,7 +521,7 @@ impl<E: Engine> Runner<E> {
     fn resume(&self, out: &Path, change_solver: bool) -> Result<Live<E>> {
         let path = folder::checkpoint_to_resume(out)?;
         let mut cp = if change_solver {
-            solver_change::load(out, E::NAME, (self.source.crc32(), self.model_crc32))?
+            solver_change::load(out, E::NAME, (self.source.crc32(), self.model_crc32()))?
         } else {
             Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source.crc32())?
         };
@@ -615,6 +617,14 @@ impl<E: Engine> Runner<E> {
         Ok(live)
     }
 
+    /// [`solver_change::model_crc32`] of the scene's text, `None` for a system built in code.
+    fn model_crc32(&self) -> Option<u32> {
+        *self.model_crc32.get_or_init(|| match &self.source {
+            Source::Scene { text } => solver_change::model_crc32(text),
+            Source::Code { .. } => None,
+        })
+    }
+
     /// Writes `checkpoint.json` for the run in progress.
     fn checkpoint(&self, out: &Path, live: &mut Live<E>) -> Result<()> {
         let series_bytes = live.series.sync()?;
@@ -629,7 +639,7 @@ impl<E: Engine> Runner<E> {
             version: env!("CARGO_PKG_VERSION").to_string(),
             engine: E::NAME.to_string(),
             source_crc32: self.source.crc32(),
-            model_crc32: self.model_crc32,
+            model_crc32: self.model_crc32(),
             first_step: live.first_step,
             step: live.sys.steps_done(),
             series_bytes,
