@@ -141,10 +141,26 @@ pub fn read_checked<T: DeserializeOwned>(dir: &Path) -> Result<(PathBuf, T)> {
 /// # Errors
 /// [`Error::Checkpoint`] naming what differs.
 pub fn check_origin(path: &Path, (engine, version, source_crc32): (&str, &str, u32), want: (&str, u32)) -> Result<()> {
-    if engine != want.0 {
+    check_writer(path, (engine, version), want.0)?;
+    if source_crc32 != want.1 {
+        return Err(Error::Checkpoint(format!(
+            "{}: the checkpoint was written for another scene; start a fresh run instead of resuming",
+            path.display()
+        )));
+    }
+    Ok(())
+}
+
+/// Checks the engine and version a checkpoint at `path` was written by against the engine `want` and this
+/// build ([`check_origin`] without the scene).
+///
+/// # Errors
+/// [`Error::Checkpoint`] naming what differs.
+pub fn check_writer(path: &Path, (engine, version): (&str, &str), want: &str) -> Result<()> {
+    if engine != want {
         return Err(invalid(
             path,
-            format!("written by the {} engine, the scene is for {}", crate::error::clip(engine), want.0),
+            format!("written by the {} engine, the scene is for {want}", crate::error::clip(engine)),
         ));
     }
     let this = env!("CARGO_PKG_VERSION");
@@ -156,12 +172,6 @@ pub fn check_origin(path: &Path, (engine, version, source_crc32): (&str, &str, u
                 crate::error::clip(version)
             ),
         ));
-    }
-    if source_crc32 != want.1 {
-        return Err(Error::Checkpoint(format!(
-            "{}: the checkpoint was written for another scene; start a fresh run instead of resuming",
-            path.display()
-        )));
     }
     Ok(())
 }

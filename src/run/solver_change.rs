@@ -13,7 +13,7 @@
 //! `solver_changes.csv` (step, time, scene key, before, after) and a checkpoint with the new settings is written
 //! at once, so that the run resumes from then on with the new scene alone.
 
-use super::checkpoint::{check_origin, read_checked, Checkpoint};
+use super::checkpoint::{check_writer, read_checked, Checkpoint};
 use crate::error::{Error, Result};
 use crate::io::layout;
 use serde::de::DeserializeOwned;
@@ -67,7 +67,7 @@ pub fn load<S: Serialize + DeserializeOwned, C: Serialize + DeserializeOwned>(
 ) -> Result<Checkpoint<S, C>> {
     let (path, cp): (_, Checkpoint<S, C>) = read_checked(dir)?;
     // The engine and the version as a plain resume checks them; the scene below.
-    check_origin(&path, (&cp.engine, &cp.version, crc), (engine, crc))?;
+    check_writer(&path, (&cp.engine, &cp.version), engine)?;
     if cp.source_crc32 == crc {
         return Ok(cp);
     }
