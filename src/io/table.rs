@@ -198,7 +198,26 @@ pub fn read_columns(path: &Path, names: &[&str]) -> Result<Vec<Vec<f64>>> {
 /// Writes `rows` to a new table at `path` with the header of `R`'s fields
 /// (for summary tables of studies).
 pub fn write_all<R: Serialize>(path: &Path, rows: &[R]) -> Result<()> {
-    let mut w = csv::Writer::from_path(path).map_err(|e| csv_error(path, "create", e))?;
+    write_rows(path, rows, false)
+}
+
+/// Appends `rows` to the table at `path`, created with the header of `R`'s fields if it does not exist (a
+/// record that grows over the resumes of a run: `solver_changes.csv`).
+pub fn append_all<R: Serialize>(path: &Path, rows: &[R]) -> Result<()> {
+    write_rows(path, rows, true)
+}
+
+/// [`write_all`], or with `append` [`append_all`].
+fn write_rows<R: Serialize>(path: &Path, rows: &[R], append: bool) -> Result<()> {
+    let header = !(append && path.is_file());
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .write(true)
+        .append(append)
+        .truncate(!append)
+        .open(path)
+        .map_err(|e| io_error(path, "create", e))?;
+    let mut w = csv::WriterBuilder::new().has_headers(header).from_writer(file);
     for r in rows {
         w.serialize(r).map_err(|e| csv_error(path, "write", e))?;
     }

@@ -107,15 +107,7 @@ pub struct SolverChange {
 /// # Errors
 /// A file that cannot be written, named.
 pub fn record(out: &Path, changes: &[SolverChange]) -> Result<()> {
-    let path = out.join(layout::SOLVER_CHANGES);
-    let fresh = !path.is_file();
-    let io_err = |e: &dyn std::fmt::Display| crate::io::io_error(&path, "write", std::io::Error::other(e.to_string()));
-    let file = std::fs::OpenOptions::new().create(true).append(true).open(&path).map_err(|e| io_err(&e))?;
-    let mut w = csv::WriterBuilder::new().has_headers(fresh).from_writer(file);
-    for c in changes {
-        w.serialize(c).map_err(|e| io_err(&e))?;
-    }
-    w.flush().map_err(|e| io_err(&e))
+    crate::io::table::append_all(&out.join(layout::SOLVER_CHANGES), changes)
 }
 
 #[cfg(test)]
