@@ -55,6 +55,9 @@ pub trait Engine: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// Whether a step solves an iterative problem (NSCD: NLGS sweeps), whose
     /// iterations and unconverged steps the summary reports.
     const ITERATIVE: bool;
+    /// The scene keys (`table.key`) of the per-step solve's settings, which a run may change when it resumes
+    /// ([`Engine::change_solver`], [`crate::run::RunOptions::change_solver`]); none by default.
+    const SOLVER_KEYS: &'static [&'static str] = &[];
     /// What one step measured.
     type Stats: Copy + std::fmt::Debug;
     /// One row of `series.csv` (serde, written by the run loop and read back by the engine's rows module, e.g.

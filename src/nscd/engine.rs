@@ -32,6 +32,7 @@ impl PlaneSystem for System {
 impl PlaneEngine for System {
     const NAME: &'static str = "nscd";
     const ITERATIVE: bool = true;
+    const SOLVER_KEYS: &'static [&'static str] = &crate::nscd::method::NlgsSettings::SCENE_KEYS;
     type Stats = StepStats;
 
     fn plane_step_once(&mut self) -> Result<StepStats> {

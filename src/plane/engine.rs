@@ -49,6 +49,8 @@ pub trait PlaneEngine: PlaneSystem + Clone + Send + Serialize + DeserializeOwned
     const NAME: &'static str;
     /// Whether a step solves an iterative problem ([`Engine::ITERATIVE`]).
     const ITERATIVE: bool;
+    /// As [`Engine::SOLVER_KEYS`] (none by default).
+    const SOLVER_KEYS: &'static [&'static str] = &[];
     /// What one step measured.
     type Stats: Copy + std::fmt::Debug;
 
@@ -112,6 +114,7 @@ impl<T: PlaneEngine> Engine for T {
     const DIM: usize = 2;
     const EXTRAPOLATED: usize = 2;
     const ITERATIVE: bool = <T as PlaneEngine>::ITERATIVE;
+    const SOLVER_KEYS: &'static [&'static str] = <T as PlaneEngine>::SOLVER_KEYS;
     type Stats = <T as PlaneEngine>::Stats;
     type Row = PlaneSeriesRow;
     type CycleState = PlaneCycleState;

@@ -521,7 +521,7 @@ impl<E: Engine> Runner<E> {
     fn resume(&self, out: &Path, change_solver: bool) -> Result<Live<E>> {
         let path = folder::checkpoint_to_resume(out)?;
         let mut cp = if change_solver {
-            solver_change::load(out, E::NAME, (self.source.crc32(), self.model_crc32()))?
+            solver_change::load(out, (self.source.crc32(), self.model_crc32()))?
         } else {
             Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source.crc32())?
         };
@@ -620,7 +620,7 @@ impl<E: Engine> Runner<E> {
     /// [`solver_change::model_crc32`] of the scene's text, `None` for a system built in code.
     fn model_crc32(&self) -> Option<u32> {
         *self.model_crc32.get_or_init(|| match &self.source {
-            Source::Scene { text } => solver_change::model_crc32(text),
+            Source::Scene { text } => solver_change::model_crc32(text, E::SOLVER_KEYS),
             Source::Code { .. } => None,
         })
     }

@@ -57,6 +57,7 @@ impl Engine for System3 {
     const DIM: usize = 3;
     const EXTRAPOLATED: usize = 3;
     const ITERATIVE: bool = true;
+    const SOLVER_KEYS: &'static [&'static str] = &crate::nscd::method::NlgsSettings::SCENE_KEYS;
     type Stats = StepStats3;
     type Row = SeriesRow3;
     type CycleState = CycleState3;

@@ -166,27 +166,54 @@ fn default_split_min_rows() -> usize {
 }
 
 impl NlgsSettings {
-    /// The settings of `new` that differ from these, as `[scene key, before, after]` in the order of the
-    /// `[nscd]` keys of `docs/scene-format.md` (what a run resumed with other solver settings records,
-    /// [`crate::run::solver_change`]); `split_min_rows`, which no scene sets, under its field name.
+    /// The scene keys of these settings (`[nscd]` of `docs/scene-format.md`), in the order of
+    /// [`Self::scene_values`]: the NSCD engines' [`crate::engine::Engine::SOLVER_KEYS`], which a run resumed
+    /// with other solver settings may change ([`crate::run::solver_change`]).
+    pub const SCENE_KEYS: [&'static str; 12] = [
+        "nscd.criterion",
+        "nscd.tolerance",
+        "nscd.min_iterations",
+        "nscd.max_iterations",
+        "nscd.max_factor",
+        "nscd.symmetric",
+        "nscd.relaxation",
+        "nscd.anderson",
+        "nscd.measure",
+        "nscd.solver",
+        "nscd.on_stall",
+        "nscd.stall_max_iterations",
+    ];
+
+    /// The values of [`Self::SCENE_KEYS`], as a scene writes them.
+    fn scene_values(&self) -> [String; 12] {
+        [
+            self.policy.name().into(),
+            self.tolerance.to_string(),
+            self.min_iterations.to_string(),
+            self.max_iterations.to_string(),
+            self.max_factor.to_string(),
+            self.symmetric.to_string(),
+            self.relaxation.to_string(),
+            self.anderson.to_string(),
+            self.measure.name().into(),
+            self.solver.name().into(),
+            self.on_stall.name().into(),
+            self.stall_max_iterations.to_string(),
+        ]
+    }
+
+    /// The settings of `new` that differ from these, as `[scene key, before, after]` in the order of
+    /// [`Self::SCENE_KEYS`] (what a run resumed with other solver settings records,
+    /// [`crate::run::solver_change`]); `split_min_rows`, which no scene sets, last under its field name.
     pub fn changes(&self, new: &NlgsSettings) -> Vec<[String; 3]> {
-        let (a, b) = (self, new);
-        let pairs: [(&str, String, String); 13] = [
-            ("nscd.criterion", a.policy.name().into(), b.policy.name().into()),
-            ("nscd.tolerance", a.tolerance.to_string(), b.tolerance.to_string()),
-            ("nscd.min_iterations", a.min_iterations.to_string(), b.min_iterations.to_string()),
-            ("nscd.max_iterations", a.max_iterations.to_string(), b.max_iterations.to_string()),
-            ("nscd.max_factor", a.max_factor.to_string(), b.max_factor.to_string()),
-            ("nscd.symmetric", a.symmetric.to_string(), b.symmetric.to_string()),
-            ("nscd.relaxation", a.relaxation.to_string(), b.relaxation.to_string()),
-            ("nscd.anderson", a.anderson.to_string(), b.anderson.to_string()),
-            ("nscd.measure", a.measure.name().into(), b.measure.name().into()),
-            ("nscd.solver", a.solver.name().into(), b.solver.name().into()),
-            ("nscd.on_stall", a.on_stall.name().into(), b.on_stall.name().into()),
-            ("nscd.stall_max_iterations", a.stall_max_iterations.to_string(), b.stall_max_iterations.to_string()),
-            ("split_min_rows", a.split_min_rows.to_string(), b.split_min_rows.to_string()),
-        ];
-        pairs.into_iter().filter(|(_, x, y)| x != y).map(|(k, x, y)| [k.to_string(), x, y]).collect()
+        let keys = Self::SCENE_KEYS.map(String::from);
+        let split = |s: &Self| s.split_min_rows.to_string();
+        let pairs = keys.into_iter().zip(self.scene_values().into_iter().zip(new.scene_values()));
+        pairs
+            .chain(std::iter::once(("split_min_rows".to_string(), (split(self), split(new)))))
+            .filter(|(_, (x, y))| x != y)
+            .map(|(k, (x, y))| [k, x, y])
+            .collect()
     }
 
     /// Whether a problem of `rows` rows (contacts + springs) is solved split in two halves
