@@ -166,9 +166,9 @@ fn default_split_min_rows() -> usize {
 }
 
 impl NlgsSettings {
-    /// The scene keys of these settings (`[nscd]` of `docs/scene-format.md`), in the order of
-    /// [`Self::scene_values`]: the NSCD engines' [`crate::engine::Engine::SOLVER_KEYS`], which a run resumed
-    /// with other solver settings may change ([`crate::run::solver_change`]).
+    /// The scene keys of these settings (`[nscd]` of `docs/scene-format.md`), in the order [`Self::changes`]
+    /// reports them: the NSCD engines' [`crate::engine::Engine::SOLVER_KEYS`], which a run resumed with other
+    /// solver settings may change ([`crate::run::solver_change`]).
     pub const SCENE_KEYS: [&'static str; 12] = [
         "nscd.criterion",
         "nscd.tolerance",
