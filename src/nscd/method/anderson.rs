@@ -119,6 +119,11 @@ fn carries(p: &[f64]) -> bool {
     p.iter().any(|&c| c != 0.0)
 }
 
+/// The weight `√W` of an entry whose Delassus diagonal is `d`.
+fn weight(d: f64) -> f64 {
+    d.max(0.0).sqrt()
+}
+
 /// `(a · b, a · c)` in one pass over `a` (it is read once for both).
 fn dot_pair(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
     let (mut s, mut t) = ([0.0; 4], [0.0; 4]);
@@ -182,7 +187,7 @@ impl Lane {
         self.w.clear();
         self.x.clear();
         for s in springs {
-            self.w.push(s.w().max(0.0).sqrt());
+            self.w.push(weight(s.w()));
             self.x.push(s.impulse());
         }
         self.at.clear();
@@ -191,9 +196,7 @@ impl Lane {
         for (i, r) in rows.iter().enumerate() {
             let p = r.impulse();
             if carries(p.as_ref()) {
-                self.at[i] = self.x.len() as u32;
-                self.live.push(i as u32);
-                self.w.extend(r.diagonal().as_ref().iter().map(|d| d.max(0.0).sqrt()));
+                self.enlist(i, r, self.x.len());
                 self.x.extend_from_slice(p.as_ref());
             }
         }
@@ -218,6 +221,13 @@ impl Lane {
         self.du.resize(self.ug.len() * depth, 0.0);
     }
 
+    /// Makes row `i` live, its entries starting at `at`: its place and its weights.
+    fn enlist<R: ConeRow>(&mut self, i: usize, r: &R, at: usize) {
+        self.at[i] = at as u32;
+        self.live.push(i as u32);
+        self.w.extend(r.diagonal().as_ref().iter().map(|&d| weight(d)));
+    }
+
     /// Takes the map's value `G(x)` from the rows and `u`: rows that carry an impulse for the first time become
     /// live (zero in the history so far); then the new residual, the new differences in `slots.new`, their dot
     /// products with the valid slots; `x` becomes `G(x)` (the start of the next map if no mix follows).
@@ -229,7 +239,7 @@ impl Lane {
         springs: &[S],
     ) -> Dots {
         let mut dots = Dots::default();
-        let g_new = &mut self.scratch;
+        let mut g_new = std::mem::take(&mut self.scratch);
         g_new.clear();
         g_new.extend(springs.iter().map(|s| s.impulse()));
         g_new.resize(self.x.len(), 0.0);
@@ -242,10 +252,8 @@ impl Lane {
                 g_new[at..at + p.len()].copy_from_slice(p);
             } else if carries(p) {
                 let at = g_new.len();
-                self.at[i] = at as u32;
-                self.live.push(i as u32);
+                self.enlist(i, r, at);
                 g_new.extend_from_slice(p);
-                self.w.extend(r.diagonal().as_ref().iter().map(|d| d.max(0.0).sqrt()));
                 for v in [&mut self.x, &mut self.g, &mut self.f] {
                     v.resize(at + p.len(), 0.0);
                 }
@@ -291,7 +299,8 @@ impl Lane {
             }
         }
         std::mem::swap(f, &mut self.x);
-        std::mem::swap(&mut self.g, g_new);
+        std::mem::swap(&mut self.g, &mut g_new);
+        self.scratch = g_new;
         self.x.clear();
         self.x.extend_from_slice(&self.g);
         if let Some(h) = slots.new {
@@ -308,7 +317,7 @@ impl Lane {
     /// Moves the live rows to the mixed point `G(x) − ΔG γ` and the bodies' velocities to `u(G(x)) − ΔU γ` (the
     /// same combination: `u` is affine in the impulses); where a row's law projects its mixed impulse, the
     /// projection's change is scattered to `u`. `x` becomes the mixed point. The other rows carry no impulse and
-    /// keep none.
+    /// keep none. Called right after [`Lane::absorb`], which left `x = G(x)`.
     pub(crate) fn mix<R: ConeRow, S: AffineRow<Dofs = R::Dofs>>(
         &mut self,
         gamma: &[f64; MAX_DEPTH],
@@ -318,8 +327,6 @@ impl Lane {
         springs: &mut [S],
     ) {
         let x = &mut self.x;
-        x.clear();
-        x.extend_from_slice(&self.g);
         subtract_columns(x, &self.dg, self.stride, gamma, self.depth);
         if self.velocities {
             let um = &mut self.scratch;
