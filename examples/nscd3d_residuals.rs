@@ -2,15 +2,19 @@
 //! point by point ([`ballast::nscd::d3::system::System3::check_by_point`]), the diagnosis behind
 //! docs/track3d.md, "Why Gauss–Seidel stops at the cap on the loaded 2 000-grain section".
 //!
-//! `cargo run --release --example nscd3d_residuals -- SCENE.toml [STEPS] [THREADS] [TOP]` (defaults 1, 1, 10).
-//! The scene runs with its own `[nscd]` settings. Printed after the last step:
+//! `cargo run --release --example nscd3d_residuals -- SCENE.toml [STEPS] [THREADS] [TOP] [RUN_DIR]` (defaults 1, 1,
+//! 10). The scene runs with its own `[nscd]` settings; with `RUN_DIR`, from the state of that run's
+//! `checkpoint.json` (its warm start included) instead of the scene's, with the scene's `[nscd]` settings (as
+//! `ballast run --resume --change-solver` takes them). Each step's sweeps are printed, and after the last step:
 //! - the step's sweeps and the `quad` norms of the check pass of the final iterate (`QuadDV`, `QuadDVR`,
 //!   `MeanDVoR`), summed over the springs and the points;
 //! - the share of `QuadDV`² and of `QuadDVR`² held by the springs and by the 1, 10, 100 and 1 000 leading points;
 //! - the TOP points by their share of `QuadDVR`² (of the springs' and points' sum), with their bodies, normal, impulse and the ratio
 //!   `|P_T| / P_N` (the friction coefficient when the point slides).
 
+use ballast::nscd::d3::system::System3;
 use ballast::nscd::method::criterion::SweepNorms;
+use ballast::run::checkpoint::{read_checked, Checkpoint};
 use ballast::scene::{Scene3, SceneFile};
 
 /// One of the sums of [`SweepNorms`].
@@ -23,10 +27,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let threads: usize = args.get(2).map_or(Ok(1), |s| s.parse())?;
     let top: usize = args.get(3).map_or(Ok(10), |s| s.parse())?;
     let mut sys = Scene3::load(path)?.build()?;
+    if let Some(dir) = args.get(4) {
+        let (_, checkpoint): (_, Checkpoint<System3, serde_json::Value>) = read_checked(std::path::Path::new(dir))?;
+        let settings = sys.params.nlgs;
+        sys = checkpoint.system;
+        sys.params.nlgs = settings;
+    }
     sys.set_threads(threads);
     let mut last = None;
     for _ in 0..steps {
-        last = Some(sys.step()?);
+        let t = std::time::Instant::now();
+        let stats = sys.step()?;
+        let s = t.elapsed().as_secs_f64();
+        println!("step {}: {} sweeps, converged {}, {s:.2} s", sys.steps, stats.nlgs.iterations, stats.nlgs.converged);
+        last = Some(stats);
     }
     let stats = last.ok_or("STEPS must be at least 1")?;
     let (springs, points) = sys.check_by_point();
