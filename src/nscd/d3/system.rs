@@ -36,7 +36,9 @@ use crate::nscd::contact::ContactLaw;
 use crate::nscd::method::anderson::{solve_nlgs_anderson_split, AndersonWorkspace};
 use crate::nscd::method::apgd::{solve_apgd_with, ApgdOptions, ApgdWorkspace};
 use crate::nscd::method::split::SplitWorkspace;
-use crate::nscd::method::{apply_impulses, check_by_row, NlgsReport, NlgsSettings, OnStall, Solver, SweepNorms};
+use crate::nscd::method::{
+    apply_impulses, check_by_row, remove_impulses, NlgsProblem, NlgsReport, NlgsSettings, OnStall, Solver, SweepNorms,
+};
 use crate::space::bodies::{advance, Bodies, Dofs6};
 use crate::space::detection::{Detector, FaceGaps};
 use crate::space::loads::LoadKind;
@@ -304,6 +306,25 @@ impl System3 {
         let (mut u, mut rows, mut springs) = (self.bodies.u.clone(), self.rows.clone(), self.spring_rows.clone());
         let (of_springs, norms) = check_by_row(&mut u, &self.bodies.inv_m, &mut rows, &mut springs);
         (of_springs, self.contacts.iter().map(|c| c.key).zip(norms).collect())
+    }
+
+    /// The last step's problem with its solution (as [`crate::nscd::System::nlgs_problem`] in 2D, for
+    /// benchmarks and solver prototypes, `examples/socp_prototype.rs`): the free velocities
+    /// `u_free = u − M⁻¹ Σ H P` recovered from the end velocities, the inverse masses, and the contact and spring
+    /// rows with the impulses the solve found (zero them for a cold start). `None` before the first step and
+    /// after a failed one, as [`Self::check_by_point`].
+    pub fn nlgs_problem(&self) -> Option<NlgsProblem<ContactRow3, SpringRow3>> {
+        let kept = self.rows.len() == self.contacts.len()
+            && self.rows.iter().zip(&self.contacts).all(|(r, c)| (r.a, r.b) == (c.key.0, c.key.1) && r.p == c.p)
+            && self.spring_rows.len() == self.springs.len()
+            && self.spring_rows.iter().zip(&self.springs).all(|(r, s)| r.p == s.impulse);
+        if !kept || self.steps == 0 {
+            return None;
+        }
+        let (rows, springs) = (self.rows.clone(), self.spring_rows.clone());
+        let mut u = self.bodies.u.clone();
+        remove_impulses(&mut u, &self.bodies.inv_m, &rows, &springs);
+        Some(NlgsProblem { u, inv_m: self.bodies.inv_m.clone(), rows, springs })
     }
 
     /// The warm-start memory: the world impulses (N·s) of the last step's contact points, sorted by key.
