@@ -22,6 +22,10 @@
 //! factorised by faer's sparse Cholesky (symbolic once). Springs are taken as linear (their compression-only
 //! clamp is ignored and reported). The shift is updated from the iterate every `UPDATE` iterations.
 //!
+//! With `GUARD=1` in the environment, the 2D interior point's safeguards, in a first form: every step keeps the
+//! pairs in the wide neighbourhood `sqrt(det x det z) ≥ 1e-3 μ`, and after 3 steps shorter than 0.1 in a row the
+//! slacks are recomputed from the velocities and every pair moved inside its cone by a tenth of `sqrt(μ)`.
+//!
 //! **Judged** as the library judges NLGS: the impulses `P = A x` and the velocities `u_free + M⁻¹ H P` go through
 //! LMGC90's check pass and the scene's policy (`quad`), printed at every iteration with the duality gap and the
 //! residuals.
@@ -42,6 +46,8 @@ use nalgebra::{Matrix3, Vector3};
 use std::time::Instant;
 
 type M3 = Matrix3<f64>;
+/// The wide neighbourhood's γ (`GUARD`; 1e-3 in the 2D interior point).
+const GAMMA: f64 = 1e-3;
 type V3 = Vector3<f64>;
 const NONE: u32 = u32::MAX;
 
@@ -123,6 +129,34 @@ fn nt_scaling(x: &V3, z: &V3) -> (M3, M3, M3) {
     (w, wi, wi2)
 }
 
+/// A row's velocity `f(u)`, linear in the velocities of its bodies `(a, b)`, as its columns on their free dofs
+/// (numbered by `dof`) and its value from the other dofs: probed with unit steps of `probe` (the free velocities,
+/// left as they were).
+fn linear_map(
+    (a, b): (u32, u32),
+    dof: &[[u32; 6]],
+    probe: &mut [[f64; 6]],
+    f: impl Fn(&[[f64; 6]]) -> V3,
+) -> (Vec<(u32, V3)>, V3) {
+    let base = f(probe);
+    let (mut columns, mut rest) = (Vec::new(), base);
+    for i in [a, b].into_iter().filter(|&i| i != NONE) {
+        for d in 0..6 {
+            let j = dof[i as usize][d];
+            if j == NONE {
+                continue;
+            }
+            let keep = probe[i as usize][d];
+            probe[i as usize][d] = keep + 1.0;
+            let column = f(probe) - base;
+            probe[i as usize][d] = keep;
+            rest -= column * keep;
+            columns.push((j, column));
+        }
+    }
+    (columns, rest)
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.len() < 3 {
@@ -135,6 +169,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // (`z = A (Hᵀ v + (μ|U_T(v)| − c) e_N)` linearised with `B = I + μ e_N (0, t̂ᵀ)`), which is not symmetric:
     // faer's sparse LU instead of the Cholesky.
     let coupled = update < 0;
+    // GUARD=1 in the environment: the 2D interior point's safeguards (a wide neighbourhood, re-centring).
+    let guard = std::env::var("GUARD").is_ok_and(|g| g == "1");
     let update = update.max(0) as usize;
     let settings = Scene3::load(&args[0])?.build()?.params.nlgs;
     let (_, checkpoint): (_, Checkpoint<System3, serde_json::Value>) = read_checked(std::path::Path::new(&args[1]))?;
@@ -184,29 +220,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let n = mass.len();
-    // Probe a row's local map with unit velocities: the columns of Hᵀ on each dof of its bodies.
+    // Each row's local map, probed with unit velocities: the columns of Hᵀ on the free dofs of its bodies.
     let mut probe = u_free.clone();
-    let bodies_of = |a: u32, b: u32| [a, b].into_iter().filter(|&i| i != NONE).collect::<Vec<_>>();
     let mut locals = Vec::with_capacity(nlgs_rows.len());
     for r in &nlgs_rows {
-        let (a, b) = r.bodies();
-        let constant = V3::from(r.local_velocity(&u_free));
-        let mut dofs = Vec::new();
-        let mut fixed_part = constant;
-        for i in bodies_of(a, b) {
-            for d in 0..6 {
-                let j = dof[i as usize][d];
-                if j == NONE {
-                    continue;
-                }
-                let keep = probe[i as usize][d];
-                probe[i as usize][d] = keep + 1.0;
-                let col = V3::from(r.local_velocity(&probe)) - constant;
-                probe[i as usize][d] = keep;
-                fixed_part -= col * keep;
-                dofs.push((j, col));
-            }
-        }
+        let (dofs, fixed_part) = linear_map(r.bodies(), &dof, &mut probe, |u| V3::from(r.local_velocity(u)));
         // A frictionless point gets μ = 1e-6 (the scaling divides by μ): |P_T| ≤ 1e-6 P_N.
         locals.push(Local { dofs, constant: fixed_part, c: r.c_closed, mu: r.mu().max(1e-6) });
     }
@@ -216,24 +234,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut k0: Vec<(u32, u32, f64)> = (0..n as u32).map(|j| (j, j, mass[j as usize])).collect();
     let mut rhs0: Vec<f64> = (0..n).map(|j| mass[j] * vfree[j]).collect();
     for s in &springs0 {
-        let (a, b) = s.bodies();
-        let base = s.axial_velocity(&u_free);
-        let mut g = Vec::new();
-        let mut fixed_part = base;
-        for i in bodies_of(a, b) {
-            for d in 0..6 {
-                let j = dof[i as usize][d];
-                if j == NONE {
-                    continue;
-                }
-                let keep = probe[i as usize][d];
-                probe[i as usize][d] = keep + 1.0;
-                let col = s.axial_velocity(&probe) - base;
-                probe[i as usize][d] = keep;
-                fixed_part -= col * keep;
-                g.push((j, col));
-            }
-        }
+        let (g, fixed_part) = linear_map(s.bodies(), &dof, &mut probe, |u| V3::new(s.axial_velocity(u), 0.0, 0.0));
+        let (g, fixed_part): (Vec<(u32, f64)>, f64) = (g.into_iter().map(|(j, c)| (j, c[0])).collect(), fixed_part[0]);
         // P_s = hα − hβ (gᵀ v + fixed_part): K₀ += hβ g gᵀ, rhs₀ += g (hα − hβ fixed_part).
         let (ha, hb) = (s.h_alpha(), s.h_beta());
         for &(j, gj) in &g {
@@ -297,10 +299,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a0 = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &pattern)?;
     let symbolic = SymbolicLlt::try_new(a0.symbolic(), Side::Lower)?;
     let symbolic_lu = if coupled { Some(SymbolicLu::try_new(a0.symbolic())?) } else { None };
-    println!("pattern {} nonzeros (lower), symbolic {:.2} s", a0.compute_nnz(), t.elapsed().as_secs_f64());
+    println!(
+        "pattern {} nonzeros (the lower triangle; both with UPDATE < 0), symbolic {:.2} s",
+        a0.compute_nnz(),
+        t.elapsed().as_secs_f64()
+    );
     drop(pattern);
 
     let mut best = f64::INFINITY;
+    let mut short = 0;
     for it in 1..=iterations {
         let t = Instant::now();
         if (coupled || update > 0) && it > 1 && (coupled || (it - 1) % update == 0) {
@@ -435,13 +442,49 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             })
             .collect();
         let (dv, dx, dz) = solve(&d);
-        let alpha = (0.99 * step_length(&dx, &dz)).min(1.0);
+        let mut alpha = (0.99 * step_length(&dx, &dz)).min(1.0);
+        // The wide neighbourhood (GUARD): every pair keeps `sqrt(det x det z) ≥ γ μ` at the new point.
+        if guard {
+            for _ in 0..30 {
+                let (mut gap_new, mut worst) = (0.0, f64::INFINITY);
+                for k in 0..m {
+                    let (xn, zn) = (x[k] + alpha * dx[k], z[k] + alpha * dz[k]);
+                    gap_new += xn.dot(&zn);
+                    worst = worst.min((det(&xn).max(0.0) * det(&zn).max(0.0)).sqrt());
+                }
+                if worst >= GAMMA * gap_new / m as f64 {
+                    break;
+                }
+                alpha *= 0.7;
+            }
+            short = if alpha < 0.1 { short + 1 } else { 0 };
+        }
         for j in 0..n {
             v[j] += alpha * dv[j];
         }
         for k in 0..m {
             x[k] += alpha * dx[k];
             z[k] += alpha * dz[k];
+        }
+        // Re-centring (GUARD) after 3 short steps in a row: z from the velocities (no primal residual), then each
+        // pair moved along e until `x₀ − |x₁|` and `z₀ − |z₁|` are at least a tenth of `sqrt(μ)`.
+        if guard && short >= 3 {
+            short = 0;
+            let mut gap_now = 0.0;
+            for (k, l) in locals.iter().enumerate() {
+                z[k] = zk(l, &v, shift[k]);
+                gap_now += x[k].dot(&z[k]).abs();
+            }
+            let floor = 0.1 * (gap_now / m as f64).sqrt();
+            for k in 0..m {
+                for c in [&mut x[k], &mut z[k]] {
+                    let room = c[0] - c[1].hypot(c[2]);
+                    if room < floor {
+                        c[0] += floor - room;
+                    }
+                }
+            }
+            println!("it {it:3}: re-centred");
         }
         // Judged on the law: P = A x.
         let p: Vec<V3> = locals.iter().zip(&x).map(|(l, xk)| scale(l, *xk)).collect();
