@@ -526,6 +526,7 @@ fn the_last_steps_problem_is_the_step() {
         a.iter().zip(b).flat_map(|(x, y)| x.iter().zip(y).map(|(p, q)| (p - q).abs())).fold(0.0, f64::max)
     };
     assert!(gap(&u, &sys.bodies.u) < 1e-13, "{}", gap(&u, &sys.bodies.u));
+    assert!(problem.springs.is_empty(), "the pile has no springs");
     let (mut rows, mut springs) = (problem.rows.clone(), problem.springs.clone());
     for r in &mut rows {
         r.p = [0.0; 3];

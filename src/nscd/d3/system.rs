@@ -293,14 +293,7 @@ impl System3 {
     /// Both empty before the first step of this system and after a failed step.
     #[allow(clippy::type_complexity)]
     pub fn check_by_point(&self) -> (Vec<SweepNorms>, Vec<((u32, u32, u32), SweepNorms)>) {
-        // The rows are those of the kept step when they match its contact list point for point and its springs'
-        // impulses spring for spring (a failed step rebuilt and re-solved them without keeping anything; before
-        // the first step there are no spring rows, or nothing to report).
-        let kept = self.rows.len() == self.contacts.len()
-            && self.rows.iter().zip(&self.contacts).all(|(r, c)| (r.a, r.b) == (c.key.0, c.key.1) && r.p == c.p)
-            && self.spring_rows.len() == self.springs.len()
-            && self.spring_rows.iter().zip(&self.springs).all(|(r, s)| r.p == s.impulse);
-        if !kept {
+        if !self.rows_kept() {
             return (Vec::new(), Vec::new());
         }
         let (mut u, mut rows, mut springs) = (self.bodies.u.clone(), self.rows.clone(), self.spring_rows.clone());
@@ -314,17 +307,23 @@ impl System3 {
     /// rows with the impulses the solve found (zero them for a cold start). `None` before the first step and
     /// after a failed one, as [`Self::check_by_point`].
     pub fn nlgs_problem(&self) -> Option<NlgsProblem<ContactRow3, SpringRow3>> {
-        let kept = self.rows.len() == self.contacts.len()
-            && self.rows.iter().zip(&self.contacts).all(|(r, c)| (r.a, r.b) == (c.key.0, c.key.1) && r.p == c.p)
-            && self.spring_rows.len() == self.springs.len()
-            && self.spring_rows.iter().zip(&self.springs).all(|(r, s)| r.p == s.impulse);
-        if !kept || self.steps == 0 {
+        if !self.rows_kept() || self.steps == 0 {
             return None;
         }
         let (rows, springs) = (self.rows.clone(), self.spring_rows.clone());
         let mut u = self.bodies.u.clone();
         remove_impulses(&mut u, &self.bodies.inv_m, &rows, &springs);
         Some(NlgsProblem { u, inv_m: self.bodies.inv_m.clone(), rows, springs })
+    }
+
+    /// Whether the rows are those of the kept step: they match its contact list point for point and its springs'
+    /// impulses spring for spring (a failed step rebuilt and re-solved them without keeping anything; before the
+    /// first step there are no spring rows).
+    fn rows_kept(&self) -> bool {
+        self.rows.len() == self.contacts.len()
+            && self.rows.iter().zip(&self.contacts).all(|(r, c)| (r.a, r.b) == (c.key.0, c.key.1) && r.p == c.p)
+            && self.spring_rows.len() == self.springs.len()
+            && self.spring_rows.iter().zip(&self.springs).all(|(r, s)| r.p == s.impulse)
     }
 
     /// The warm-start memory: the world impulses (N·s) of the last step's contact points, sorted by key.
