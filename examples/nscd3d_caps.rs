@@ -1,6 +1,6 @@
 //! How far a 3D NSCD step's Gauss–Seidel iterate is from where it goes: one step solved from the same state with
 //! growing sweep caps, each iterate compared with the last one (the diagnosis behind docs/track3d.md, "What holds
-//! the seated section at `quad` 3e-5").
+//! the seated 2 000-grain section at `quad` 3e-5").
 //!
 //! `cargo run --release --example nscd3d_caps -- SCENE.toml RUN_DIR STEPS CAPS TOLERANCE [THREADS]`
 //! - the state is that of `RUN_DIR/checkpoint.json` (a run of `SCENE.toml`, its warm start included) with the
@@ -11,8 +11,9 @@
 //!   every solve run to its cap);
 //! - printed per cap: sweeps, converged, wall time; the contact points' states (open: `P_N` = 0; sliding:
 //!   `|P_T| ≥ (1 − 1e-6) μ P_N`; sticking otherwise) against the last cap's, as a 3 × 3 table (rows: this cap,
-//!   columns: the last; open, sticking, sliding); the mass-weighted relative difference of the grains'
-//!   translational velocities from the last cap's, `sqrt(Σ m |Δv|² / Σ m |v|²)`; the vertical velocity of the
+//!   columns: the last; open, sticking, sliding); the mass-weighted relative difference of the translational
+//!   velocities of the mobile bodies but the sleeper (the grains and the sublayer's pads) from the last cap's,
+//!   `sqrt(Σ m |Δv|² / Σ m |v|²)`; the vertical velocity of the
 //!   body named `sleeper` (m/s; the `z` component), which the settlement integrates.
 
 use ballast::nscd::d3::system::System3;
