@@ -100,10 +100,10 @@ pub fn record(out: &Path, changes: &[SolverChange]) -> Result<()> {
 mod tests {
     use super::*;
 
-    /// The solver keys do not count, every other key does; comments and spacing do not.
     /// The NSCD engines' solver keys.
     const K: &[&str] = &crate::nscd::method::NlgsSettings::SCENE_KEYS;
 
+    /// The solver keys do not count, every other key does; comments and spacing do not.
     #[test]
     fn the_model_crc_ignores_the_solver_keys_only() {
         let a = "[simulation]\ndt = 1e-3\n\n[nscd]\ntheta = 0.5\ntolerance = 1e-4\n";
