@@ -17,10 +17,11 @@
 //!   body named `sleeper` (m/s; the `z` component), which the settlement integrates.
 
 use ballast::nscd::d3::system::System3;
-use ballast::run::checkpoint::{read_checked, Checkpoint};
-use ballast::scene::{Scene3, SceneFile};
 use std::collections::HashMap;
 use std::time::Instant;
+
+#[path = "common/resumed.rs"]
+mod resumed;
 
 /// A point's state: 0 open, 1 sticking, 2 sliding.
 fn states(sys: &System3) -> HashMap<(u32, u32, u32), usize> {
@@ -33,8 +34,7 @@ fn states(sys: &System3) -> HashMap<(u32, u32, u32), usize> {
             1
         }
     };
-    let material = |i: u32| sys.bodies.info[i as usize].material as usize;
-    let mu = |a: u32, b: u32| sys.laws()[material(a) * sys.materials() + material(b)].friction;
+    let mu = |a: u32, b: u32| sys.law(a as usize, b as usize).friction;
     sys.contacts().iter().map(|c| (c.key, state(c.p, mu(c.key.0, c.key.1)))).collect()
 }
 
@@ -48,10 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let caps: Vec<usize> = args[3].split(',').map(str::parse).collect::<Result<_, _>>()?;
     let tolerance: f64 = args[4].parse()?;
     let threads: usize = args.get(5).map_or(Ok(2), |s| s.parse())?;
-    let settings = Scene3::load(&args[0])?.build()?.params.nlgs;
-    let (_, checkpoint): (_, Checkpoint<System3, serde_json::Value>) = read_checked(std::path::Path::new(&args[1]))?;
-    let mut sys = checkpoint.system;
-    sys.params.nlgs = settings;
+    let mut sys = resumed::system(&args[0], Some(&args[1]))?;
     sys.set_threads(threads);
     for _ in 0..steps {
         sys.step()?;

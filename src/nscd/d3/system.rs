@@ -336,7 +336,8 @@ impl System3 {
         &self.contacts
     }
 
-    fn law(&self, a: usize, b: usize) -> &ContactLaw {
+    /// The contact law between bodies `a` and `b` (that of their materials' pair).
+    pub fn law(&self, a: usize, b: usize) -> &ContactLaw {
         let (ma, mb) = (self.bodies.info[a].material as usize, self.bodies.info[b].material as usize);
         &self.laws[ma.min(self.materials - 1) * self.materials + mb.min(self.materials - 1)]
     }
