@@ -12,10 +12,10 @@
 //! - the TOP points by their share of `QuadDVR`² (of the springs' and points' sum), with their bodies, normal, impulse and the ratio
 //!   `|P_T| / P_N` (the friction coefficient when the point slides).
 
-use ballast::nscd::d3::system::System3;
 use ballast::nscd::method::criterion::SweepNorms;
-use ballast::run::checkpoint::{read_checked, Checkpoint};
-use ballast::scene::{Scene3, SceneFile};
+
+#[path = "common/resumed.rs"]
+mod resumed;
 
 /// One of the sums of [`SweepNorms`].
 type Part = fn(&SweepNorms) -> f64;
@@ -26,13 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let steps: u64 = args.get(1).map_or(Ok(1), |s| s.parse())?;
     let threads: usize = args.get(2).map_or(Ok(1), |s| s.parse())?;
     let top: usize = args.get(3).map_or(Ok(10), |s| s.parse())?;
-    let mut sys = Scene3::load(path)?.build()?;
-    if let Some(dir) = args.get(4) {
-        let (_, checkpoint): (_, Checkpoint<System3, serde_json::Value>) = read_checked(std::path::Path::new(dir))?;
-        let settings = sys.params.nlgs;
-        sys = checkpoint.system;
-        sys.params.nlgs = settings;
-    }
+    let mut sys = resumed::system(path, args.get(4).map(String::as_str))?;
     sys.set_threads(threads);
     let mut last = None;
     for _ in 0..steps {

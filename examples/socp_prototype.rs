@@ -5,7 +5,7 @@
 //!
 //! `cargo run --release --example socp_prototype -- SCENE.toml RUN_DIR STEPS [ITERATIONS] [UPDATE]`: the state
 //! of `RUN_DIR/checkpoint.json` with the scene's `[nscd]` settings, `STEPS` steps by NLGS, then the last step's
-//! problem ([`System3::nlgs_problem`]) solved again from a cold start by at most `ITERATIONS` (default 60)
+//! problem (`System3::nlgs_problem`) solved again from a cold start by at most `ITERATIONS` (default 60)
 //! interior-point iterations; `UPDATE` (default 1) is how many iterations pass between two updates of the
 //! De Saxcé shift (0: never, the convex problem with the shift of NLGS's solution).
 //!
@@ -32,18 +32,18 @@
 
 use ballast::nscd::d3::contact::ContactRow3;
 use ballast::nscd::d3::spring::SpringRow3;
-use ballast::nscd::d3::system::System3;
 use ballast::nscd::method::apgd::{AffineRow, ConeRow};
 use ballast::nscd::method::criterion::evaluate;
-use ballast::nscd::method::{check, Row};
-use ballast::run::checkpoint::{read_checked, Checkpoint};
-use ballast::scene::{Scene3, SceneFile};
+use ballast::nscd::method::{apply_impulses, check, Row};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 use nalgebra::{Matrix3, Vector3};
 use std::time::Instant;
+
+#[path = "common/resumed.rs"]
+mod resumed;
 
 type M3 = Matrix3<f64>;
 /// The wide neighbourhood's γ (`GUARD`; 1e-3 in the 2D interior point).
@@ -172,10 +172,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // GUARD=1 in the environment: the 2D interior point's safeguards (a wide neighbourhood, re-centring).
     let guard = std::env::var("GUARD").is_ok_and(|g| g == "1");
     let update = update.max(0) as usize;
-    let settings = Scene3::load(&args[0])?.build()?.params.nlgs;
-    let (_, checkpoint): (_, Checkpoint<System3, serde_json::Value>) = read_checked(std::path::Path::new(&args[1]))?;
-    let mut sys = checkpoint.system;
-    sys.params.nlgs = settings;
+    let mut sys = resumed::system(&args[0], Some(&args[1]))?;
+    let settings = sys.params.nlgs;
     sys.set_threads(2);
     let mut last = None;
     for _ in 0..steps {
@@ -187,15 +185,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (u_free, inv_m, nlgs_rows, springs0) = (problem.u, problem.inv_m, problem.rows, problem.springs);
     // The consistent pair of impulses `p` (contacts) and `ps` (springs): u = u_free + M⁻¹ H P, then the check.
     let judge = |rows: &mut Vec<ContactRow3>, springs: &mut Vec<SpringRow3>, p: &[V3], ps: &[f64]| {
-        let mut u = u_free.clone();
         for (r, pk) in rows.iter_mut().zip(p) {
             r.set_impulse([pk[0], pk[1], pk[2]]);
-            r.add_impulse(&mut u, &inv_m, 1.0);
         }
         for (s, &pk) in springs.iter_mut().zip(ps) {
             s.set_impulse(pk);
-            s.add_impulse(&mut u, &inv_m, 1.0);
         }
+        let mut u = u_free.clone();
+        apply_impulses(&mut u, &inv_m, rows, springs);
         let norms = check(&mut u, &inv_m, rows, springs);
         evaluate(settings.policy, settings.tolerance, settings.max_factor, &norms, 0.0).0
     };
