@@ -1,5 +1,5 @@
 //! Where Gauss–Seidel stalls on one frozen 3D NSCD step, and three cheap ways around the stall measured there (the
-//! diagnosis behind docs/track3d.md, "The plateau of the sweeps on the seated 2 000-grain section").
+//! diagnosis behind docs/track3d.md, "The plateau of the sweeps, and the section seating under `quad` 3e-5").
 //!
 //! `cargo run --release --example nscd3d_plateau -- SCENE.toml RUN_DIR SWEEPS EVERY [MODE] [TOP]`
 //! - the state is that of `RUN_DIR/checkpoint.json` (a run of `SCENE.toml`) with the scene's `[nscd]` settings,
