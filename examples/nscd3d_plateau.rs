@@ -21,7 +21,7 @@
 use ballast::nscd::d3::cone::project_cone;
 use ballast::nscd::d3::contact::ContactRow3;
 use ballast::nscd::d3::spring::SpringRow3;
-use ballast::nscd::method::{apply_impulses, check_by_row, sweep, SweepNorms};
+use ballast::nscd::method::{apply_impulses, check, check_by_row, sweep, SweepNorms};
 use std::collections::HashSet;
 
 #[path = "common/resumed.rs"]
@@ -47,14 +47,14 @@ fn mode(s: &str) -> Option<Mode> {
     }
 }
 
-/// The check pass of an iterate: per point, and the whole `(QuadDV, QuadDVR)`.
+/// The check pass of an iterate (which writes nothing): per point, and the whole `(QuadDV, QuadDVR)`.
 fn checked(
-    u: &[[f64; 6]],
+    u: &mut [[f64; 6]],
     inv_m: &[[f64; 6]],
-    rows: &[ContactRow3],
-    springs: &[SpringRow3],
+    rows: &mut [ContactRow3],
+    springs: &mut [SpringRow3],
 ) -> (Vec<SweepNorms>, [f64; 2]) {
-    let (of_springs, per) = check_by_row(&mut u.to_vec(), inv_m, &mut rows.to_vec(), &mut springs.to_vec());
+    let (of_springs, per) = check_by_row(u, inv_m, rows, springs);
     let total = per.iter().chain(&of_springs).fold(SweepNorms::default(), |a, b| a.merged(*b)).norms();
     (per, [total[0], total[2]])
 }
@@ -97,14 +97,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         done += every;
-        let (per, norms) = checked(&u, &inv_m, &rows, &springs);
+        let (per, norms) = checked(&mut u, &inv_m, &mut rows, &mut springs);
         work += n;
         let (mut ra, mut sa) = (rows.clone(), springs.clone());
         ra.iter_mut().zip(&sum_p).for_each(|(r, s)| r.p = s.map(|x| x / every as f64));
         sa.iter_mut().zip(&sum_s).for_each(|(r, s)| r.p = s / every as f64);
         let mut ua = u_free.clone();
         apply_impulses(&mut ua, &inv_m, &ra, &sa);
-        let (_, averaged) = checked(&ua, &inv_m, &ra, &sa);
+        let averaged = check(&mut ua, &inv_m, &mut ra, &mut sa).norms();
         let mut order: Vec<usize> = (0..rows.len()).collect();
         order.sort_by(|&i, &j| per[j].sum_dvdvrr.total_cmp(&per[i].sum_dvdvrr));
         let leading: HashSet<usize> = order.iter().take(top).copied().collect();
@@ -122,11 +122,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             leading.intersection(first).count(),
             bodies.len(),
             averaged[0],
-            averaged[1]
+            averaged[2]
         );
         match mode {
             Mode::Plain => {}
-            Mode::Local(sweeps, ring) => {
+            Mode::Local(local, ring) => {
                 let mut pick: Vec<usize> = leading.iter().copied().collect();
                 if ring {
                     pick = (0..rows.len())
@@ -135,12 +135,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
                 pick.sort_unstable();
                 let mut sub: Vec<ContactRow3> = pick.iter().map(|&i| rows[i]).collect();
-                for _ in 0..sweeps {
+                for _ in 0..local {
                     sweep(&mut u, &inv_m, &mut sub, &mut [] as &mut [SpringRow3], false);
                     work += sub.len();
                 }
                 pick.iter().zip(&sub).for_each(|(&i, r)| rows[i] = *r);
-                print!(" | {} points swept {sweeps} times", pick.len());
+                print!(" | {} points swept {local} times", pick.len());
             }
             Mode::Extrapolate => {
                 let mut best = (norms[1], 0.0, None);
@@ -151,7 +151,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     }
                     let mut ut = u_free.clone();
                     apply_impulses(&mut ut, &inv_m, &trial, &springs);
-                    let (_, [_, value]) = checked(&ut, &inv_m, &trial, &springs);
+                    let value = check(&mut ut, &inv_m, &mut trial, &mut springs).norms()[2];
                     work += 2 * n;
                     print!(" | β {beta}: {value:.2e}");
                     if value < best.0 {
