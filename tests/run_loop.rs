@@ -102,6 +102,9 @@ fn resume_is_bit_identical<E: Engine>(runner: &Runner<E>, other: &Runner<E>, sto
     let mut f = std::fs::OpenOptions::new().append(true).open(parts.join("series.csv")).unwrap();
     std::io::Write::write_all(&mut f, b"9e9,9e9,9,9,9,9e9,1,9e9,9e9,9e9\n").unwrap();
     drop(f);
+    let mut f = std::fs::OpenOptions::new().append(true).open(parts.join("cycle_times.csv")).unwrap();
+    std::io::Write::write_all(&mut f, b"999,1.0,1\n").unwrap();
+    drop(f);
     let end = runner.run(&parts, &resume, &mut |_| {}).unwrap();
     assert_eq!(end.status, Status::Ended(RunEnd::Finished));
     assert!(!parts.join("checkpoint.json").exists());
@@ -111,6 +114,20 @@ fn resume_is_bit_identical<E: Engine>(runner: &Runner<E>, other: &Runner<E>, sto
         assert_eq!(std::fs::read(&f).unwrap(), std::fs::read(&g).unwrap(), "{name:?} differs");
     }
     assert_eq!(summary_without_wall_time(&whole), summary_without_wall_time(&parts));
+    // The wall time of each cycle, in both folders: one row per row of cycles.csv (the rows written after the
+    // last checkpoint dropped, the cycles split by a stop timed across it), together no more than the run's.
+    for d in [&whole, &parts] {
+        let rows = ballast::run::cycle_times::read(d).unwrap();
+        let cycles = std::fs::read_to_string(d.join("cycles.csv")).unwrap().lines().count() as u64 - 1;
+        assert!(cycles >= 3, "{test}: {cycles} cycles");
+        assert_eq!(rows.iter().map(|r| r.cycle).collect::<Vec<_>>(), (1..=cycles).collect::<Vec<_>>(), "{d:?}");
+        let walls: Vec<f64> = rows.iter().map(|r| r.wall_s.expect("every cycle timed")).collect();
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap()).unwrap();
+        let run = summary["wall_time_s"].as_f64().unwrap();
+        let sum: f64 = walls.iter().sum();
+        assert!(walls.iter().all(|&w| w >= 0.0) && sum > 0.0 && sum <= run, "{d:?}: {walls:?} against {run} s");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -5,7 +5,8 @@
 //! - [`SERIES`]: one row of step statistics every `output.every` steps (the engine's row type);
 //! - [`CYCLES`]: per-cycle statistics with `output.cycles`, and with `output.cycles.positions` the reference
 //!   coordinates of every followed body ([`CYCLE_BODIES`]) and their displacement at each cycle end
-//!   ([`CYCLE_DISPLACEMENTS`], `.npy`; [`crate::run::positions`]);
+//!   ([`CYCLE_DISPLACEMENTS`], `.npy`; [`crate::run::positions`]), and the wall-clock time of each cycle
+//!   ([`CYCLE_TIMES`], [`crate::run::cycle_times`]);
 //! - [`FINAL`]: the state of every body (and wall) at the end ([`crate::engine::FinalState`]);
 //! - [`CONTACTS`]: every contact at the end with its point, normal and forces ([`crate::engine::contacts`]);
 //! - [`SUMMARY`]: wall time and speed, mean contacts, overlaps, NLGS iterations
@@ -56,6 +57,8 @@ pub const FAILED: &str = "failed.txt";
 pub const CYCLE_BODIES: &str = "cycle_bodies.csv";
 /// Their displacements at each cycle end.
 pub const CYCLE_DISPLACEMENTS: &str = "cycle_displacements.npy";
+/// The wall-clock time of each cycle (`crate::run::cycle_times`).
+pub const CYCLE_TIMES: &str = "cycle_times.csv";
 /// The per-cycle table of an accelerated run.
 pub const SETTLEMENT: &str = "settlement.csv";
 /// The per-jump table of an accelerated run.

@@ -77,6 +77,11 @@ pub struct Checkpoint<S, C> {
     pub positions: Option<crate::engine::Configuration>,
     /// CRC-32 of the records of `cycle_displacements.npy` (0 without positions).
     pub positions_crc32: u32,
+    /// The run's wall time ([`RunSummary::wall_time_s`]) when its last completed cycle ended, from which the cycle
+    /// under way is timed in `cycle_times.csv` ([`super::cycle_times`]); `None` without cycles (and in
+    /// checkpoints written before it was kept).
+    #[serde(default)]
+    pub cycle_wall_start_s: Option<f64>,
 }
 
 /// CRC-32 (IEEE) of `bytes`.

@@ -1,6 +1,6 @@
 //! Running a simulation: the run loop over any [`Engine`](crate::engine::Engine) ([`Runner`]: equilibrium
 //! stop, outputs, checkpoints and `--resume`, divergence handling, progress callback) and the run's records
-//! ([`summary`], [`checkpoint`], [`positions`]). A scene file of either engine is opened and run by
+//! ([`summary`], [`checkpoint`], [`positions`], [`cycle_times`]). A scene file of either engine is opened and run by
 //! [`crate::open::run_file`]:
 //!
 //! ```no_run
@@ -14,6 +14,7 @@
 //! [`RunPlan`] (see the crate documentation and `examples/library_run.rs`).
 
 pub mod checkpoint;
+pub mod cycle_times;
 mod equilibrium;
 pub mod folder;
 pub mod plan;

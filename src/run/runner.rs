@@ -25,6 +25,7 @@ use crate::io::table::TableWriter;
 use crate::io::vtk::PvdCollection;
 use crate::io::{self, RunInfo};
 use crate::run::checkpoint::Checkpoint;
+use crate::run::cycle_times::CycleTimes;
 use crate::run::positions::PositionsWriter;
 use crate::run::solver_change::{self, SolverChange};
 use crate::run::summary::{RunEnd, RunReport, RunSummary};
@@ -128,6 +129,8 @@ struct Live<E: Engine> {
     snapshots: PvdCollection,
     cycles: Option<(E::CycleState, TableWriter)>,
     cycles_done: u64,
+    /// The wall time of each cycle (with cycles).
+    cycle_times: Option<CycleTimes>,
     positions: Option<PositionsWriter>,
     first_step: u64,
     /// The solver settings changed on resuming.
@@ -259,6 +262,10 @@ impl<E: Engine> Runner<E> {
         }
         let mut live = if opts.resume { self.resume(out, opts.change_solver)? } else { self.start(out, opts)? };
         live.sys.set_threads(opts.threads.max(1));
+        let threads = live.sys.threads_used(opts.threads.max(1));
+        if let Some(t) = live.cycle_times.as_mut() {
+            t.set_threads(threads);
+        }
         Ok(live)
     }
 
@@ -301,7 +308,8 @@ impl<E: Engine> Runner<E> {
                 at_equilibrium = live.summary.equilibrium.observe(rule, rule.holds(en.kinetic, en.potential));
             }
             let written = k.is_multiple_of(plan.output_every) || k == end_step || at_equilibrium;
-            self.record_step(live, &stats, written, opts.vtk_every, (&vtk_dir, &pvd_path))?;
+            let wall = wall0 + started.elapsed().as_secs_f64();
+            self.record_step(live, &stats, (written, wall), opts.vtk_every, (&vtk_dir, &pvd_path))?;
             last_stats = Some((stats, written));
             let flow = control(&Progress {
                 step: k,
@@ -325,14 +333,14 @@ impl<E: Engine> Runner<E> {
         Ok(Ending { last_stats, diverged, at_equilibrium })
     }
 
-    /// The outputs of step `k` (made, with its statistics `stats`): its series row when `written`, the cycle
-    /// table's row and positions at a cycle's end, a VTK snapshot every `vtk_every` steps (into `vtk_dir`, listed
-    /// in the `.pvd` file).
+    /// The outputs of step `k` (made, with its statistics `stats`, at the run's wall time `wall_s`): its series
+    /// row when `written`, the cycle table's row (flushed), the cycle's wall time and positions at a cycle's end, a
+    /// VTK snapshot every `vtk_every` steps (into `vtk_dir`, listed in the `.pvd` file).
     fn record_step(
         &self,
         live: &mut Live<E>,
         stats: &E::Stats,
-        written: bool,
+        (written, wall_s): (bool, f64),
         vtk_every: u64,
         (vtk_dir, pvd_path): (&Path, &Path),
     ) -> Result<()> {
@@ -345,7 +353,11 @@ impl<E: Engine> Runner<E> {
             let done = cycles_at(live.sys.time(), c.frequency, live.sys.dt());
             if done > live.cycles_done {
                 table.write(&live.sys.cycle_end(state, done))?;
+                table.flush()?;
                 live.cycles_done = done;
+                if let Some(t) = live.cycle_times.as_mut() {
+                    t.record(done, wall_s)?;
+                }
                 if let Some(p) = live.positions.as_mut() {
                     let bodies = p.reference().bodies.clone();
                     p.append(&live.sys.configuration_of(&bodies))?;
@@ -459,6 +471,7 @@ impl<E: Engine> Runner<E> {
                 layout::SUMMARY,
                 layout::CYCLE_BODIES,
                 layout::CYCLE_DISPLACEMENTS,
+                layout::CYCLE_TIMES,
                 layout::SCENE,
                 layout::INITIAL_STATE,
             ],
@@ -499,6 +512,7 @@ impl<E: Engine> Runner<E> {
             summary,
             series,
             snapshots,
+            cycle_times: cycles.as_ref().map(|_| CycleTimes::create(out)),
             cycles,
             cycles_done: 0,
             positions,
@@ -603,6 +617,10 @@ impl<E: Engine> Runner<E> {
             summary: cp.summary,
             series,
             snapshots: cp.snapshots,
+            cycle_times: match &cycles {
+                Some(_) => Some(CycleTimes::resume(out, cp.cycles_done, cp.cycle_wall_start_s)?),
+                None => None,
+            },
             cycles,
             cycles_done: cp.cycles_done,
             positions,
@@ -655,6 +673,7 @@ impl<E: Engine> Runner<E> {
             cycles_done: live.cycles_done,
             positions: live.positions.as_ref().map(|p| p.reference().clone()),
             positions_crc32: live.positions.as_ref().map_or(0, |p| p.crc32()),
+            cycle_wall_start_s: live.cycle_times.as_ref().and_then(CycleTimes::start_wall_s),
         }
         .write(out)?;
         Ok(())
