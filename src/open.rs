@@ -211,9 +211,16 @@ impl Loaded {
         if !self.settles() {
             return Ok(None);
         }
-        if opts.change_solver {
+        if opts.change_solver || opts.extend {
+            let key = if opts.change_solver { "change_solver" } else { "extend" };
+            return Err(Error::Scene(format!(
+                "{key}: a run with [settlement] resumes only with the scene it started from"
+            )));
+        }
+        if opts.keep_checkpoint {
             return Err(Error::Scene(
-                "change_solver: a run with [settlement] resumes only with the scene it started from".into(),
+                "keep_checkpoint: a run with [settlement] ends without a checkpoint; ask for the cycles it should reach"
+                    .into(),
             ));
         }
         let opts = RunOptions { length: None, engine: None, ..opts.clone() };

@@ -145,3 +145,32 @@ fn a_2d_run_takes_a_new_tolerance() {
     run_file(&b, &out, &quiet(), &mut |_| {}).unwrap();
     assert!(!out.join("solver_changes.csv").exists());
 }
+
+/// `extend` with `change_solver` on the 3D engine: the cubes of [`cubes`] run 30 steps at `quad` 1e-6 and keep
+/// their checkpoint, then go on to 60 steps at `quad` 1e-4 with Anderson mixing; the files of the 60-step run
+/// stopped at 30 and resumed with the new settings, bit for bit. Without `change_solver` the new settings are
+/// refused as more than the duration.
+#[test]
+fn a_finished_run_is_extended_with_other_solver_settings() {
+    let dir = scratch::path("cubes-extend");
+    let (text, a60) = cubes(&dir, "0.06");
+    let a30 = variant(&dir, "a30.toml", &text, "duration = 0.06", "duration = 0.03");
+    let b60 = variant(&dir, "b60.toml", &text, "tolerance = 1.0e-6", "tolerance = 1.0e-4\nanderson = 3");
+    let (reference, extended) = (dir.join("reference"), dir.join("extended"));
+    let first = run_file(&a60, &reference, &RunOptions { stop_after: Some(30), ..quiet() }, &mut |_| {}).unwrap();
+    assert_eq!(first.status, Status::Stopped);
+    let change = RunOptions { resume: true, change_solver: true, ..quiet() };
+    run_file(&b60, &reference, &change, &mut |_| {}).unwrap();
+    let done = run_file(&a30, &extended, &RunOptions { keep_checkpoint: true, ..quiet() }, &mut |_| {}).unwrap();
+    assert_eq!((done.status, done.step), (Status::Ended(RunEnd::Finished), 30));
+    let plain = RunOptions { extend: true, change_solver: false, ..change.clone() };
+    let err = run_file(&b60, &extended, &plain, &mut |_| {}).unwrap_err().to_string();
+    assert!(err.contains("in more than simulation.duration;"), "{err}");
+    let end = run_file(&b60, &extended, &RunOptions { extend: true, ..change }, &mut |_| {}).unwrap();
+    assert_eq!((end.status, end.step, end.solver_changes.len()), (Status::Ended(RunEnd::Finished), 60, 2));
+    for f in ["series.csv", "final.json", "contacts.csv", "solver_changes.csv"] {
+        let (r, e) = (std::fs::read(reference.join(f)).unwrap(), std::fs::read(extended.join(f)).unwrap());
+        assert!(r == e, "{f} differs");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -408,3 +408,64 @@ fn an_opened_scene_runs_stops_and_resumes() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `extend` and `keep_checkpoint`, on both engines: a run of `n` steps (inside a loading cycle) that keeps its
+/// checkpoint, resumed with `extend` to `2n + 1` steps, writes the bytes of a run asked for `2n + 1` steps from
+/// the start (`n` is off the output grid, so the kept checkpoint must come before the last row); a finished
+/// run without a kept
+/// checkpoint, a plain resume with another length, an extension that ends before the step reached and a scene
+/// changed in more than its duration are refused, naming the option or key.
+#[test]
+fn a_kept_checkpoint_extends_a_finished_run_with_the_numbers_of_a_longer_run() {
+    use ballast::open::run_file;
+    use ballast::run::RunLength;
+    let dir = scratch::dir("extend");
+    let md = dir.join("md.toml");
+    std::fs::write(&md, md_scene(0.004, false)).unwrap();
+    let nscd = dir.join("nscd.toml");
+    std::fs::write(&nscd, nscd_text()).unwrap();
+    for (scene, n) in [(&nscd, 23), (&md, 2601)] {
+        let out = |name: &str| dir.join(format!("{}-{name}", scene.file_stem().unwrap().to_string_lossy()));
+        let steps = |k| RunOptions { length: Some(RunLength::Steps(k)), ..quiet() };
+        let whole = run_file(scene, &out("whole"), &steps(2 * n + 1), &mut |_| {}).unwrap();
+        assert_eq!((whole.status, whole.step), (Status::Ended(RunEnd::Finished), 2 * n + 1));
+        // Finished without a kept checkpoint: nothing to extend.
+        run_file(scene, &out("plain"), &steps(n), &mut |_| {}).unwrap();
+        let extend = |k| RunOptions { resume: true, extend: true, ..steps(k) };
+        let e = run_file(scene, &out("plain"), &extend(2 * n + 1), &mut |_| {}).unwrap_err().to_string();
+        assert!(e.contains("resume: no checkpoint.json"), "{e}");
+        // Kept: a finished run with its checkpoint.
+        let first = run_file(scene, &out("parts"), &RunOptions { keep_checkpoint: true, ..steps(n) }, &mut |_| {});
+        assert_eq!(first.unwrap().status, Status::Ended(RunEnd::Finished));
+        assert!(out("parts").join("checkpoint.json").is_file() && out("parts").join("final.json").is_file());
+        // Another length without `extend` is another scene; with it, not shorter than the steps made.
+        let resume = RunOptions { resume: true, ..steps(2 * n + 1) };
+        let e = run_file(scene, &out("parts"), &resume, &mut |_| {}).unwrap_err().to_string();
+        assert!(e.contains("another scene"), "{e}");
+        let e = run_file(scene, &out("parts"), &extend(n - 1), &mut |_| {}).unwrap_err().to_string();
+        assert!(e.contains("extend: simulation.duration ends the run at step") && !e.contains('\n'), "{e}");
+        // A scene changed in more than its duration.
+        let other = dir.join("other.toml");
+        let text = std::fs::read_to_string(scene).unwrap();
+        let changed = text.replacen("seed = ", "seed = 1", 1);
+        assert_ne!(changed, text, "the scenes have a seed");
+        std::fs::write(&other, changed).unwrap();
+        let e = run_file(&other, &out("parts"), &extend(2 * n + 1), &mut |_| {}).unwrap_err().to_string();
+        assert!(e.contains("differs from the run's") && e.contains("simulation.duration"), "{e}");
+        assert!(out("parts").join("final.json").is_file(), "a refused extension leaves the folder as it was");
+        let end = run_file(scene, &out("parts"), &extend(2 * n + 1), &mut |_| {}).unwrap();
+        assert_eq!((end.status, end.step), (Status::Ended(RunEnd::Finished), 2 * n + 1));
+        assert!(!out("parts").join("checkpoint.json").exists());
+        let files: Vec<PathBuf> = outputs(&out("whole")).into_iter().filter(|f| f.exists()).collect();
+        assert!(files.len() >= 4, "{files:?}");
+        for f in files.iter().chain(&[out("whole").join("contacts.csv"), out("whole").join("scene.toml")]) {
+            let g = out("parts").join(f.strip_prefix(out("whole")).unwrap());
+            assert_eq!(std::fs::read(f).unwrap(), std::fs::read(&g).unwrap(), "{f:?} differs");
+        }
+        assert_eq!(summary_without_wall_time(&out("whole")), summary_without_wall_time(&out("parts")));
+        let cycles = ballast::run::cycle_times::read(&out("parts")).unwrap();
+        let rows = std::fs::read_to_string(out("parts").join("cycles.csv")).unwrap().lines().count() as u64 - 1;
+        assert_eq!(cycles.iter().map(|r| r.cycle).collect::<Vec<_>>(), (1..=rows).collect::<Vec<_>>());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -34,6 +34,16 @@ pub struct RunArgs {
     /// new settings and records them in `DIR/solver_changes.csv` (not for runs with `[settlement]`).
     #[arg(long, requires = "resume")]
     change_solver: bool,
+    /// With --resume: the scene may differ from the run's in `[simulation] duration` (or --steps/--duration give
+    /// the new length), every other key the same; the run goes on past its end with the numbers of a run that
+    /// asked for the longer duration from the start. A finished run can be extended if it ran with
+    /// --keep-checkpoint (not for runs with `[settlement]`).
+    #[arg(long, requires = "resume")]
+    extend: bool,
+    /// At the end, keep a checkpoint of the last step (`DIR/checkpoint.json`) from which `--resume --extend`
+    /// continues the run.
+    #[arg(long)]
+    keep_checkpoint: bool,
     /// Stop after this many steps in this invocation, with a checkpoint to resume from.
     #[arg(long, value_name = "STEPS")]
     stop_after: Option<u64>,
@@ -86,6 +96,8 @@ pub fn main(a: RunArgs) -> Result<(), Failure> {
         checkpoint_every_s: a.checkpoint_every,
         resume: a.resume,
         change_solver: a.change_solver,
+        extend: a.extend,
+        keep_checkpoint: a.keep_checkpoint,
         stop_after: a.stop_after,
         vtk_every: a.vtk_every,
         threads: a.threads.unwrap_or_else(default_threads),

@@ -16,6 +16,7 @@
 pub mod checkpoint;
 pub mod cycle_times;
 mod equilibrium;
+pub mod extend;
 pub mod folder;
 pub mod plan;
 pub mod positions;

@@ -53,6 +53,15 @@ pub struct RunOptions {
     /// every other key the same ([`super::solver_change`]); the run goes on with the new settings and records
     /// the change in `solver_changes.csv`. A run of a system built in code, or with `[settlement]`, refuses it.
     pub change_solver: bool,
+    /// With `resume`: accept a scene whose `[simulation] duration` differs from the run's (a `length` override
+    /// is such a change), every other key the same (and the solver keys with `change_solver`): the run goes on
+    /// to the new end, which may not come before the step it has reached ([`super::extend`]). A finished run
+    /// has no checkpoint unless it ran with `keep_checkpoint`. A run of a system built in code, or with
+    /// `[settlement]`, refuses it.
+    pub extend: bool,
+    /// At the end of a finished run, keep a checkpoint of its last step (`checkpoint.json`) from which `extend`
+    /// continues it (refused with `[settlement]`).
+    pub keep_checkpoint: bool,
     /// Stop after this many steps in this invocation, leaving a checkpoint.
     pub stop_after: Option<u64>,
     /// A VTK snapshot every this many steps (0: none).
@@ -90,6 +99,8 @@ impl Default for RunOptions {
             checkpoint_every_s: 300.0,
             resume: false,
             change_solver: false,
+            extend: false,
+            keep_checkpoint: false,
             stop_after: None,
             vtk_every: 0,
             threads: default_threads(),
@@ -127,6 +138,9 @@ pub fn check_options(opts: &RunOptions) -> Result<()> {
     }
     if opts.change_solver && !opts.resume {
         return Err(Error::Scene("change_solver: changes the solver of a resumed run; set resume too".into()));
+    }
+    if opts.extend && !opts.resume {
+        return Err(Error::Scene("extend: continues a resumed run past its end; set resume too".into()));
     }
     Ok(())
 }

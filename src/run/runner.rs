@@ -26,6 +26,7 @@ use crate::io::vtk::PvdCollection;
 use crate::io::{self, RunInfo};
 use crate::run::checkpoint::Checkpoint;
 use crate::run::cycle_times::CycleTimes;
+use crate::run::extend;
 use crate::run::positions::PositionsWriter;
 use crate::run::solver_change::{self, SolverChange};
 use crate::run::summary::{RunEnd, RunReport, RunSummary};
@@ -260,7 +261,7 @@ impl<E: Engine> Runner<E> {
         if self.plan.output_every == 0 {
             return Err(Error::Scene("output.every: must be at least 1, got 0".into()));
         }
-        let mut live = if opts.resume { self.resume(out, opts.change_solver)? } else { self.start(out, opts)? };
+        let mut live = if opts.resume { self.resume(out, opts)? } else { self.start(out, opts)? };
         live.sys.set_threads(opts.threads.max(1));
         let threads = live.sys.threads_used(opts.threads.max(1));
         if let Some(t) = live.cycle_times.as_mut() {
@@ -307,7 +308,9 @@ impl<E: Engine> Runner<E> {
                 let en = live.sys.energies(&stats, potential);
                 at_equilibrium = live.summary.equilibrium.observe(rule, rule.holds(en.kinetic, en.potential));
             }
-            let written = k.is_multiple_of(plan.output_every) || k == end_step || at_equilibrium;
+            // The last step's row comes after a kept checkpoint (`finish`) when it is off the output grid.
+            let last_row = k == end_step && !opts.keep_checkpoint;
+            let written = k.is_multiple_of(plan.output_every) || last_row || at_equilibrium;
             let wall = wall0 + started.elapsed().as_secs_f64();
             self.record_step(live, &stats, (written, wall), opts.vtk_every, (&vtk_dir, &pvd_path))?;
             last_stats = Some((stats, written));
@@ -421,6 +424,11 @@ impl<E: Engine> Runner<E> {
             live.series.flush()?;
             return Ok(outcome(Status::Stopped));
         }
+        let keep = opts.keep_checkpoint && diverged.is_none() && !at_equilibrium;
+        if keep {
+            // Before the last off-grid row: a run extended from it writes the rows of the longer run.
+            self.checkpoint(out, live)?;
+        }
         if let Some((stats, false)) = last_stats {
             // The run stopped off the output grid: its last good step gets a row.
             live.series.write(&live.sys.series_row(&stats))?;
@@ -440,7 +448,9 @@ impl<E: Engine> Runner<E> {
         if let Some(e) = diverged {
             return Err(e);
         }
-        io::remove_stale(out, layout::CHECKPOINT)?;
+        if !keep {
+            io::remove_stale(out, layout::CHECKPOINT)?;
+        }
         if let (Some(restart), Some(path)) = (&self.restart, &self.scene_path) {
             let text = format!(
                 "# Written by ballast {}: the state of {} at t = {} s (step {}).\n\
@@ -531,13 +541,21 @@ impl<E: Engine> Runner<E> {
     /// The run continued from the checkpoint in `out`, checked against the plan,
     /// the initial system and the files. The record of the input is written
     /// again (the checkpoint holds the CRC-32 of the scene text: it is the same, or with `change_solver` the
-    /// same but for the solver keys, whose changes are recorded and checkpointed at once).
-    fn resume(&self, out: &Path, change_solver: bool) -> Result<Live<E>> {
+    /// same but for the solver keys, whose changes are recorded and checkpointed at once; with `extend` it may
+    /// differ in its duration too). The outputs of an earlier end (`final.json`, `contacts.csv`,
+    /// `summary.json`, `final_scene.toml`) are removed.
+    fn resume(&self, out: &Path, opts: &RunOptions) -> Result<Live<E>> {
+        let change_solver = opts.change_solver;
         let path = folder::checkpoint_to_resume(out)?;
-        let mut cp = if change_solver {
-            solver_change::load(out, (self.source.crc32(), self.model_crc32()))?
-        } else {
-            Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source.crc32())?
+        let mut cp = match (&self.source, opts.extend) {
+            (Source::Scene { text }, true) => extend::load(out, text, change_solver)?,
+            (Source::Code { .. }, true) => {
+                return Err(Error::Scene(
+                    "extend: a run of a system built in code runs its plan's length; extend a run of a scene".into(),
+                ))
+            }
+            _ if change_solver => solver_change::load(out, (self.source.crc32(), self.model_crc32()))?,
+            _ => Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source.crc32())?,
         };
         let bad = |msg: String| folder::invalid_checkpoint(&path, msg);
         let changed = if change_solver { cp.system.change_solver(&self.system)? } else { Vec::new() };
@@ -546,6 +564,9 @@ impl<E: Engine> Runner<E> {
         let first = self.system.steps_done();
         let end = first.saturating_add(plan.steps);
         let step = cp.system.steps_done();
+        if opts.extend && cp.first_step == first && step > end {
+            return Err(extend::too_short(&path, (step, end), self.system.dt()));
+        }
         if cp.first_step != first || cp.step != step || !(first..=end).contains(&step) {
             return Err(bad(format!(
                 "its step {} (engine at {step}, started at {}) is not within this run's steps {first}..={end}",
@@ -607,7 +628,9 @@ impl<E: Engine> Runner<E> {
         if cp.snapshots.entries().iter().any(|e| !e.parts.iter().all(|p| out.join(&p.file).is_file())) {
             return Err(bad("a snapshot it lists is missing".into()));
         }
-        io::remove_stale(out, layout::FINAL_SCENE)?;
+        for stale in [layout::FINAL_SCENE, layout::FINAL, layout::CONTACTS, layout::SUMMARY] {
+            io::remove_stale(out, stale)?;
+        }
         self.write_records(out)?;
         let (step, time_s) = (cp.system.steps_done(), cp.system.time());
         let solver_changes: Vec<SolverChange> =

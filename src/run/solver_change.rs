@@ -24,8 +24,8 @@ use std::path::Path;
 
 /// The CRC-32 of the scene `text` with the `keys` (`table.key`, an engine's
 /// [`crate::engine::Engine::SOLVER_KEYS`]) taken out (and a table with them if nothing else is left in it), written
-/// back as TOML: comments and spacing do not count, the order of the keys does. `None` if `text` is not a TOML
-/// table.
+/// back as TOML: comments, spacing and the order of the keys within a table do not count (a table is written
+/// sorted), the order of the entries of an array of tables does. `None` if `text` is not a TOML table.
 pub fn model_crc32(text: &str, keys: &[&str]) -> Option<u32> {
     let mut table: toml::Table = text.parse().ok()?;
     for (section, key) in keys.iter().filter_map(|k| k.split_once('.')) {
