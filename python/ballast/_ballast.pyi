@@ -84,12 +84,16 @@ class Simulation:
         figures: bool = False,
         threads: Optional[int] = None,
         change_solver: bool = False,
+        extend: bool = False,
+        keep_checkpoint: bool = False,
     ) -> dict[str, Any]:
         """Runs through the library's run loop into ``out`` (None: a temporary folder) from the state held,
         ``steps`` steps (None: the scene's duration), and keeps the state reached. ``progress`` gets a dict at
         the first step, every 20 ms and at the last; ``False`` from it stops the run (a checkpoint). Ctrl-C stops
         it between two steps with a checkpoint and raises KeyboardInterrupt; ``resume=True`` continues the run
-        in ``out``, and with ``change_solver=True`` from a scene whose ``[nscd]`` solver keys differ. Returns
+        in ``out``, and with ``change_solver=True`` from a scene whose ``[nscd]`` solver keys differ;
+        ``extend=True`` continues it past its end to ``steps`` (a finished run keeps the checkpoint to extend
+        from when it ran with ``keep_checkpoint=True``). Returns
         ``status``, ``step``, ``end_step``, ``time`` (s), ``kinetic_energy`` (J), ``elapsed_s``, ``out``,
         ``report`` (``summary.json``), ``solver_changes`` (what ``change_solver`` changed)."""
     def settle(

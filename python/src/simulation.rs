@@ -183,7 +183,10 @@ impl Simulation {
     /// `threads`: threads of a step (1 or 2; `None`: 2 on a machine with 2 cores; the numbers do not depend on
     /// it). `change_solver` (with `resume`): the simulation's scene may differ from the run's in its `[nscd]`
     /// solver keys (tolerance, sweep caps, `anderson`, …), every other key the same; the run goes on with the new
-    /// settings and records them in `solver_changes.csv` (docs/scene-format.md).
+    /// settings and records them in `solver_changes.csv` (docs/scene-format.md). `extend` (with `resume`): the
+    /// scene may differ from the run's in its duration (`steps` is such a change), and the run goes on past its
+    /// end with the numbers of a run asked for the longer length from the start; a finished run keeps the
+    /// checkpoint to extend from only when it ran with `keep_checkpoint`.
     ///
     /// Returns a dict: `status` (`finished`, `equilibrium` or `stopped`), `step`, `end_step`, `time` (s),
     /// `kinetic_energy` (J), `elapsed_s`, `out` (`None` for a temporary folder), `report` (the contents of
@@ -194,7 +197,8 @@ impl Simulation {
     /// raises `DivergedError` (the outputs and the simulation hold the last good step).
     #[pyo3(signature = (
         out = None, steps = None, checkpoint_every = None, resume = false, progress = None, stop_after = None,
-        vtk_every = 0, figures = false, threads = None, change_solver = false
+        vtk_every = 0, figures = false, threads = None, change_solver = false, extend = false,
+        keep_checkpoint = false
     ))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
@@ -210,6 +214,8 @@ impl Simulation {
         figures: bool,
         threads: Option<usize>,
         change_solver: bool,
+        extend: bool,
+        keep_checkpoint: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         if resume && out.is_none() {
             return Err(PyValueError::new_err("resume: needs the folder `out` of the run to continue"));
@@ -219,6 +225,8 @@ impl Simulation {
             vtk_every,
             length: steps.map(RunLength::Steps),
             change_solver,
+            extend,
+            keep_checkpoint,
             ..options(&folder, checkpoint_every, resume, stop_after, figures, threads)
         };
         let loaded = &mut self.loaded;

@@ -61,6 +61,17 @@ def test_a_stopped_run_resumes_to_the_bytes_of_an_uninterrupted_one(tmp_path, ho
         sim.run(tmp_path / "parts", steps=steps, resume=True)
 
 
+def test_a_finished_run_is_extended_to_the_bytes_of_a_longer_one(tmp_path):
+    ballast.load(SPHERES).run(tmp_path / "whole", steps=401)
+    first = ballast.load(SPHERES).run(tmp_path / "parts", steps=200, keep_checkpoint=True)
+    assert first["status"] == "finished" and (tmp_path / "parts" / "checkpoint.json").is_file()
+    with pytest.raises(ballast.CheckpointError, match="another scene"):
+        ballast.load(SPHERES).run(tmp_path / "parts", steps=401, resume=True)
+    end = ballast.load(SPHERES).run(tmp_path / "parts", steps=401, resume=True, extend=True)
+    assert end["status"] == "finished" and end["step"] == 401
+    same_outputs(tmp_path / "whole", tmp_path / "parts")
+
+
 def test_a_run_resumes_with_another_tolerance(tmp_path):
     changed = tmp_path / "tight.toml"
     changed.write_text(BLOCK.read_text().replace("[output]", "[nscd]\ntolerance = 1e-6\n\n[output]", 1))
