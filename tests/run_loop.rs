@@ -441,7 +441,7 @@ fn a_kept_checkpoint_extends_a_finished_run_with_the_numbers_of_a_longer_run() {
         // Another length without `extend` is another scene; with it, not shorter than the steps made.
         let resume = RunOptions { resume: true, ..steps(2 * n + 1) };
         let e = run_file(scene, &out("parts"), &resume, &mut |_| {}).unwrap_err().to_string();
-        assert!(e.contains("another scene"), "{e}");
+        assert!(e.contains("another scene") && e.contains("only in simulation.duration: resume with extend"), "{e}");
         let e = run_file(scene, &out("parts"), &extend(n - 1), &mut |_| {}).unwrap_err().to_string();
         assert!(e.contains("extend: simulation.duration ends the run at step") && !e.contains('\n'), "{e}");
         // A scene changed in more than its duration.

@@ -76,6 +76,23 @@ pub fn load<E: Engine, C: Serialize + DeserializeOwned>(
     }
 }
 
+/// `err`, a plain resume's refusal of the scene `text` as another scene, with a hint when `text` differs from the
+/// run's copy in `dir` (`scene.toml`) only in [`LENGTH_KEY`]: an extension is what was meant.
+pub fn hint(err: Error, dir: &Path, text: &str) -> Error {
+    let Error::Checkpoint(msg) = &err else { return err };
+    if !msg.contains("another scene") {
+        return err;
+    }
+    let run = std::fs::read_to_string(dir.join(layout::SCENE)).ok();
+    let run_model = run.and_then(|t| model_crc32(&t, &[LENGTH_KEY]));
+    match (run_model, model_crc32(text, &[LENGTH_KEY])) {
+        (Some(a), Some(b)) if a == b => Error::Checkpoint(format!(
+            "{msg} (it differs from the run's only in {LENGTH_KEY}: resume with extend to run it longer)"
+        )),
+        _ => err,
+    }
+}
+
 /// The refusal of an extension whose new end (`end` steps of the engine) comes before the step `step` the run has
 /// reached.
 pub fn too_short(path: &Path, (step, end): (u64, u64), dt: f64) -> Error {
