@@ -485,3 +485,25 @@ fn an_opened_scene_settles_with_a_request_stops_and_resumes() {
         let _ = std::fs::remove_dir_all(dir);
     }
 }
+
+/// The run-loop options that change a run's scene or keep its last checkpoint are refused by a `[settlement]`
+/// run, before anything is written, with one line naming the option; `extend` without `resume` is refused as
+/// any run refuses it.
+#[test]
+fn a_settlement_run_refuses_the_run_loops_scene_changes() {
+    let dir = scratch::path("refusals");
+    let base = RunOptions { checkpoint_every_s: 0.0, threads: 1, ..RunOptions::default() };
+    let cases = [
+        (RunOptions { resume: true, change_solver: true, ..base.clone() }, "change_solver: "),
+        (RunOptions { resume: true, extend: true, ..base.clone() }, "extend: "),
+        (RunOptions { keep_checkpoint: true, ..base.clone() }, "keep_checkpoint: "),
+    ];
+    for (opts, key) in cases {
+        let e = settle_file(SCENE.as_ref(), &dir, &opts, &mut |_| {}).unwrap_err().to_string();
+        assert!(e.starts_with(key) && e.contains("[settlement]") && !e.contains('\n'), "{e}");
+        assert!(!dir.exists(), "{key}: nothing written");
+    }
+    let opts = RunOptions { extend: true, ..base };
+    let e = ballast::open::run_file("examples/block_on_floor.toml".as_ref(), &dir, &opts, &mut |_| {}).unwrap_err();
+    assert!(e.to_string().starts_with("extend: continues a resumed run past its end"), "{e}");
+}
