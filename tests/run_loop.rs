@@ -49,6 +49,15 @@ fn md_scene(duration: f64, with_lid: bool) -> String {
     out
 }
 
+/// [`nscd_text`] and [`md_scene`] (lasting `md_duration` seconds, no lid) written as `dir/nscd.toml` and
+/// `dir/md.toml`, for the tests that open scene files.
+fn scene_files(dir: &Path, md_duration: f64) -> (PathBuf, PathBuf) {
+    let (nscd, md) = (dir.join("nscd.toml"), dir.join("md.toml"));
+    std::fs::write(&nscd, nscd_text()).unwrap();
+    std::fs::write(&md, md_scene(md_duration, false)).unwrap();
+    (nscd, md)
+}
+
 fn quiet() -> RunOptions {
     RunOptions { checkpoint_every_s: 0.0, ..RunOptions::default() }
 }
@@ -319,10 +328,7 @@ fn a_run_length_replaces_the_scene_duration() {
     use ballast::open::run_file;
     use ballast::run::RunLength;
     let dir = scratch::dir("length");
-    let md = dir.join("md.toml");
-    std::fs::write(&md, md_scene(0.01, false)).unwrap();
-    let nscd = dir.join("nscd.toml");
-    std::fs::write(&nscd, nscd_text()).unwrap();
+    let (nscd, md) = scene_files(&dir, 0.01);
     for (scene, dt) in [(&nscd, 1e-3), (&md, 2e-6)] {
         let out = dir.join(format!("out-{}", scene.file_stem().unwrap().to_string_lossy()));
         for (length, steps) in [(RunLength::Steps(7), 7), (RunLength::Duration(11.0 * dt), 11)] {
@@ -364,10 +370,7 @@ fn an_opened_scene_runs_stops_and_resumes() {
     use ballast::open::{open, Loaded};
     use std::ops::ControlFlow;
     let dir = scratch::dir("run_on");
-    let md = dir.join("md.toml");
-    std::fs::write(&md, md_scene(0.004, false)).unwrap();
-    let nscd = dir.join("nscd.toml");
-    std::fs::write(&nscd, nscd_text()).unwrap();
+    let (nscd, md) = scene_files(&dir, 0.004);
     let steps_done = |l: &Loaded| match l {
         Loaded::Nscd(o) => o.system.steps_done(),
         Loaded::PlanarMd(o, _) => o.system.steps_done(),
@@ -412,18 +415,14 @@ fn an_opened_scene_runs_stops_and_resumes() {
 /// `extend` and `keep_checkpoint`, on both engines: a run of `n` steps (inside a loading cycle) that keeps its
 /// checkpoint, resumed with `extend` to `2n + 1` steps, writes the bytes of a run asked for `2n + 1` steps from
 /// the start (`n` is off the output grid, so the kept checkpoint must come before the last row); a finished
-/// run without a kept
-/// checkpoint, a plain resume with another length, an extension that ends before the step reached and a scene
-/// changed in more than its duration are refused, naming the option or key.
+/// run without a kept checkpoint, a plain resume with another length, an extension that ends before the step
+/// reached and a scene changed in more than its duration are refused, naming the option or key.
 #[test]
 fn a_kept_checkpoint_extends_a_finished_run_with_the_numbers_of_a_longer_run() {
     use ballast::open::run_file;
     use ballast::run::RunLength;
     let dir = scratch::dir("extend");
-    let md = dir.join("md.toml");
-    std::fs::write(&md, md_scene(0.004, false)).unwrap();
-    let nscd = dir.join("nscd.toml");
-    std::fs::write(&nscd, nscd_text()).unwrap();
+    let (nscd, md) = scene_files(&dir, 0.004);
     for (scene, n) in [(&nscd, 23), (&md, 2601)] {
         let out = |name: &str| dir.join(format!("{}-{name}", scene.file_stem().unwrap().to_string_lossy()));
         let steps = |k| RunOptions { length: Some(RunLength::Steps(k)), ..quiet() };

@@ -555,9 +555,12 @@ impl<E: Engine> Runner<E> {
                 ))
             }
             _ if change_solver => solver_change::load(out, (self.source.crc32(), self.model_crc32()))?,
-            (Source::Scene { text }, false) => Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source.crc32())
-                .map_err(|e| extend::hint(e, out, text))?,
-            (Source::Code { .. }, false) => Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source.crc32())?,
+            (source, false) => {
+                Checkpoint::<E, E::CycleState>::load(out, E::NAME, self.source.crc32()).map_err(|e| match source {
+                    Source::Scene { text } => extend::hint(e, out, text),
+                    Source::Code { .. } => e,
+                })?
+            }
         };
         let bad = |msg: String| folder::invalid_checkpoint(&path, msg);
         let changed = if change_solver { cp.system.change_solver(&self.system)? } else { Vec::new() };
