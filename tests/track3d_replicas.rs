@@ -309,3 +309,75 @@ fn the_commands_run_replicas_and_the_convergence_study() {
     assert_eq!(table.rows.len(), 4);
     assert!(table.rows.iter().all(|r| field(&table.header, r, "settlement_diff_m").parse::<f64>().is_ok()));
 }
+
+/// The convergence study from a loaded scene, a seated state (`ballast::scenarios::track3d::reloaded_scene`):
+/// the `final_scene.toml` of a one-cycle run of the sample, run on for two more cycles under each setting. Each
+/// run keeps the scene's own time step (not the loading's default) and is, cycle for cycle, what
+/// `ballast run SCENE --replica r` gives on that scene with its tolerance and duration edited by hand; the
+/// loading's other fields are refused by name, by the library and the command line, before any run.
+#[test]
+fn the_convergence_study_runs_on_from_a_loaded_scene() {
+    let (dir, s) = sample();
+    let dir = dir.join("reloaded");
+    let first = dir.join("first");
+    let loaded = dir.join("loaded.toml");
+    let scene = ballast::scenarios::track3d::loaded_scene(&Scene3::load(&s.path).unwrap(), &loading(1)).unwrap();
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(&loaded, scene.to_toml_string().unwrap()).unwrap();
+    let (code, err) = ballast(&["run", loaded.to_str().unwrap(), "--out", first.to_str().unwrap(), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let seated = first.join("final_scene.toml");
+    let out = dir.join("study");
+    // Only `cycles` is the study's: dt stays the scene's LOAD_DT although the loading says 2e-4 s.
+    let spec = ConvergenceSpec {
+        sample: seated.clone(),
+        policies: vec![("quad".into(), 1e-2)],
+        reference: Some(("quad".into(), 1e-3)),
+        replicas: replicas(2, 1e-6, 0),
+        loading: LoadingSpec { cycles: 2, ..LoadingSpec::default() },
+    };
+    let report = study::convergence(&spec, &StudyOptions { jobs: Some(2), ..StudyOptions::new(&out) }, &Quiet).unwrap();
+    assert!(report.failed.is_empty(), "{:?}", report.failed);
+    assert_eq!(report.table.unwrap().rows.len(), 4);
+    // The same runs by hand: the seated scene with the tolerance and two cycles' duration written in.
+    let mut by_hand = Scene3::load(&seated).unwrap();
+    by_hand.simulation.duration = 100.0 * LOAD_DT;
+    by_hand.nscd.as_mut().unwrap().tolerance = Some(1e-3);
+    let by_hand_file = dir.join("by_hand.toml");
+    std::fs::write(&by_hand_file, by_hand.to_toml_string().unwrap()).unwrap();
+    for r in ["0", "1"] {
+        let run = dir.join(format!("by_hand-{r}"));
+        let args = ["run", by_hand_file.to_str().unwrap(), "--out", run.to_str().unwrap(), "--quiet"];
+        let perturb = ["--replica", r, "--perturb", "1e-6", "--perturb-seed", "11"];
+        let (code, err) = ballast(&[&args[..], &perturb].concat());
+        assert_eq!(code, 0, "{err}");
+        let cycles = |d: &Path| std::fs::read_to_string(d.join("cycles.csv")).unwrap();
+        let studied = out.join("runs/quad_1e-3").join(format!("replica-{r}"));
+        assert_eq!(cycles(&studied), cycles(&run), "replica {r}");
+        let c = read_cycles(&studied.join("cycles.csv")).unwrap();
+        assert_eq!(c.len(), 2, "two cycles of 50 steps of the scene's own dt");
+    }
+    let written = Scene3::load(&out.join("scenes/quad_1e-2/replica-0.toml")).unwrap();
+    assert_eq!((written.simulation.dt, written.nscd.as_ref().unwrap().tolerance), (LOAD_DT, Some(1e-2)));
+    // A loading field other than cycles is the scene's own: refused by name, nothing run.
+    let bad = dir.join("bad");
+    let refuse = |loading: LoadingSpec, field: &str| {
+        let spec = ConvergenceSpec { loading, ..spec.clone() };
+        let e = study::convergence(&spec, &StudyOptions::new(&bad), &Quiet).unwrap_err().to_string();
+        assert!(e.starts_with(&format!("{field}:")) && !e.contains('\n'), "{e}");
+    };
+    refuse(LoadingSpec { cycles: 1, dt: LOAD_DT, ..LoadingSpec::default() }, "dt");
+    refuse(LoadingSpec { cycles: 1, anderson: 0, ..LoadingSpec::default() }, "anderson");
+    refuse(LoadingSpec { cycles: 0, ..LoadingSpec::default() }, "cycles");
+    let mut no_cycles = Scene3::load(&seated).unwrap();
+    no_cycles.output = None;
+    let no_cycles_file = dir.join("no_cycles.toml");
+    std::fs::write(&no_cycles_file, no_cycles.to_toml_string().unwrap()).unwrap();
+    let spec_nc = ConvergenceSpec { sample: no_cycles_file, ..spec.clone() };
+    let e = study::convergence(&spec_nc, &StudyOptions::new(&bad), &Quiet).unwrap_err().to_string();
+    assert!(e.starts_with("sample:") && e.contains("[output] cycles"), "{e}");
+    let args = ["track3d", "convergence", "--sample", seated.to_str().unwrap(), "--out", bad.to_str().unwrap()];
+    refused(&[&args[..], &["--dt", "1e-3", "--quiet"]].concat(), "--dt:");
+    refused(&[&args[..], &["--frequency", "10", "--quiet"]].concat(), "--frequency:");
+    assert!(!bad.join("runs").exists(), "nothing ran");
+}

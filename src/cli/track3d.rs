@@ -74,7 +74,8 @@ pub enum Track3dCommand {
     /// With --replicas R > 1: R runs from perturbed starts side by side in DIR/runs/replica-<r>/ (their
     /// starts in DIR/scenes/), and DIR/settlement_ensemble.csv (mean, sd, 95 % CI per cycle).
     Settle(Box<SettleArgs>),
-    /// The cycles of a sample with each convergence policy and tolerance, from R starts each: convergence.csv
+    /// The cycles of a sample (or of a loaded scene, from its seated state) with each convergence policy and
+    /// tolerance, from R starts each: convergence.csv
     /// (sweeps per step, steps at the cap, wall time per cycle, overlaps, settlement; the ensemble of each
     /// setting and its difference from the reference's with Welch's 95 % interval) and figures.
     /// (--criterion and --tolerance are replaced by those of each run.)
@@ -84,7 +85,9 @@ pub enum Track3dCommand {
 /// The arguments of `track3d convergence`.
 #[derive(Debug, clap::Args)]
 pub struct ConvergenceArgs {
-    /// A deposited sample (`sample.toml` of `ballast track3d sample`).
+    /// A deposited sample (`sample.toml` of `ballast track3d sample`), or a loaded scene to run on from its
+    /// state (a run's `final_scene.toml`, one with the sleeper): its loading and solver kept, --cycles of its
+    /// cycles under each policy; the other loading flags are then refused.
     #[arg(long, value_name = "FILE")]
     sample: PathBuf,
     /// Runs as POLICY:TOLERANCE, comma separated.

@@ -6,10 +6,12 @@
 //! 1. [`sample_scene`]: loose grains above the sublayer in a box of four smooth half-space walls, to deposit to
 //!    equilibrium (`[simulation] equilibrium`);
 //! 2. [`loaded_scene`]: the deposited sample with the sleeper placed on the highest grain under it, guided
-//!    along z, under the harmonic load, `[output] cycles` following it.
+//!    along z, under the harmonic load, `[output] cycles` following it;
+//! 3. [`reloaded_scene`]: a loaded scene (a run's `final_scene.toml`) run on for more cycles under another
+//!    stopping rule, the start of a study from a seated state.
 //!
-//! The files: `mod.rs` the sample, `loading.rs` the sleeper and its load, `measure.rs` what `sample.json`
-//! records.
+//! The files: `mod.rs` the sample, `loading.rs` the sleeper and its load, `reload.rs` the loaded scene run on,
+//! `measure.rs` what `sample.json` records.
 //!
 //! Decisions, written down (every default with its unit; `docs/track3d.md` has the same table):
 //! - **Axes.** `z` is up (gravity `(0, 0, −9.81)`), `x` along the track, `y` across it. The box is centred on
@@ -57,9 +59,11 @@
 
 mod loading;
 mod measure;
+mod reload;
 
 pub use loading::{loaded_scene, LoadingSpec, SLEEPER_GAP};
 pub use measure::{measure_sample, SampleReport};
+pub use reload::{is_loaded, reloaded_scene};
 
 use super::grains3d::{grains, GrainSpec};
 use super::{non_negative, positive, refuse, theta};

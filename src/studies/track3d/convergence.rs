@@ -6,7 +6,7 @@
 use super::replicas::write_start;
 use crate::error::{Error, Result};
 use crate::nscd::d3::rows::read_cycles;
-use crate::scenarios::track3d::{loaded_scene, LoadingSpec};
+use crate::scenarios::track3d::{is_loaded, loaded_scene, reloaded_scene, LoadingSpec};
 use crate::scene::{Scene3, SceneFile};
 use crate::studies::campaigns::{
     convergence_summary, label_number, not_summarized, reference_of, replica_labels, run_written, StudyOptions,
@@ -50,8 +50,8 @@ impl ConvergenceSpec {
     ///
     /// # Errors
     /// [`Error::Scene`] naming `replicas`, `perturbation.distance_m`, `policies` (none, or one whose policy or
-    /// tolerance is invalid), `reference` (likewise), `sample` (unreadable), or the loading's field (`cycles`,
-    /// `dt`, …).
+    /// tolerance is invalid), `reference` (likewise), `sample` (unreadable; a loaded scene without `[output]
+    /// cycles`), or the loading's field (`cycles`, `dt`, …; for a loaded scene, any field but `cycles` given).
     pub fn check(&self) -> Result<()> {
         self.scenes().map(drop)
     }
@@ -63,11 +63,13 @@ impl ConvergenceSpec {
             return Err(Error::Scene("policies: give at least one POLICY:TOLERANCE".into()));
         }
         let sample = Scene3::load(&self.sample)?;
+        let seated = is_loaded(&sample);
         self.settings()
             .iter()
             .map(|(policy, tol)| {
                 let loading = LoadingSpec { criterion: policy.clone(), tolerance: *tol, ..self.loading.clone() };
-                loaded_scene(&sample, &loading).map_err(|e| match e {
+                let scene = if seated { reloaded_scene(&sample, &loading) } else { loaded_scene(&sample, &loading) };
+                scene.map_err(|e| match e {
                     // The setting's own fields: named as the policy or reference they came from.
                     Error::Scene(m) if m.starts_with("criterion:") || m.starts_with("tolerance:") => {
                         let from =
@@ -83,8 +85,12 @@ impl ConvergenceSpec {
 
 /// The 3D convergence study (`ballast track3d convergence`): for each setting `(policy, tolerance)` (the
 /// policies, then the reference when it is not among them) and each replica `r`, the sample loaded with that
-/// criterion and tolerance
-/// (replica `r ≥ 1` perturbed, [`crate::studies::replicas::perturb_scene3`]), written as
+/// criterion and tolerance ([`loaded_scene`]) — or, when `spec.sample` is a loaded scene already (it has the
+/// sleeper: a run's `final_scene.toml`, a seated state), that scene for `spec.loading.cycles` cycles of its own
+/// loading with that criterion and tolerance, all its other settings kept ([`reloaded_scene`]; the other fields
+/// of `spec.loading` must then be the defaults) —
+/// (replica `r ≥ 1` perturbed, [`crate::studies::replicas::perturb_scene3`], as `ballast run --replica r`
+/// perturbs a scene), written as
 /// `DIR/scenes/<run>.toml` and run in `DIR/runs/<run>/` (`<run>` is `<policy>_<tolerance>/replica-<r>`, or
 /// `<policy>_<tolerance>` with one replica), `study.jobs` at a time; then, as the 2D study,
 /// `convergence.csv` (one row per run: the setting, `replica`, mean sweeps per step, steps at the sweep cap,
@@ -120,7 +126,16 @@ pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn R
     let Some(outcomes) = run_written(&labels, 0, study, 0, display, &mut failed, read_cycles)? else {
         return Ok(not_summarized(&study.out, failed));
     };
-    let iterations = (spec.loading.min_iterations, spec.loading.max_iterations);
+    let iterations = iterations(&scenes[0]);
     let seating = spec.replicas.seating_cycles.min(spec.loading.cycles);
     convergence_summary(&study.out, &runs, reference, &outcomes, &spec.replicas, seating, iterations, failed)
+}
+
+/// A loaded scene's `(min_iterations, max_iterations)`, the scene file's defaults where it gives none (a
+/// reloaded scene keeps its own; [`loaded_scene`] writes the loading's).
+fn iterations(scene: &Scene3) -> (usize, usize) {
+    let nlgs = crate::nscd::NscdParams::default().nlgs;
+    let ns = scene.nscd.as_ref();
+    let min = ns.and_then(|n| n.min_iterations).unwrap_or(nlgs.min_iterations);
+    (min, ns.and_then(|n| n.max_iterations).unwrap_or(nlgs.max_iterations.max(min)))
 }
