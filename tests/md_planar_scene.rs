@@ -33,11 +33,15 @@ fn scene_file(dir: &Path, text: &str) -> PathBuf {
 /// The block of `examples/block_on_floor.toml` (0.1 m square, 27 kg) run with
 /// `--engine md` and the default `[soft]`: one column of grains, so the
 /// reference load is its weight and the stiffness is set for an overlap of
-/// 1e-3 × its inradius (50 µm): at rest the face sits exactly that deep.
+/// 1e-3 × its inradius (50 µm): at rest the face sits exactly that deep. Asked for two threads, the summary
+/// records the one the planar step runs on.
 #[test]
 fn a_block_run_with_engine_md_rests_at_the_overlap_its_stiffness_was_derived_for() {
     let out = scratch::path("block");
-    let outcome = run_file(BLOCK.as_ref(), &out, &opts(Some("md")), &mut |_| {}).unwrap();
+    // Two threads asked: the planar step is not split, and the summary says it ran on one.
+    let two = RunOptions { threads: 2, ..opts(Some("md")) };
+    let outcome = run_file(BLOCK.as_ref(), &out, &two, &mut |_| {}).unwrap();
+    assert_eq!(json(&out.join("summary.json"))["threads"], 1);
     let run = json(&out.join("run.json"));
     assert_eq!(run["engine"], "md2d");
     let model = &run["model"];

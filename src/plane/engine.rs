@@ -69,6 +69,11 @@ pub trait PlaneEngine: PlaneSystem + Clone + Send + Serialize + DeserializeOwned
     /// Threads of a step ([`Engine::set_threads`]).
     fn plane_set_threads(&mut self, threads: usize);
 
+    /// The threads a step uses when `asked` were asked for ([`Engine::threads_used`]); default `asked`.
+    fn plane_threads_used(&self, asked: usize) -> usize {
+        asked
+    }
+
     /// Gravitational plus elastic potential energy (J).
     fn plane_potential_energy(&self) -> f64;
 
@@ -138,6 +143,10 @@ impl<T: PlaneEngine> Engine for T {
 
     fn set_threads(&mut self, threads: usize) {
         self.plane_set_threads(threads);
+    }
+
+    fn threads_used(&self, asked: usize) -> usize {
+        self.plane_threads_used(asked)
     }
 
     fn body_count(&self) -> usize {

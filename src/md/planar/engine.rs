@@ -60,6 +60,11 @@ impl PlaneEngine for PlanarSystem {
     /// One thread: the explicit step is not split.
     fn plane_set_threads(&mut self, _threads: usize) {}
 
+    /// One, whatever was asked: the run's summary and `cycle_times.csv` say so.
+    fn plane_threads_used(&self, _asked: usize) -> usize {
+        1
+    }
+
     fn plane_potential_energy(&self) -> f64 {
         self.potential_energy()
     }
