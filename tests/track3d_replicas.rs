@@ -357,7 +357,7 @@ fn the_convergence_study_runs_on_from_a_loaded_scene() {
         let c = read_cycles(&studied.join("cycles.csv")).unwrap();
         assert_eq!(c.len(), 2, "two cycles of 50 steps of the scene's own dt");
     }
-    let written = Scene3::load(&out.join("scenes/quad_1e-2/replica-0.toml")).unwrap();
+    let written = Scene3::load(out.join("scenes/quad_1e-2/replica-0.toml")).unwrap();
     assert_eq!((written.simulation.dt, written.nscd.as_ref().unwrap().tolerance), (LOAD_DT, Some(1e-2)));
     // A loading field other than cycles is the scene's own: refused by name, nothing run.
     let bad = dir.join("bad");
