@@ -87,7 +87,8 @@ pub enum Track3dCommand {
 pub struct ConvergenceArgs {
     /// A deposited sample (`sample.toml` of `ballast track3d sample`), or a loaded scene to run on from its
     /// state (a run's `final_scene.toml`, one with the sleeper): its loading and solver kept, --cycles of its
-    /// cycles under each policy; the other loading flags are then refused.
+    /// cycles under each policy; the other loading flags are then refused unless at their defaults (the scene's
+    /// own values apply).
     #[arg(long, value_name = "FILE")]
     sample: PathBuf,
     /// Runs as POLICY:TOLERANCE, comma separated.
