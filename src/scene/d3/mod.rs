@@ -115,8 +115,20 @@ pub use format::*;
 pub use validate::QUATERNION_TOLERANCE;
 
 use crate::error::{clip, Result};
+use crate::nscd::NlgsSettings;
 use crate::scene::common::{self, AccelerationPlan, SettlementRef, Simulation};
 use crate::scene::{OutputSection, SceneFile};
+
+impl Scene3 {
+    /// The solver settings a run of the scene takes (`[nscd]` with the defaults filled in), the scene checked
+    /// whole as [`SceneFile::validate`] checks it.
+    ///
+    /// # Errors
+    /// As [`SceneFile::validate`].
+    pub(crate) fn nlgs_settings(&self) -> Result<NlgsSettings> {
+        validate::check(self).map(|c| c.params.nlgs)
+    }
+}
 
 impl SceneFile for Scene3 {
     fn validate(&self) -> Result<()> {

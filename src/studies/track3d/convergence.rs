@@ -107,6 +107,9 @@ impl ConvergenceSpec {
 pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn RunDisplay) -> Result<StudyReport> {
     crate::io::figures::require()?; // the study ends with its figures
     let scenes = spec.scenes()?;
+    // Every setting's scene has the same caps (the settings differ in criterion and tolerance only): a reloaded
+    // scene keeps its own, `loaded_scene` writes the loading's.
+    let nlgs = scenes[0].nlgs_settings()?;
     let runs = spec.settings();
     let reference = reference_of(&runs, spec.reference.as_ref())?;
     study.threads()?;
@@ -126,16 +129,7 @@ pub fn convergence(spec: &ConvergenceSpec, study: &StudyOptions, display: &dyn R
     let Some(outcomes) = run_written(&labels, 0, study, 0, display, &mut failed, read_cycles)? else {
         return Ok(not_summarized(&study.out, failed));
     };
-    let iterations = iterations(&scenes[0]);
+    let iterations = (nlgs.min_iterations, nlgs.max_iterations);
     let seating = spec.replicas.seating_cycles.min(spec.loading.cycles);
     convergence_summary(&study.out, &runs, reference, &outcomes, &spec.replicas, seating, iterations, failed)
-}
-
-/// A loaded scene's `(min_iterations, max_iterations)`, the scene file's defaults where it gives none (a
-/// reloaded scene keeps its own; [`loaded_scene`] writes the loading's).
-fn iterations(scene: &Scene3) -> (usize, usize) {
-    let nlgs = crate::nscd::NscdParams::default().nlgs;
-    let ns = scene.nscd.as_ref();
-    let min = ns.and_then(|n| n.min_iterations).unwrap_or(nlgs.min_iterations);
-    (min, ns.and_then(|n| n.max_iterations).unwrap_or(nlgs.max_iterations.max(min)))
 }
